@@ -1,0 +1,205 @@
+# foldest: foldable estimators.
+#
+# The two commands a new user needs are `make demo` and `make check`; both
+# install missing Debian packages first (the `deps` step).  Everything is
+# discovered from the tree: literate/*.org tangle into include/ and src/,
+# src/*.c build the library, src/cli/*.c the `foldest` tool, tests/check_*.c
+# the Check suites, examples/*.c and bench/*.c one program each.
+
+VERSION      := 0.1.0
+SOVERSION    := 0
+PREFIX       ?= /usr/local
+DESTDIR      ?=
+LIBDIR       ?= $(PREFIX)/lib
+INCLUDEDIR   ?= $(PREFIX)/include
+BINDIR       ?= $(PREFIX)/bin
+
+CC           ?= cc
+CFLAGS       ?= -O2 -g
+WARN         := -std=c11 -Wall -Wextra -Werror -pedantic
+SAN          := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+B            := build
+
+# pkg-config is read when a recipe runs (after `deps`), hence `=` not `:=`.
+EXT_CFLAGS    = $(shell pkg-config --cflags lapacke blas)
+EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm
+BENCH_LIBS    = $(shell pkg-config --libs gsl)
+CHECK_CFLAGS  = $(shell pkg-config --cflags check)
+CHECK_LIBS    = $(shell pkg-config --libs check)
+
+ORG          := $(wildcard literate/*.org)
+LIB_SRC      := $(wildcard src/*.c)
+CLI_SRC      := $(wildcard src/cli/*.c)
+HEADERS      := include/foldest.h $(wildcard include/foldest/*.h)
+TEST_SRC     := $(wildcard tests/check_*.c)
+EXAMPLES     := $(patsubst examples/%.c,$(B)/examples/%,$(wildcard examples/*.c))
+BENCHES      := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
+
+LIB_OBJ      := $(patsubst src/%.c,$(B)/obj/%.o,$(LIB_SRC))
+SAN_OBJ      := $(patsubst src/%.c,$(B)/san/%.o,$(LIB_SRC))
+CLI_OBJ      := $(patsubst src/cli/%.c,$(B)/obj/cli/%.o,$(CLI_SRC))
+STATIC       := $(B)/lib/libfoldest.a
+SHARED       := $(B)/lib/libfoldest.so.$(VERSION)
+CLI          := $(B)/bin/foldest
+
+# Real recordings live beside the checkout; tests skip visibly without them.
+export FOLDEST_DATA ?= $(abspath ../shared/data)
+# One BLAS thread: the matrices are small and valgrind stays quiet.
+export OPENBLAS_NUM_THREADS := 1
+
+.PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
+        check-install check-tangle tangle doc demo bench install uninstall clean
+
+all: lib cli examples
+
+# ---------------------------------------------------------------- deps
+# A stamp records that the packages were present; .ci/deps does the work.
+deps: $(B)/.deps
+$(B)/.deps: .ci/deps
+	@sh .ci/deps
+	@mkdir -p $(B) && touch $@
+
+# ---------------------------------------------------------------- library
+lib: $(STATIC) $(SHARED)
+
+$(B)/obj/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) -fPIC -Iinclude $(EXT_CFLAGS) -c $< -o $@
+
+$(STATIC): $(LIB_OBJ)
+	@mkdir -p $(@D)
+	rm -f $@ && ar rcs $@ $^
+
+$(SHARED): $(LIB_OBJ)
+	@mkdir -p $(@D)
+	$(CC) -shared -Wl,-soname,libfoldest.so.$(SOVERSION) -o $@ $^ $(EXT_LIBS)
+	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so.$(SOVERSION)
+	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so
+
+# ---------------------------------------------------------------- command line
+cli: $(CLI)
+$(B)/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) -Iinclude -Isrc/cli -c $< -o $@
+$(CLI): $(CLI_OBJ) $(STATIC)
+	@mkdir -p $(@D)
+	$(if $(CLI_OBJ),$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
+
+# ---------------------------------------------------------------- examples, bench
+examples: $(EXAMPLES)
+$(B)/examples/%: examples/%.c $(STATIC)
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) -Iinclude -o $@ $< $(STATIC) $(EXT_LIBS)
+
+$(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -D_POSIX_C_SOURCE=200809L -O3 -march=native -g -Iinclude -Ibench $(EXT_CFLAGS) -o $@ $< $(STATIC) $(EXT_LIBS) $(BENCH_LIBS)
+
+bench: $(BENCHES)
+	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+
+# ---------------------------------------------------------------- tests
+# The runner adds every suite it finds: tests/check_<module>.c defines
+# `Suite *fe_<module>_suite(void)`, listed into suites.h at build time.
+$(B)/tests/suites.h: $(TEST_SRC)
+	@mkdir -p $(@D)
+	sed -n 's/^Suite \*\(fe_[a-z0-9_]*_suite\)(void)$$/FE_SUITE(\1)/p' $(TEST_SRC) > $@
+
+$(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC)
+	$(CC) $(WARN) -O2 -g -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS)
+
+$(B)/san/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
+
+$(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(SAN_OBJ)
+	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
+
+tests: $(B)/tests/check_foldest $(B)/tests/check_foldest_san
+
+check: check-plain check-san check-valgrind check-install
+
+check-plain: $(B)/tests/check_foldest all
+	@echo "== tests (plain build)"
+	$(B)/tests/check_foldest
+
+check-san: $(B)/tests/check_foldest_san
+	@echo "== tests (AddressSanitizer + UndefinedBehaviorSanitizer)"
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  $(B)/tests/check_foldest_san
+
+# Under valgrind the heavy statistical loops run smaller (FE_TEST_QUICK).
+check-valgrind: $(B)/tests/check_foldest
+	@echo "== tests (valgrind memcheck)"
+	CK_FORK=no FE_TEST_QUICK=1 valgrind -q --error-exitcode=99 --leak-check=full \
+	  --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible \
+	  $(B)/tests/check_foldest
+
+# Install into a scratch DESTDIR and build every example from it with pkg-config.
+check-install: lib
+	@echo "== install into a scratch DESTDIR; build the examples with pkg-config"
+	@set -e; d=$$(mktemp -d); trap 'rm -rf "$$d"' EXIT; \
+	$(MAKE) -s install DESTDIR="$$d" PREFIX=/usr/local >/dev/null; \
+	for e in examples/*.c; do \
+	  PKG_CONFIG_SYSROOT_DIR="$$d" PKG_CONFIG_PATH="$$d/usr/local/lib/pkgconfig" \
+	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest)' _ "$$d" "$$e"; \
+	  echo "built $$e against $$d/usr/local"; \
+	done
+
+# ---------------------------------------------------------------- literate
+# Tangle into a scratch copy, then copy only the files whose content changed,
+# so that make rebuilds only what really changed.
+TANGLE_TMP := $(B)/tangle
+.PHONY: tangle-scratch
+tangle-scratch: $(B)/.deps
+	@rm -rf $(TANGLE_TMP) && mkdir -p $(TANGLE_TMP)/literate
+	@cp $(ORG) $(TANGLE_TMP)/literate/
+	@cd $(TANGLE_TMP)/literate && emacs --batch -Q -l ../../../literate/tangle.el \
+	  -f fe-tangle $(notdir $(ORG)) 2>&1 | grep -v '^Tangled' || true
+
+tangle: tangle-scratch
+	@cd $(TANGLE_TMP) && find include src -type f | sort | while read f; do \
+	  if ! cmp -s "$$f" "../../$$f"; then mkdir -p "../../$$(dirname $$f)"; \
+	    cp "$$f" "../../$$f"; echo "tangled $$f"; fi; \
+	done
+
+check-tangle: tangle-scratch
+	@status=0; \
+	for f in $$(cd $(TANGLE_TMP) && find include src -type f | sort); do \
+	  cmp -s "$(TANGLE_TMP)/$$f" "$$f" || { echo "check-tangle: $$f differs from what literate/ produces"; status=1; }; \
+	done; \
+	for f in $$(find include src -type f | sort); do \
+	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
+	done; \
+	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org"; exit $$status
+
+doc: $(B)/.deps
+	@mkdir -p $(B)/doc
+	emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) 2>&1 | grep -E '^Wove|rror' || true
+	@echo "open $(B)/doc/index.html"
+
+# ---------------------------------------------------------------- demo
+demo: all
+	@sh examples/demo.sh $(B)
+
+# ---------------------------------------------------------------- install
+install: lib cli
+	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)/foldest
+	install -m 644 include/foldest.h $(DESTDIR)$(INCLUDEDIR)/
+	install -m 644 $(wildcard include/foldest/*.h) $(DESTDIR)$(INCLUDEDIR)/foldest/
+	install -m 644 $(STATIC) $(DESTDIR)$(LIBDIR)/
+	install -m 755 $(SHARED) $(DESTDIR)$(LIBDIR)/
+	ln -sf libfoldest.so.$(VERSION) $(DESTDIR)$(LIBDIR)/libfoldest.so.$(SOVERSION)
+	ln -sf libfoldest.so.$(VERSION) $(DESTDIR)$(LIBDIR)/libfoldest.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \
+	    -e 's|@VERSION@|$(VERSION)|' foldest.pc.in > $(DESTDIR)$(LIBDIR)/pkgconfig/foldest.pc
+	$(if $(CLI_OBJ),install -d $(DESTDIR)$(BINDIR) && install -m 755 $(CLI) $(DESTDIR)$(BINDIR)/,)
+
+uninstall:
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/foldest $(DESTDIR)$(INCLUDEDIR)/foldest.h
+	rm -f $(DESTDIR)$(LIBDIR)/libfoldest.* $(DESTDIR)$(LIBDIR)/pkgconfig/foldest.pc $(DESTDIR)$(BINDIR)/foldest
+
+clean:
+	rm -rf $(B)

@@ -1,0 +1,15 @@
+/* Tangled from literate/index.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../literate/index.org::Umbrella Header][Umbrella Header]] */
+#ifndef FOLDEST_H
+#define FOLDEST_H
+
+#define FE_VERSION "0.1.0"
+
+#include "foldest/error.h"
+#include "foldest/fold.h"
+#include "foldest/stream.h"
+#include "foldest/meanvar.h"
+#include "foldest/random.h"
+
+#endif /* FOLDEST_H */
+/* Umbrella Header ends here */

@@ -1,0 +1,248 @@
+/* Running mean and variance: the vectors of Kalman Folding, merge laws,
+   streaming equals batch, precision, refusal of bad input. */
+#include <float.h>
+#include <stdint.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+static const double ten[10] = {-0.178654, 0.828305, 0.0592247, -0.0121089,
+                               -1.48014,  -0.315044, -0.324796, -0.676357,
+                               0.16301,   -0.858164};
+
+START_TEST(mean_of_three)
+{
+    const double z[3] = {55, 89, 144};
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    size_t done = 99;
+    ck_assert_int_eq(fe_fold(&f, &a, z, 3, &done), FE_OK);
+    ck_assert_uint_eq(done, 3);
+    ck_assert_uint_eq(a.n, 3);
+    ck_assert_double_eq(fe_meanvar_mean(&a), 96.0);
+}
+END_TEST
+
+START_TEST(variance_scan_of_three)
+{
+    /* Kalman Folding: {0,0,0}, {0,55,1}, {578,72,2}, {2017,96,3} as
+       (variance, mean, n). */
+    const double z[3] = {55, 89, 144};
+    const double want[4][3] = {{0, 0, 0}, {0, 55, 1}, {578, 72, 2}, {2017, 96, 3}};
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY, out[4];
+    ck_assert_int_eq(fe_scan(&f, &a, z, 3, out, NULL), FE_OK);
+    for (int k = 0; k < 4; k++) {
+        ck_assert_double_eq_tol(fe_meanvar_variance(&out[k]), want[k][0], 1e-12);
+        ck_assert_double_eq_tol(fe_meanvar_mean(&out[k]), want[k][1], 1e-12);
+        ck_assert_uint_eq(out[k].n, (uint64_t)want[k][2]);
+    }
+}
+END_TEST
+
+START_TEST(ten_values)
+{
+    fe_meanvar a = FE_MEANVAR_EMPTY, b = FE_MEANVAR_EMPTY;
+    for (int i = 0; i < 10; i++)
+        ck_assert_int_eq(fe_meanvar_add(&a, ten[i]), FE_OK);
+    FE_ASSERT_REL(fe_meanvar_mean(&a), -0.27947242, 1e-12);
+    FE_ASSERT_REL(fe_meanvar_variance(&a), 0.3951831517200817, 1e-12);
+    /* The blocked path gives the same. */
+    ck_assert_int_eq(fe_meanvar_add_many(&b, ten, 10, NULL), FE_OK);
+    FE_ASSERT_REL(fe_meanvar_mean(&b), -0.27947242, 1e-12);
+    FE_ASSERT_REL(fe_meanvar_variance(&b), 0.3951831517200817, 1e-12);
+}
+END_TEST
+
+START_TEST(merge_every_split)
+{
+    fe_meanvar whole = FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_meanvar_add_many(&whole, ten, 10, NULL), FE_OK);
+    for (size_t s = 0; s <= 10; s++) {
+        fe_meanvar left = FE_MEANVAR_EMPTY, right = FE_MEANVAR_EMPTY;
+        for (size_t i = 0; i < s; i++)
+            ck_assert_int_eq(fe_meanvar_add(&left, ten[i]), FE_OK);
+        for (size_t i = s; i < 10; i++)
+            ck_assert_int_eq(fe_meanvar_add(&right, ten[i]), FE_OK);
+        ck_assert_int_eq(fe_meanvar_merge(&left, &right), FE_OK);
+        ck_assert_uint_eq(left.n, 10);
+        FE_ASSERT_REL(left.mean, whole.mean, 1e-12);
+        FE_ASSERT_REL(left.m2, whole.m2, 1e-12);
+    }
+}
+END_TEST
+
+START_TEST(merge_through_accumulator_is_associative)
+{
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar p = FE_MEANVAR_EMPTY, q = FE_MEANVAR_EMPTY, r = FE_MEANVAR_EMPTY;
+    fe_meanvar left, right;
+    ck_assert_int_eq(fe_fold(&f, &p, ten, 3, NULL), FE_OK);
+    ck_assert_int_eq(fe_fold(&f, &q, ten + 3, 4, NULL), FE_OK);
+    ck_assert_int_eq(fe_fold(&f, &r, ten + 7, 3, NULL), FE_OK);
+    left = p;                                   /* (p + q) + r */
+    ck_assert_int_eq(fe_merge(&f, &left, &q), FE_OK);
+    ck_assert_int_eq(fe_merge(&f, &left, &r), FE_OK);
+    right = q;                                  /* p + (q + r) */
+    ck_assert_int_eq(fe_merge(&f, &right, &r), FE_OK);
+    {
+        fe_meanvar t = p;
+        ck_assert_int_eq(fe_merge(&f, &t, &right), FE_OK);
+        right = t;
+    }
+    FE_ASSERT_REL(left.mean, right.mean, 1e-14);
+    FE_ASSERT_REL(left.m2, right.m2, 1e-14);
+}
+END_TEST
+
+START_TEST(empty_and_single)
+{
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY, e = FE_MEANVAR_EMPTY;
+    size_t done = 7;
+    ck_assert_int_eq(fe_fold(&f, &a, ten, 0, &done), FE_OK);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_uint_eq(a.n, 0);
+    ck_assert_double_eq(fe_meanvar_mean(&a), 0.0);
+    ck_assert_double_eq(fe_meanvar_variance(&a), 0.0);
+    ck_assert_double_eq(fe_meanvar_population_variance(&a), 0.0);
+    ck_assert_int_eq(fe_meanvar_add(&a, 3.5), FE_OK);
+    ck_assert_double_eq(fe_meanvar_mean(&a), 3.5);
+    ck_assert_double_eq(fe_meanvar_variance(&a), 0.0);
+    /* The empty accumulation is the identity of merge, on both sides. */
+    ck_assert_int_eq(fe_meanvar_merge(&a, &e), FE_OK);
+    ck_assert_uint_eq(a.n, 1);
+    ck_assert_double_eq(a.mean, 3.5);
+    ck_assert_int_eq(fe_meanvar_merge(&e, &a), FE_OK);
+    ck_assert_double_eq(e.mean, 3.5);
+}
+END_TEST
+
+START_TEST(nonfinite_is_refused_and_nothing_changes)
+{
+    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    for (int i = 0; i < 3; i++) {
+        fe_meanvar a = FE_MEANVAR_EMPTY, before;
+        ck_assert_int_eq(fe_meanvar_add_many(&a, ten, 10, NULL), FE_OK);
+        before = a;
+        ck_assert_int_eq(fe_meanvar_add(&a, bad[i]), FE_ENONFINITE);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+    }
+    /* Overflow of the deviation is refused, too. */
+    {
+        fe_meanvar a = FE_MEANVAR_EMPTY, before;
+        ck_assert_int_eq(fe_meanvar_add(&a, -DBL_MAX), FE_OK);
+        before = a;
+        ck_assert_int_eq(fe_meanvar_add(&a, DBL_MAX), FE_ENONFINITE);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+    }
+}
+END_TEST
+
+START_TEST(bulk_stops_exactly_at_the_bad_value)
+{
+    /* A NaN deep inside the second block: the blocked path must fold
+       exactly what precedes it, like the one-by-one path. */
+    enum { N = 2000, BAD = 777 };
+    static double x[N];
+    fe_rng r = fe_rng_seed(5);
+    fe_meanvar fast = FE_MEANVAR_EMPTY, slow = FE_MEANVAR_EMPTY;
+    fe_accumulator f = fe_meanvar_accumulator();
+    size_t done = 0;
+    for (int i = 0; i < N; i++)
+        x[i] = 10.0 + fe_rng_normal(&r);
+    x[BAD] = NAN;
+    ck_assert_int_eq(fe_fold(&f, &fast, x, N, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(done, BAD);
+    ck_assert_uint_eq(fast.n, BAD);
+    for (int i = 0; i < BAD; i++)
+        ck_assert_int_eq(fe_meanvar_add(&slow, x[i]), FE_OK);
+    FE_ASSERT_REL(fast.mean, slow.mean, 1e-13);
+    FE_ASSERT_REL(fast.m2, slow.m2, 1e-11);
+    /* Resuming after the bad value folds the rest. */
+    ck_assert_int_eq(fe_fold(&f, &fast, x + BAD + 1, N - BAD - 1, &done), FE_OK);
+    ck_assert_uint_eq(fast.n, N - 1);
+}
+END_TEST
+
+START_TEST(streaming_equals_batch)
+{
+    enum { N = 100003 };
+    static double x[N];
+    fe_rng r = fe_rng_seed(11);
+    fe_meanvar fast = FE_MEANVAR_EMPTY, slow = FE_MEANVAR_EMPTY;
+    long double sum = 0, ss = 0, mean;
+    int rc = FE_OK;
+    for (int i = 0; i < N; i++) {
+        x[i] = 3.0 + 2.0 * fe_rng_normal(&r);
+        sum += x[i];
+    }
+    mean = sum / N;
+    for (int i = 0; i < N; i++)
+        ss += (x[i] - mean) * (x[i] - mean);
+    ck_assert_int_eq(fe_meanvar_add_many(&fast, x, N, NULL), FE_OK);
+    for (int i = 0; i < N; i++)
+        rc |= fe_meanvar_add(&slow, x[i]);
+    ck_assert_int_eq(rc, FE_OK);
+    FE_ASSERT_REL(fast.mean, (double)mean, 1e-13);
+    FE_ASSERT_REL(slow.mean, (double)mean, 1e-12);
+    FE_ASSERT_REL(fe_meanvar_variance(&fast), (double)(ss / (N - 1)), 1e-12);
+    FE_ASSERT_REL(fe_meanvar_variance(&slow), (double)(ss / (N - 1)), 1e-12);
+}
+END_TEST
+
+START_TEST(precision_at_large_offset)
+{
+    /* 10^7 samples of 1e9 + N(0,1): variance to 1e-6 relative, where the
+       sum-of-squares formula has no correct digit.  The reference is the
+       two-pass formula in long double. */
+    size_t n = fe_test_quick() ? 1000000 : 10000000;
+    double *x = malloc(n * sizeof *x);
+    fe_rng r = fe_rng_seed(2026);
+    fe_meanvar fast = FE_MEANVAR_EMPTY, slow = FE_MEANVAR_EMPTY;
+    long double sum = 0, ss = 0, mean, var;
+    double naive_s = 0, naive_q = 0, naive;
+    int rc = FE_OK;
+    ck_assert_ptr_nonnull(x);
+    for (size_t i = 0; i < n; i++) {
+        x[i] = 1e9 + fe_rng_normal(&r);
+        sum += x[i];
+        naive_s += x[i];
+        naive_q += x[i] * x[i];
+    }
+    mean = sum / (long double)n;
+    for (size_t i = 0; i < n; i++)
+        ss += (x[i] - mean) * (x[i] - mean);
+    var = ss / (long double)(n - 1);
+    ck_assert_int_eq(fe_meanvar_add_many(&fast, x, n, NULL), FE_OK);
+    for (size_t i = 0; i < n; i++)
+        rc |= fe_meanvar_add(&slow, x[i]);
+    ck_assert_int_eq(rc, FE_OK);
+    FE_ASSERT_REL(fe_meanvar_variance(&fast), (double)var, 1e-6);
+    FE_ASSERT_REL(fe_meanvar_variance(&slow), (double)var, 1e-6);
+    /* The textbook formula is off by far more than 1e-6: the test can fail. */
+    naive = (naive_q - naive_s * naive_s / (double)n) / (double)(n - 1);
+    ck_assert_msg(fabs(naive - (double)var) > 1e-3 * (double)var,
+                  "naive formula unexpectedly accurate: %g vs %Lg", naive, var);
+    free(x);
+}
+END_TEST
+
+Suite *fe_meanvar_suite(void)
+{
+    Suite *s = suite_create("meanvar");
+    TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, mean_of_three);
+    tcase_add_test(t, variance_scan_of_three);
+    tcase_add_test(t, ten_values);
+    tcase_add_test(t, merge_every_split);
+    tcase_add_test(t, merge_through_accumulator_is_associative);
+    tcase_add_test(t, empty_and_single);
+    tcase_add_test(t, nonfinite_is_refused_and_nothing_changes);
+    tcase_add_test(t, bulk_stops_exactly_at_the_bad_value);
+    tcase_add_test(t, streaming_equals_batch);
+    tcase_add_test(t, precision_at_large_offset);
+    suite_add_tcase(s, t);
+    return s;
+}

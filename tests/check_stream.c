@@ -1,0 +1,159 @@
+/* Streams: array, generator and file descriptor sources; folding them;
+   rewinding; truncated records and pipes. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdint.h>
+#include <unistd.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+START_TEST(array_source_folds_and_rewinds)
+{
+    const double z[3] = {55, 89, 144};
+    fe_array_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    size_t done = 0;
+    ck_assert_int_eq(fe_source_from_array(&src, &st, z, 3, sizeof(double)), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, &done), FE_OK);
+    ck_assert_uint_eq(done, 3);
+    ck_assert_double_eq(a.mean, 96.0);
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, &done), FE_OK);
+    ck_assert_uint_eq(a.n, 6);
+    ck_assert_double_eq_tol(fe_meanvar_variance(&a), 1613.6, 1e-9);
+}
+END_TEST
+
+/* A generator: 1e6 seeded normals around 5; the stream is a function of
+   the index, so rewinding replays it exactly. */
+typedef struct { fe_rng rng; size_t n; } gen_ctx;
+
+static int gen_normals(void *obs, size_t index, void *ctx)
+{
+    gen_ctx *g = ctx;
+    if (index == 0)
+        g->rng = fe_rng_seed(42);
+    if (index >= g->n)
+        return FE_END;
+    *(double *)obs = 5.0 + fe_rng_normal(&g->rng);
+    return FE_OK;
+}
+
+START_TEST(generator_source_in_constant_memory)
+{
+    gen_ctx g = {fe_rng_seed(0), fe_test_quick() ? 100000 : 1000000};
+    double slot;
+    fe_generator_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY, b = FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_source_from_generator(&src, &st, gen_normals, &g, &slot, sizeof slot), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_OK);
+    ck_assert_uint_eq(a.n, g.n);
+    ck_assert_double_eq_tol(a.mean, 5.0, 0.01);
+    ck_assert_double_eq_tol(fe_meanvar_variance(&a), 1.0, 0.02);
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &b, &src, NULL), FE_OK);
+    ck_assert_mem_eq(&a, &b, sizeof a);
+}
+END_TEST
+
+static int count_visits(const void *acc, size_t index, void *ctx)
+{
+    (void)acc;
+    *(size_t *)ctx = index;
+    return FE_OK;
+}
+
+START_TEST(fd_source_reads_records_through_a_small_buffer)
+{
+    /* 1000 doubles through a 24-byte buffer: refills split every read. */
+    char path[] = "/tmp/foldest-test-XXXXXX";
+    int fd = mkstemp(path);
+    double x[1000], buf[3];
+    fe_fd_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY, want = FE_MEANVAR_EMPTY;
+    size_t last = 0;
+    ck_assert_int_ge(fd, 0);
+    unlink(path);
+    for (int i = 0; i < 1000; i++)
+        x[i] = i * 0.5;
+    ck_assert_int_eq(write(fd, x, sizeof x), (ssize_t)sizeof x);
+    ck_assert_int_eq(lseek(fd, 0, SEEK_SET), 0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, fd, sizeof(double), buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_scan_source(&f, &a, &src, count_visits, &last, NULL), FE_OK);
+    ck_assert_uint_eq(last, 1000);
+    fe_meanvar_add_many(&want, x, 1000, NULL);
+    FE_ASSERT_REL(a.mean, want.mean, 1e-14);
+    FE_ASSERT_REL(a.m2, want.m2, 1e-12);
+    /* Rewind by seeking. */
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    a = (fe_meanvar)FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_OK);
+    ck_assert_uint_eq(a.n, 1000);
+    /* A truncated last record is an error, after the whole records. */
+    ck_assert_int_eq(write(fd, x, 3), 3);
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    a = (fe_meanvar)FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_EPARSE);
+    ck_assert_uint_eq(a.n, 1000);
+    close(fd);
+}
+END_TEST
+
+START_TEST(fd_source_on_a_pipe_cannot_rewind)
+{
+    int p[2];
+    double x[4] = {1, 2, 3, 4}, buf[8];
+    fe_fd_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(pipe(p), 0);
+    ck_assert_int_eq(write(p[1], x, sizeof x), (ssize_t)sizeof x);
+    close(p[1]);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, p[0], sizeof(double), buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_OK);
+    ck_assert_double_eq(a.mean, 2.5);
+    ck_assert_int_eq(fe_source_rewind(&src), FE_ENOTSUP);
+    close(p[0]);
+}
+END_TEST
+
+START_TEST(bad_arguments_and_mismatched_sizes)
+{
+    double z[2] = {1, 2}, slot;
+    fe_array_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    fe_generator_source gs;
+    fe_fd_source fs;
+    ck_assert_int_eq(fe_source_from_array(&src, &st, z, 2, sizeof(float)), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_array(&src, &st, NULL, 2, 8), FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_generator(&src, &gs, NULL, NULL, &slot, 8), FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_fd(&src, &fs, -1, 8, z, sizeof z), FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_fd(&src, &fs, 0, 8, z, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_source_rewind(NULL), FE_EINVAL);
+    ck_assert_uint_eq(a.n, 0);
+}
+END_TEST
+
+Suite *fe_stream_suite(void)
+{
+    Suite *s = suite_create("stream");
+    TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 60);
+    tcase_add_test(t, array_source_folds_and_rewinds);
+    tcase_add_test(t, generator_source_in_constant_memory);
+    tcase_add_test(t, fd_source_reads_records_through_a_small_buffer);
+    tcase_add_test(t, fd_source_on_a_pipe_cannot_rewind);
+    tcase_add_test(t, bad_arguments_and_mismatched_sizes);
+    suite_add_tcase(s, t);
+    return s;
+}

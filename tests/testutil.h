@@ -1,0 +1,48 @@
+/* Helpers shared by the test suites. */
+#ifndef FE_TESTUTIL_H
+#define FE_TESTUTIL_H
+
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Assert |got - want| <= rel * max(|want|, tiny): a relative tolerance. */
+#define FE_ASSERT_REL(got, want, rel)                                        \
+    do {                                                                     \
+        double fe_g_ = (got), fe_w_ = (want);                                \
+        double fe_s_ = fabs(fe_w_) > 1e-300 ? fabs(fe_w_) : 1e-300;          \
+        ck_assert_msg(fabs(fe_g_ - fe_w_) <= (rel) * fe_s_,                  \
+                      "%s = %.17g, want %.17g (relative error %.3g > %.3g)", \
+                      #got, fe_g_, fe_w_, fabs(fe_g_ - fe_w_) / fe_s_,      \
+                      (double)(rel));                                        \
+    } while (0)
+
+/* Nonzero under valgrind (FE_TEST_QUICK=1): heavy loops run smaller. */
+static inline int fe_test_quick(void)
+{
+    const char *q = getenv("FE_TEST_QUICK");
+    return q != NULL && *q != '\0' && *q != '0';
+}
+
+/* Directory of the real recordings (FOLDEST_DATA, else ../shared/data), or
+   NULL with a visible message when it is missing: tests then skip. */
+static inline const char *fe_test_data_dir(const char *why)
+{
+    const char *d = getenv("FOLDEST_DATA");
+    char probe[4096];
+    FILE *f;
+    if (d == NULL || *d == '\0')
+        d = "../shared/data";
+    snprintf(probe, sizeof probe, "%s/README.md", d);
+    f = fopen(probe, "r");
+    if (f == NULL) {
+        fprintf(stderr, "SKIP %s: no recordings at %s (set FOLDEST_DATA)\n", why, d);
+        return NULL;
+    }
+    fclose(f);
+    return d;
+}
+
+#endif /* FE_TESTUTIL_H */
