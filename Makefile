@@ -105,16 +105,18 @@ $(B)/tests/suites.h: $(TEST_SRC)
 	@mkdir -p $(@D)
 	sed -n 's/^Suite \*\(fe_[a-z0-9_]*_suite\)(void)$$/FE_SUITE(\1)/p' $(TEST_SRC) > $@
 
-$(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC)
-	$(CC) $(WARN) -O2 -g -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"'
+
+$(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
+	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS)
 
 $(B)/san/%.o: src/%.c $(HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
-$(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(SAN_OBJ)
-	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+$(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(SAN_OBJ) $(CLI)
+	$(CC) $(WARN) -O1 -g $(SAN) $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
 tests: $(B)/tests/check_foldest $(B)/tests/check_foldest_san

@@ -1,0 +1,57 @@
+/* Tangled from literate/csv.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/csv.org::CSV Reader Declarations][CSV Reader Declarations]] */
+#ifndef FOLDEST_CSV_H
+#define FOLDEST_CSV_H
+
+#include <stddef.h>
+
+/* A line reader over a file descriptor, through a caller buffer. */
+typedef struct fe_csv_reader {
+    int fd;
+    char *buf;
+    size_t cap, len, pos;
+    size_t line;                /* number of the line last returned, from 1 */
+    int eof;
+    int skipping;               /* discarding the rest of a too-long line */
+} fe_csv_reader;
+
+/* fe_csv_reader_init: read from `fd` (the caller's to close) through
+   `buffer` of `cap` bytes; `cap` - 1 is the longest line accepted. */
+int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap);
+
+/* fe_csv_next_line: point *line at the next line, NUL-terminated, without
+   its line end (LF or CRLF); *len is its length.  The line lives in the
+   reader's buffer until the next call and may be modified (fe_csv_split
+   does).  Returns FE_OK, FE_END at end of input, FE_ESIZE for a line longer
+   than the buffer, FE_EPARSE for a NUL byte (binary input), FE_EIO for a
+   read error.  r->line is the line's number in every case. */
+int fe_csv_next_line(fe_csv_reader *r, char **line, size_t *len);
+/* CSV Reader Declarations ends here */
+/* [[file:../../literate/csv.org::CSV Field Declarations][CSV Field Declarations]] */
+/* FE_CSV_WHITESPACE as a delimiter: split at runs of spaces and tabs. */
+#define FE_CSV_WHITESPACE ' '
+
+typedef struct fe_csv_field {
+    char *text;                 /* NUL-terminated, inside the line */
+    size_t column;              /* byte column where the field starts, from 1 */
+} fe_csv_field;
+
+/* fe_csv_guess_delimiter: ',', ';', '\t' (the first the line contains),
+   else FE_CSV_WHITESPACE. */
+char fe_csv_guess_delimiter(const char *line);
+
+/* fe_csv_split: split `line` in place into at most `max` fields.
+   *count receives the number of fields.  Errors: FE_ESIZE when the line
+   has more than `max` fields (*count is then max + 1), FE_EPARSE for an
+   unterminated quote or text after a closing quote (*bad_column receives
+   its column, if bad_column is not NULL). */
+int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
+                 size_t max, size_t *count, size_t *bad_column);
+
+/* fe_csv_number: parse a whole field as a finite double (C locale).
+   FE_EPARSE when it is empty or not entirely a number; FE_ENONFINITE
+   for "nan", "inf" and values that overflow. */
+int fe_csv_number(const fe_csv_field *field, double *value);
+
+#endif /* FOLDEST_CSV_H */
+/* CSV Field Declarations ends here */

@@ -1,0 +1,106 @@
+/* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli.org::Command Line Declarations][Command Line Declarations]] */
+#ifndef FOLDEST_CLI_H
+#define FOLDEST_CLI_H
+
+#define _POSIX_C_SOURCE 200809L
+#include <stddef.h>
+#include <stdio.h>
+#include <sys/types.h>
+
+#include <foldest.h>
+
+enum {
+    FE_CLI_OK = 0,
+    FE_CLI_REFUSED = 1,
+    FE_CLI_USAGE = 2,
+    FE_CLI_INPUT = 3,
+    FE_CLI_IO = 4
+};
+
+/* A subcommand: `foldest NAME ARGS...` calls run(argc, argv) with argv[0]
+   = NAME. */
+typedef struct fe_cli_command {
+    const char *name;
+    const char *summary;
+    int (*run)(int argc, char **argv);
+} fe_cli_command;
+/* Command Line Declarations ends here */
+/* [[file:../../literate/cli.org::Table Declarations][Table Declarations]] */
+enum { FE_CLI_LINE_MAX = 1 << 16, FE_CLI_FIELDS_MAX = 4096,
+       FE_CLI_LOOKAHEAD = 64 };
+
+/* A CSV recording read row by row. */
+typedef struct fe_cli_table {
+    const char *name;           /* for messages: the path, or <stdin> */
+    int fd;
+    fe_csv_reader reader;
+    char *buffer;
+    char delimiter;
+    size_t ncols;
+    char **names;               /* ncols column names */
+    int has_header;
+    char **pending;             /* looked-ahead data lines, replayed first */
+    size_t *pending_line;
+    size_t npending, next_pending;
+    fe_csv_field *fields;
+    size_t line;                /* line number of the row last returned */
+    size_t rows;                /* rows returned so far */
+    off_t size;                 /* file size for progress; 0: unknown */
+    int progress;               /* show progress on stderr */
+} fe_cli_table;
+
+/* Open `path` ("-": standard input).  skip < 0 guesses where the data
+   start; skip >= 0 skips that many lines.  On failure `err` holds the
+   message and the return value is an exit status. */
+int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
+                      char *err, size_t errlen);
+
+/* Find the column `spec` (name, case-insensitive name, unique prefix, or
+   number from 1); FE_CLI_USAGE with a message listing the columns if none. */
+int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
+                        char *err, size_t errlen);
+
+/* Read the next row's columns cols[0..k-1] into out.  Returns FE_OK,
+   FE_END, or an exit status with `err` = "FILE:LINE:COLUMN: message". */
+int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
+                      double *out, char *err, size_t errlen);
+
+/* Rewind to the first data row (files only: FE_CLI_IO for a pipe). */
+int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen);
+
+void fe_cli_table_close(fe_cli_table *t);
+/* Table Declarations ends here */
+/* [[file:../../literate/cli.org::Output Declarations][Output Declarations]] */
+typedef struct fe_cli_output {
+    FILE *file;
+    char *path, *tmp;
+} fe_cli_output;
+
+/* Create a temporary file beside `path`; FE_CLI_IO with a message. */
+int fe_cli_output_open(fe_cli_output *o, const char *path, char *err,
+                       size_t errlen);
+/* Flush, close and rename into place; FE_CLI_IO if any write failed. */
+int fe_cli_output_commit(fe_cli_output *o, char *err, size_t errlen);
+/* Close and delete: nothing is left behind. */
+void fe_cli_output_abort(fe_cli_output *o);
+
+/* Progress of a table on stderr, when stderr is a terminal and the input
+   is large; call once per row, cheap; fe_cli_progress_done clears it. */
+void fe_cli_progress(fe_cli_table *t);
+void fe_cli_progress_done(fe_cli_table *t);
+
+/* Parse option values; FE_CLI_USAGE with a message on error. */
+int fe_cli_parse_double(const char *opt, const char *text, double *value,
+                        char *err, size_t errlen);
+int fe_cli_parse_long(const char *opt, const char *text, long *value,
+                      char *err, size_t errlen);
+
+/* Split "a,b,c" into at most `max` names (in place); the count or -1. */
+int fe_cli_split_list(char *text, char **items, int max);
+
+/* Print one JSON string, escaped. */
+void fe_cli_json_string(FILE *out, const char *s);
+
+#endif /* FOLDEST_CLI_H */
+/* Output Declarations ends here */

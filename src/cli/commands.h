@@ -1,0 +1,15 @@
+/* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli.org::Command Table][Command Table]] */
+#ifndef FOLDEST_CLI_COMMANDS_H
+#define FOLDEST_CLI_COMMANDS_H
+
+#include "cli.h"
+
+int fe_cli_stats(int argc, char **argv);
+
+static const fe_cli_command fe_cli_commands[] = {
+    {"stats", "mean, standard deviation, min and max of columns", fe_cli_stats},
+};
+
+#endif /* FOLDEST_CLI_COMMANDS_H */
+/* Command Table ends here */

@@ -1,0 +1,141 @@
+/* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli.org::Summarise columns][Summarise columns]] */
+#include "cli.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char fe__stats_help[] =
+    "usage: foldest stats [--columns a,b,...] [--skip N] [--json] FILE.csv|-\n"
+    "\n"
+    "Count, mean, standard deviation, minimum and maximum of numeric columns,\n"
+    "in one pass.  Columns are named by header name or number from 1; default:\n"
+    "every column.  The header is found automatically among metadata lines;\n"
+    "--skip N skips N lines first.  Malformed input: FILE:LINE:COLUMN: message.\n";
+
+int fe_cli_stats(int argc, char **argv)
+{
+    const char *path = NULL;
+    char *columns = NULL, err[1024];
+    long skip = -1;
+    int json = 0, rc;
+    fe_cli_table t;
+    size_t k = 0, *cols = NULL;
+    double *row = NULL, *lo = NULL, *hi = NULL;
+    fe_meanvar *mv = NULL;
+
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(fe__stats_help, stdout);
+            return FE_CLI_OK;
+        } else if (strcmp(argv[i], "--json") == 0) {
+            json = 1;
+        } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
+            columns = argv[++i];
+        } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
+            if (fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK
+                || skip < 0) {
+                fprintf(stderr, "foldest stats: %s\n", skip < 0 ? "--skip: negative" : err);
+                return FE_CLI_USAGE;
+            }
+        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            fprintf(stderr, "foldest stats: unknown option '%s'\n%s", argv[i], fe__stats_help);
+            return FE_CLI_USAGE;
+        } else if (path == NULL) {
+            path = argv[i];
+        } else {
+            fprintf(stderr, "foldest stats: one input file, please\n");
+            return FE_CLI_USAGE;
+        }
+    }
+    if (path == NULL) {
+        fputs(fe__stats_help, stderr);
+        return FE_CLI_USAGE;
+    }
+    rc = fe_cli_table_open(&t, path, skip, err, sizeof err);
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest stats: %s\n", err);
+        return rc;
+    }
+    cols = calloc(t.ncols, sizeof *cols);
+    if (cols == NULL)
+        goto out_of_memory;
+    if (columns != NULL) {
+        char *names[FE_CLI_FIELDS_MAX];
+        int n = fe_cli_split_list(columns, names, FE_CLI_FIELDS_MAX);
+        for (int i = 0; i < n; i++) {
+            rc = fe_cli_table_column(&t, names[i], &cols[k++], err, sizeof err);
+            if (rc != FE_CLI_OK) {
+                fprintf(stderr, "foldest stats: %s\n", err);
+                goto done;
+            }
+        }
+    } else {
+        for (k = 0; k < t.ncols; k++)
+            cols[k] = k;
+    }
+    row = calloc(k, sizeof *row);
+    lo = calloc(k, sizeof *lo);
+    hi = calloc(k, sizeof *hi);
+    mv = calloc(k, sizeof *mv);
+    if (row == NULL || lo == NULL || hi == NULL || mv == NULL)
+        goto out_of_memory;
+    while ((rc = fe_cli_table_next(&t, cols, k, row, err, sizeof err)) == FE_OK) {
+        for (size_t j = 0; j < k; j++) {
+            if (mv[j].n == 0 || row[j] < lo[j])
+                lo[j] = row[j];
+            if (mv[j].n == 0 || row[j] > hi[j])
+                hi[j] = row[j];
+            rc = fe_meanvar_add(&mv[j], row[j]);
+            if (rc != FE_OK) {
+                fprintf(stderr, "foldest stats: %s:%zu: %s\n", t.name, t.line, fe_strerror(rc));
+                rc = FE_CLI_INPUT;
+                goto done;
+            }
+        }
+        fe_cli_progress(&t);
+    }
+    fe_cli_progress_done(&t);
+    if (rc != FE_END) {
+        fprintf(stderr, "foldest stats: %s\n", err);
+        goto done;
+    }
+    if (t.rows == 0) {
+        fprintf(stderr, "foldest stats: %s: no data rows\n", t.name);
+        rc = FE_CLI_INPUT;
+        goto done;
+    }
+    if (json) {
+        printf("{\"file\": ");
+        fe_cli_json_string(stdout, t.name);
+        printf(", \"rows\": %zu, \"columns\": [", t.rows);
+        for (size_t j = 0; j < k; j++) {
+            printf("%s{\"name\": ", j ? ", " : "");
+            fe_cli_json_string(stdout, t.names[cols[j]]);
+            printf(", \"mean\": %.17g, \"stddev\": %.17g, \"min\": %.17g, \"max\": %.17g}",
+                   fe_meanvar_mean(&mv[j]), fe_meanvar_stddev(&mv[j]), lo[j], hi[j]);
+        }
+        printf("]}\n");
+    } else {
+        printf("%s: %zu rows\n%-24s %15s %15s %15s %15s\n", t.name, t.rows, "column",
+               "mean", "stddev", "min", "max");
+        for (size_t j = 0; j < k; j++)
+            printf("%-24.24s %15.6g %15.6g %15.6g %15.6g\n", t.names[cols[j]],
+                   fe_meanvar_mean(&mv[j]), fe_meanvar_stddev(&mv[j]), lo[j], hi[j]);
+    }
+    rc = FE_CLI_OK;
+    goto done;
+out_of_memory:
+    fprintf(stderr, "foldest stats: out of memory\n");
+    rc = FE_CLI_IO;
+done:
+    free(cols);
+    free(row);
+    free(lo);
+    free(hi);
+    free(mv);
+    fe_cli_table_close(&t);
+    return rc;
+}
+/* Summarise columns ends here */

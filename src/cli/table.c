@@ -1,0 +1,489 @@
+/* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli.org::Table Includes][Table Includes]] */
+#include "cli.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+/* Table Includes ends here */
+/* [[file:../../literate/cli.org::Format a located message][Format a located message]] */
+static int fe__cli_at(const fe_cli_table *t, size_t line, size_t column,
+                      int status, char *err, size_t errlen,
+                      const char *fmt, ...)
+{
+    va_list ap;
+    int n = snprintf(err, errlen, "%s:%zu:%zu: ", t->name, line, column);
+    if (n >= 0 && (size_t)n < errlen) {
+        va_start(ap, fmt);
+        vsnprintf(err + n, errlen - (size_t)n, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+/* The message for a line the reader refused. */
+static int fe__cli_line_error(const fe_cli_table *t, int rc, char *err,
+                              size_t errlen)
+{
+    switch (rc) {
+    case FE_ESIZE:
+        return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
+                          "line longer than %d bytes", FE_CLI_LINE_MAX - 1);
+    case FE_EPARSE:
+        return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
+                          "NUL byte: this is not a text file");
+    default:
+        return fe__cli_at(t, t->reader.line, 1, FE_CLI_IO, err, errlen,
+                          "read error: %s", strerror(errno));
+    }
+}
+
+static int fe__cli_ignorable(const char *line)
+{
+    while (*line == ' ' || *line == '\t')
+        line++;
+    return *line == '\0' || *line == '#';
+}
+
+static int fe__cli_numeric(const fe_csv_field *f)
+{
+    double v;
+    int rc = fe_csv_number(f, &v);
+    return rc == FE_OK || rc == FE_ENONFINITE;
+}
+
+static char *fe__cli_strdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *p = malloc(n);
+    if (p != NULL)
+        memcpy(p, s, n);
+    return p;
+}
+/* Format a located message ends here */
+/* [[file:../../literate/cli.org::Open a table and find its header][Open a table and find its header]] */
+static void fe__cli_free_lines(char **lines, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        free(lines[i]);
+}
+
+int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
+                      char *err, size_t errlen)
+{
+    char *look[FE_CLI_LOOKAHEAD];
+    size_t look_line[FE_CLI_LOOKAHEAD], look_fields[FE_CLI_LOOKAHEAD];
+    size_t nlook = 0, start, header = (size_t)-1, first_data;
+    struct stat st;
+    char *line;
+    size_t len;
+    int rc;
+
+    memset(t, 0, sizeof *t);
+    t->name = strcmp(path, "-") == 0 ? "<stdin>" : path;
+    t->fd = strcmp(path, "-") == 0 ? 0 : open(path, O_RDONLY);
+    if (t->fd < 0) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return FE_CLI_IO;
+    }
+    if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode))
+        t->size = st.st_size;
+    t->buffer = malloc(FE_CLI_LINE_MAX);
+    t->fields = malloc(FE_CLI_FIELDS_MAX * sizeof *t->fields);
+    if (t->buffer == NULL || t->fields == NULL) {
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        fe_cli_table_close(t);
+        return FE_CLI_IO;
+    }
+    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
+
+    /* Skip what the user said to skip. */
+    for (long i = 0; skip > 0 && i < skip; i++) {
+        rc = fe_csv_next_line(&t->reader, &line, &len);
+        if (rc == FE_END)
+            break;
+        if (rc != FE_OK && rc != FE_ESIZE) {
+            rc = fe__cli_line_error(t, rc, err, errlen);
+            fe_cli_table_close(t);
+            return rc;
+        }
+    }
+    /* Look ahead. */
+    while (nlook < (skip >= 0 ? 2 : FE_CLI_LOOKAHEAD)) {
+        size_t nf;
+        rc = fe_csv_next_line(&t->reader, &line, &len);
+        if (rc == FE_END)
+            break;
+        if (rc != FE_OK) {
+            rc = fe__cli_line_error(t, rc, err, errlen);
+            fe__cli_free_lines(look, nlook);
+            fe_cli_table_close(t);
+            return rc;
+        }
+        if (fe__cli_ignorable(line))
+            continue;
+        if (nlook == 0)
+            t->delimiter = fe_csv_guess_delimiter(line);
+        look[nlook] = fe__cli_strdup(line);
+        look_line[nlook] = t->reader.line;
+        if (look[nlook] == NULL
+            || fe_csv_split(line, t->delimiter, t->fields, FE_CLI_FIELDS_MAX,
+                            &nf, NULL) == FE_ESIZE) {
+            nf = FE_CLI_FIELDS_MAX + 1;
+        }
+        look_fields[nlook++] = nf;
+    }
+    if (nlook == 0) {
+        snprintf(err, errlen, "%s: no data: the file is empty", t->name);
+        fe_cli_table_close(t);
+        return FE_CLI_INPUT;
+    }
+    /* The data block: the longest run of lines with one field count, the
+       later of equal runs (with --skip, everything after the skipped
+       lines).  Lines after it are data too, and will be checked. */
+    start = 0;
+    if (skip < 0) {
+        size_t best = 0;
+        for (size_t i = 0, j; i < nlook; i = j) {
+            for (j = i + 1; j < nlook && look_fields[j] == look_fields[i]; j++)
+                ;
+            if (j - i >= best) {
+                best = j - i;
+                start = i;
+            }
+        }
+    }
+    t->ncols = look_fields[skip < 0 ? start : nlook - 1];
+    if (t->ncols > FE_CLI_FIELDS_MAX) {
+        fe__cli_free_lines(look, nlook);
+        rc = fe__cli_at(t, look_line[nlook - 1], 1, FE_CLI_INPUT, err, errlen,
+                        "more than %d fields", FE_CLI_FIELDS_MAX);
+        fe_cli_table_close(t);
+        return rc;
+    }
+    /* Is the block's first line a header?  It is when one of its fields is
+       not a number where the next line has a number (or it is alone). */
+    {
+        fe_csv_field *a = t->fields;
+        fe_csv_field *b = malloc(FE_CLI_FIELDS_MAX * sizeof *b);
+        char *copy0 = fe__cli_strdup(look[start]);
+        char *copy1 = start + 1 < nlook ? fe__cli_strdup(look[start + 1]) : NULL;
+        size_t na = 0, nb = 0;
+        int is_header = 0;
+        if (copy0 != NULL)
+            fe_csv_split(copy0, t->delimiter, a, FE_CLI_FIELDS_MAX, &na, NULL);
+        if (copy1 != NULL && b != NULL)
+            fe_csv_split(copy1, t->delimiter, b, FE_CLI_FIELDS_MAX, &nb, NULL);
+        for (size_t j = 0; j < na && !is_header; j++)
+            if (!fe__cli_numeric(&a[j])
+                && (start + 1 == nlook || (j < nb && fe__cli_numeric(&b[j]))))
+                is_header = 1;
+        if (is_header)
+            header = start;
+        t->names = calloc(t->ncols ? t->ncols : 1, sizeof *t->names);
+        for (size_t j = 0; t->names != NULL && j < t->ncols; j++) {
+            char number[32];
+            snprintf(number, sizeof number, "%zu", j + 1);
+            t->names[j] = fe__cli_strdup(is_header && j < na ? a[j].text : number);
+        }
+        free(copy0);
+        free(copy1);
+        free(b);
+        t->has_header = is_header;
+    }
+    first_data = header == (size_t)-1 ? start : header + 1;
+    /* Keep the looked-ahead data lines to replay them. */
+    t->npending = nlook - first_data;
+    t->pending = calloc(t->npending + 1, sizeof *t->pending);
+    t->pending_line = calloc(t->npending + 1, sizeof *t->pending_line);
+    for (size_t i = 0; i < nlook; i++) {
+        if (i >= first_data && t->pending != NULL && t->pending_line != NULL) {
+            t->pending[i - first_data] = look[i];
+            t->pending_line[i - first_data] = look_line[i];
+        } else {
+            free(look[i]);
+        }
+    }
+    if (t->names == NULL || t->pending == NULL || t->pending_line == NULL) {
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        fe_cli_table_close(t);
+        return FE_CLI_IO;
+    }
+    t->progress = isatty(2) && t->size > (off_t)(1 << 22);
+    return FE_CLI_OK;
+}
+/* Open a table and find its header ends here */
+/* [[file:../../literate/cli.org::Find a column by name or number][Find a column by name or number]] */
+int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
+                        char *err, size_t errlen)
+{
+    char *end;
+    long number = strtol(spec, &end, 10);
+    size_t found = (size_t)-1, matches = 0, speclen = strlen(spec);
+    size_t n;
+
+    for (size_t j = 0; j < t->ncols; j++)
+        if (strcmp(t->names[j], spec) == 0) {
+            *col = j;
+            return FE_CLI_OK;
+        }
+    for (size_t j = 0; j < t->ncols; j++)
+        if (strcasecmp(t->names[j], spec) == 0) {
+            *col = j;
+            return FE_CLI_OK;
+        }
+    if (*spec != '\0' && *end == '\0' && number >= 1 && (size_t)number <= t->ncols) {
+        *col = (size_t)number - 1;
+        return FE_CLI_OK;
+    }
+    for (size_t j = 0; j < t->ncols; j++)
+        if (speclen > 0 && strncasecmp(t->names[j], spec, speclen) == 0) {
+            found = j;
+            matches++;
+        }
+    if (matches == 1) {
+        *col = found;
+        return FE_CLI_OK;
+    }
+    n = (size_t)snprintf(err, errlen, "%s: %s column '%s'; the columns are:",
+                         t->name, matches > 1 ? "ambiguous" : "no", spec);
+    for (size_t j = 0; j < t->ncols && n < errlen; j++)
+        n += (size_t)snprintf(err + n, errlen - n, "%s '%s'", j ? "," : "",
+                              t->names[j]);
+    return FE_CLI_USAGE;
+}
+/* Find a column by name or number ends here */
+/* [[file:../../literate/cli.org::Read the next row][Read the next row]] */
+int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
+                      double *out, char *err, size_t errlen)
+{
+    char *line;
+    size_t len, nf, bad = 0;
+    int rc;
+
+    for (;;) {
+        if (t->next_pending < t->npending) {
+            line = t->pending[t->next_pending];
+            t->line = t->pending_line[t->next_pending++];
+        } else {
+            rc = fe_csv_next_line(&t->reader, &line, &len);
+            if (rc == FE_END)
+                return FE_END;
+            if (rc != FE_OK)
+                return fe__cli_line_error(t, rc, err, errlen);
+            t->line = t->reader.line;
+        }
+        if (!fe__cli_ignorable(line))
+            break;
+    }
+    rc = fe_csv_split(line, t->delimiter, t->fields, FE_CLI_FIELDS_MAX, &nf, &bad);
+    if (rc == FE_EPARSE)
+        return fe__cli_at(t, t->line, bad, FE_CLI_INPUT, err, errlen,
+                          "unterminated or misplaced quote");
+    if (rc != FE_OK || nf != t->ncols)
+        return fe__cli_at(t, t->line, 1, FE_CLI_INPUT, err, errlen,
+                          "expected %zu fields, found %s%zu", t->ncols,
+                          rc == FE_ESIZE ? "more than " : "", rc == FE_ESIZE ? (size_t)FE_CLI_FIELDS_MAX : nf);
+    for (size_t i = 0; i < k; i++) {
+        const fe_csv_field *f = &t->fields[cols[i]];
+        rc = fe_csv_number(f, &out[i]);
+        if (rc == FE_ENONFINITE)
+            return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
+                              "'%s' in column '%s' is not a finite number",
+                              f->text, t->names[cols[i]]);
+        if (rc != FE_OK)
+            return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
+                              "'%s' in column '%s' is not a number", f->text,
+                              t->names[cols[i]]);
+    }
+    t->rows++;
+    return FE_OK;
+}
+
+int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
+{
+    if (t->fd == 0 || lseek(t->fd, 0, SEEK_SET) == (off_t)-1) {
+        snprintf(err, errlen, "%s: cannot read the input twice (a pipe?)", t->name);
+        return FE_CLI_IO;
+    }
+    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
+    /* Skip to just past the last looked-ahead line; replay the rest. */
+    if (t->npending > 0) {
+        size_t last = t->pending_line[t->npending - 1];
+        char *line;
+        size_t len;
+        while (t->reader.line < last)
+            if (fe_csv_next_line(&t->reader, &line, &len) == FE_END)
+                break;
+    }
+    t->next_pending = 0;
+    t->rows = 0;
+    return FE_CLI_OK;
+}
+
+void fe_cli_table_close(fe_cli_table *t)
+{
+    if (t->fd > 0)
+        close(t->fd);
+    t->fd = -1;
+    for (size_t j = 0; t->names != NULL && j < t->ncols; j++)
+        free(t->names[j]);
+    fe__cli_free_lines(t->pending, t->pending != NULL ? t->npending : 0);
+    free(t->names);
+    free(t->pending);
+    free(t->pending_line);
+    free(t->fields);
+    free(t->buffer);
+    t->names = NULL;
+    t->pending = NULL;
+    t->pending_line = NULL;
+    t->fields = NULL;
+    t->buffer = NULL;
+}
+/* Read the next row ends here */
+/* [[file:../../literate/cli.org::Write output atomically][Write output atomically]] */
+int fe_cli_output_open(fe_cli_output *o, const char *path, char *err,
+                       size_t errlen)
+{
+    size_t n = strlen(path) + 16;
+    int fd;
+    o->file = NULL;
+    o->path = fe__cli_strdup(path);
+    o->tmp = calloc(n, 1);
+    if (o->path == NULL || o->tmp == NULL) {
+        snprintf(err, errlen, "%s: out of memory", path);
+        free(o->path);
+        free(o->tmp);
+        o->path = o->tmp = NULL;
+        return FE_CLI_IO;
+    }
+    snprintf(o->tmp, n, "%s.tmp.XXXXXX", path);
+    fd = mkstemp(o->tmp);
+    if (fd >= 0)
+        o->file = fdopen(fd, "w");
+    if (o->file == NULL) {
+        snprintf(err, errlen, "%s: cannot create: %s", path, strerror(errno));
+        if (fd >= 0) {
+            close(fd);
+            unlink(o->tmp);
+        }
+        free(o->path);
+        free(o->tmp);
+        o->path = o->tmp = NULL;
+        return FE_CLI_IO;
+    }
+    return FE_CLI_OK;
+}
+
+int fe_cli_output_commit(fe_cli_output *o, char *err, size_t errlen)
+{
+    int bad = ferror(o->file) != 0;
+    bad |= fclose(o->file) != 0;
+    o->file = NULL;
+    if (bad || rename(o->tmp, o->path) != 0) {
+        snprintf(err, errlen, "%s: cannot write: %s", o->path, strerror(errno));
+        fe_cli_output_abort(o);
+        return FE_CLI_IO;
+    }
+    free(o->tmp);
+    free(o->path);
+    o->tmp = o->path = NULL;
+    return FE_CLI_OK;
+}
+
+void fe_cli_output_abort(fe_cli_output *o)
+{
+    if (o->file != NULL)
+        fclose(o->file);
+    if (o->tmp != NULL)
+        unlink(o->tmp);
+    free(o->tmp);
+    free(o->path);
+    o->file = NULL;
+    o->tmp = o->path = NULL;
+}
+
+void fe_cli_progress(fe_cli_table *t)
+{
+    off_t at;
+    if (!t->progress || (t->rows & 0xffff) != 0)
+        return;
+    at = lseek(t->fd, 0, SEEK_CUR);
+    if (at >= 0)
+        fprintf(stderr, "\r%s: %3.0f%% (%zu rows)", t->name,
+                100.0 * (double)at / (double)t->size, t->rows);
+}
+
+void fe_cli_progress_done(fe_cli_table *t)
+{
+    if (t->progress)
+        fprintf(stderr, "\r%*s\r", 60, "");
+}
+
+int fe_cli_parse_double(const char *opt, const char *text, double *value,
+                        char *err, size_t errlen)
+{
+    char *end;
+    double v;
+    errno = 0;
+    v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || v != v) {
+        snprintf(err, errlen, "%s: '%s' is not a number", opt, text);
+        return FE_CLI_USAGE;
+    }
+    *value = v;
+    return FE_CLI_OK;
+}
+
+int fe_cli_parse_long(const char *opt, const char *text, long *value,
+                      char *err, size_t errlen)
+{
+    char *end;
+    long v;
+    errno = 0;
+    v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE) {
+        snprintf(err, errlen, "%s: '%s' is not a whole number", opt, text);
+        return FE_CLI_USAGE;
+    }
+    *value = v;
+    return FE_CLI_OK;
+}
+
+int fe_cli_split_list(char *text, char **items, int max)
+{
+    int n = 0;
+    char *p = text;
+    for (;;) {
+        char *comma = strchr(p, ',');
+        if (n == max)
+            return -1;
+        items[n++] = p;
+        if (comma == NULL)
+            return n;
+        *comma = '\0';
+        p = comma + 1;
+    }
+}
+
+void fe_cli_json_string(FILE *out, const char *s)
+{
+    fputc('"', out);
+    for (; *s != '\0'; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(out, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(out, "\\u%04x", c);
+        else
+            fputc(c, out);
+    }
+    fputc('"', out);
+}
+/* Write output atomically ends here */

@@ -1,0 +1,226 @@
+/* Tangled from literate/csv.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../literate/csv.org::CSV Includes][CSV Includes]] */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "foldest/csv.h"
+#include "foldest/error.h"
+/* CSV Includes ends here */
+/* [[file:../literate/csv.org::Read one line][Read one line]] */
+int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap)
+{
+    if (r == NULL || fd < 0 || buffer == NULL || cap < 2)
+        return FE_EINVAL;
+    r->fd = fd;
+    r->buf = buffer;
+    r->cap = cap;
+    r->len = r->pos = 0;
+    r->line = 0;
+    r->eof = 0;
+    r->skipping = 0;
+    return FE_OK;
+}
+
+/* Move the unread bytes to the front and read until the buffer is full
+   or the input ends. */
+static int fe__csv_refill(fe_csv_reader *r)
+{
+    size_t left = r->len - r->pos;
+    if (left > 0 && r->pos > 0)
+        memmove(r->buf, r->buf + r->pos, left);
+    r->len = left;
+    r->pos = 0;
+    while (!r->eof && r->len < r->cap - 1) {
+        ssize_t got = read(r->fd, r->buf + r->len, r->cap - 1 - r->len);
+        if (got < 0) {
+            if (errno == EINTR)
+                continue;
+            return FE_EIO;
+        }
+        if (got == 0)
+            r->eof = 1;
+        r->len += (size_t)got;
+        if (memchr(r->buf + r->len - (size_t)got, '\n', (size_t)got) != NULL)
+            break;
+    }
+    return FE_OK;
+}
+
+int fe_csv_next_line(fe_csv_reader *r, char **line, size_t *len)
+{
+    char *start, *nl;
+    size_t n;
+
+    if (r == NULL || line == NULL || len == NULL)
+        return FE_EINVAL;
+    while (r->skipping) {       /* the tail of a line reported too long */
+        nl = memchr(r->buf + r->pos, '\n', r->len - r->pos);
+        if (nl != NULL) {
+            r->pos = (size_t)(nl - r->buf) + 1;
+            r->skipping = 0;
+        } else {
+            int rc;
+            r->pos = r->len = 0;
+            if (r->eof) {
+                r->skipping = 0;
+                break;
+            }
+            rc = fe__csv_refill(r);
+            if (rc != FE_OK)
+                return rc;
+            if (r->len == 0)
+                r->skipping = 0;
+        }
+    }
+    nl = memchr(r->buf + r->pos, '\n', r->len - r->pos);
+    if (nl == NULL) {
+        int rc = fe__csv_refill(r);
+        if (rc != FE_OK)
+            return rc;
+        nl = memchr(r->buf + r->pos, '\n', r->len - r->pos);
+        if (nl == NULL && r->len == 0)
+            return FE_END;
+        if (nl == NULL && !r->eof) {
+            r->line++;
+            r->pos = r->len = 0;        /* drop what we could not hold */
+            r->skipping = 1;
+            return FE_ESIZE;
+        }
+    }
+    r->line++;
+    start = r->buf + r->pos;
+    n = nl != NULL ? (size_t)(nl - start) : r->len - r->pos;
+    r->pos += n + (nl != NULL);
+    start[n] = '\0';            /* the newline's place, or the spare byte */
+    if (n > 0 && start[n - 1] == '\r')
+        start[--n] = '\0';
+    if (memchr(start, '\0', n) != NULL)
+        return FE_EPARSE;
+    *line = start;
+    *len = n;
+    return FE_OK;
+}
+/* Read one line ends here */
+/* [[file:../literate/csv.org::Split a line into fields][Split a line into fields]] */
+char fe_csv_guess_delimiter(const char *line)
+{
+    if (strchr(line, ',') != NULL)
+        return ',';
+    if (strchr(line, ';') != NULL)
+        return ';';
+    if (strchr(line, '\t') != NULL)
+        return '\t';
+    return FE_CSV_WHITESPACE;
+}
+
+static int fe__csv_blank(char c)
+{
+    return c == ' ' || c == '\t';
+}
+
+int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
+                 size_t max, size_t *count, size_t *bad_column)
+{
+    char *p = line;
+    size_t k = 0;
+    int ws = delimiter == FE_CSV_WHITESPACE;
+
+    if (line == NULL || count == NULL || (fields == NULL && max > 0))
+        return FE_EINVAL;
+    *count = 0;
+    if (ws) {
+        while (fe__csv_blank(*p))
+            p++;
+        if (*p == '\0')
+            return FE_OK;
+    }
+    for (;;) {
+        char *out, *field_start;
+        while (!ws && fe__csv_blank(*p))
+            p++;
+        field_start = p;
+        out = p;
+        if (*p == '"') {                /* quoted: copy, undoubling "" */
+            p++;
+            for (;;) {
+                if (*p == '\0') {
+                    if (bad_column != NULL)
+                        *bad_column = (size_t)(field_start - line) + 1;
+                    return FE_EPARSE;
+                }
+                if (*p == '"' && p[1] == '"') {
+                    *out++ = '"';
+                    p += 2;
+                } else if (*p == '"') {
+                    p++;
+                    break;
+                } else {
+                    *out++ = *p++;
+                }
+            }
+            while (fe__csv_blank(*p))
+                p++;
+            if (*p != '\0' && *p != delimiter && !ws) {
+                if (bad_column != NULL)
+                    *bad_column = (size_t)(p - line) + 1;
+                return FE_EPARSE;
+            }
+        } else {
+            while (*p != '\0' && (ws ? !fe__csv_blank(*p) : *p != delimiter))
+                p++;
+            out = p;
+            while (out > field_start && fe__csv_blank(out[-1]))
+                out--;
+        }
+        if (k == max) {
+            *count = max + 1;
+            return FE_ESIZE;
+        }
+        fields[k].text = field_start;
+        fields[k].column = (size_t)(field_start - line) + 1;
+        k++;
+        if (ws)
+            while (fe__csv_blank(*p))
+                p++;
+        {
+            char c = *p;
+            *out = '\0';
+            *count = k;
+            if (c == '\0')
+                return FE_OK;
+            if (!ws)
+                p++;                    /* past the delimiter */
+            else if (*p == '\0')
+                return FE_OK;
+        }
+    }
+}
+/* Split a line into fields ends here */
+/* [[file:../literate/csv.org::Parse a field as a number][Parse a field as a number]] */
+int fe_csv_number(const fe_csv_field *field, double *value)
+{
+    char *end;
+    double v;
+    const char *s;
+
+    if (field == NULL || field->text == NULL || value == NULL)
+        return FE_EINVAL;
+    s = field->text;
+    if (*s == '\0')
+        return FE_EPARSE;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end != '\0')
+        return FE_EPARSE;
+    if (!isfinite(v))
+        return FE_ENONFINITE;
+    if (errno == ERANGE && fabs(v) > 1.0)
+        return FE_ENONFINITE;   /* overflow; an underflow to 0 or a denormal is kept */
+    *value = v;
+    return FE_OK;
+}
+/* Parse a field as a number ends here */

@@ -1,0 +1,104 @@
+/* The foldest command: tables with metadata, headers, quotes, CRLF and
+   white space; every malformed input gives FILE:LINE:COLUMN and its exit
+   status.  Runs the built binary (FE_TEST_CLI) on files written here. */
+#define _POSIX_C_SOURCE 200809L
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+#ifndef FE_TEST_CLI
+#define FE_TEST_CLI "build/bin/foldest"
+#endif
+
+/* Write `content` to a fresh file; run `foldest ARGS FILE`; capture stdout
+   and stderr (together, at most 4 KiB) and return the exit status. */
+static int run_on(const char *args, const char *content, size_t len, char *out,
+                  size_t outlen, char *path, size_t pathlen)
+{
+    char cmd[1024];
+    FILE *p;
+    size_t got;
+    int fd, status;
+    snprintf(path, pathlen, "/tmp/foldest-cli-XXXXXX");
+    fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    ck_assert_int_eq(write(fd, content, len), (ssize_t)len);
+    close(fd);
+    snprintf(cmd, sizeof cmd, "%s %s %s 2>&1", FE_TEST_CLI, args, path);
+    p = popen(cmd, "r");
+    ck_assert_ptr_nonnull(p);
+    got = fread(out, 1, outlen - 1, p);
+    out[got] = '\0';
+    status = pclose(p);
+    unlink(path);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+struct cli_case {
+    const char *what, *args, *content;
+    int status;
+    const char *expect;         /* a substring of the output; %s is the path */
+};
+
+static const struct cli_case cases[] = {
+    {"metadata lines then a header", "stats --json",
+     "Fs,50.00\nInitialization time,60\nmx,my,mz\n1,2,3\n3,4,5\n", 0, "\"rows\": 2"},
+    {"quoted header, CRLF", "stats --columns Time --json",
+     "\"Time (s)\",\"x\"\r\n0.5,1\r\n1.5,2\r\n", 0, "\"mean\": 1,"},
+    {"white space, no header", "stats --columns 2 --json",
+     "0.1\t1 \n0.2\t3\n", 0, "\"mean\": 2,"},
+    {"empty file", "stats", "", 3, "%s: no data"},
+    {"header only", "stats", "a,b\n", 3, "%s: no data rows"},
+    {"wrong field count", "stats", "a,b\n1,2\n3\n", 3, "%s:3:1: expected 2 fields, found 1"},
+    {"not a number", "stats", "a,b\n1,2\n3,x4\n", 3, "%s:3:3: 'x4' in column 'b' is not a number"},
+    {"NaN text", "stats", "a,b\n1,NaN\n", 3, "%s:2:3: 'NaN' in column 'b' is not a finite number"},
+    {"Inf text", "stats", "a,b\n1,2\n-inf,2\n", 3, "%s:3:1: '-inf' in column 'a' is not a finite"},
+    {"unterminated quote", "stats", "a,b\n1,2\n1,\"2\n", 3, "%s:3:3: unterminated"},
+    {"unknown column", "stats --columns zz", "a,b\n1,2\n", 2, "no column 'zz'; the columns are: 'a', 'b'"},
+    {"unknown option", "stats --frobnicate", "a\n1\n", 2, "unknown option '--frobnicate'"},
+};
+
+START_TEST(table_driven)
+{
+    const struct cli_case *c = &cases[_i];
+    char out[4096], path[64], want[512];
+    int status = run_on(c->args, c->content, strlen(c->content), out, sizeof out,
+                        path, sizeof path);
+    snprintf(want, sizeof want, c->expect, path);
+    ck_assert_msg(status == c->status, "%s: status %d, want %d; output:\n%s", c->what,
+                  status, c->status, out);
+    ck_assert_msg(strstr(out, want) != NULL, "%s: output lacks \"%s\":\n%s", c->what, want, out);
+}
+END_TEST
+
+START_TEST(binary_and_long_lines)
+{
+    char out[4096], path[64], want[256];
+    static char big[100000];
+    const char bin[] = "a,b\n1,2\n\0\1\2\n";
+    int status = run_on("stats", bin, sizeof bin - 1, out, sizeof out, path, sizeof path);
+    ck_assert_int_eq(status, 3);
+    snprintf(want, sizeof want, "%s:3:1: NUL byte", path);
+    ck_assert_msg(strstr(out, want) != NULL, "%s", out);
+    memset(big, '1', sizeof big);
+    memcpy(big, "a\n1\n", 4);
+    big[sizeof big - 1] = '\n';
+    status = run_on("stats", big, sizeof big, out, sizeof out, path, sizeof path);
+    ck_assert_int_eq(status, 3);
+    snprintf(want, sizeof want, "%s:3:1: line longer than", path);
+    ck_assert_msg(strstr(out, want) != NULL, "%s", out);
+}
+END_TEST
+
+Suite *fe_cli_suite(void)
+{
+    Suite *s = suite_create("cli");
+    TCase *t = tcase_create("stats");
+    tcase_set_timeout(t, 60);
+    tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
+    tcase_add_test(t, binary_and_long_lines);
+    suite_add_tcase(s, t);
+    return s;
+}

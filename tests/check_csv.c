@@ -1,0 +1,155 @@
+/* The CSV reader: lines (LF, CRLF, no final newline, too long, binary),
+   fields (delimiters, quotes, white space) and numbers. */
+#define _POSIX_C_SOURCE 200809L
+#include <unistd.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+/* A reader over `text` through a pipe, with a buffer of `cap` bytes. */
+typedef struct { int fd; char buf[64]; fe_csv_reader r; } pipe_reader;
+
+static void open_text(pipe_reader *p, const char *text, size_t cap)
+{
+    int fds[2];
+    size_t n = strlen(text);
+    ck_assert_int_eq(pipe(fds), 0);
+    ck_assert_int_eq(write(fds[1], text, n), (ssize_t)n);
+    close(fds[1]);
+    p->fd = fds[0];
+    ck_assert_int_eq(fe_csv_reader_init(&p->r, p->fd, p->buf, cap), FE_OK);
+}
+
+START_TEST(lines_lf_crlf_and_last_without_newline)
+{
+    pipe_reader p;
+    char *line;
+    size_t len;
+    open_text(&p, "a,b\r\n1,2\n\n3,4", sizeof p.buf);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "a,b");
+    ck_assert_uint_eq(len, 3);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "1,2");
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "");
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "3,4");
+    ck_assert_uint_eq(p.r.line, 4);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_END);
+    close(p.fd);
+}
+END_TEST
+
+START_TEST(too_long_line_is_reported_then_skipped)
+{
+    pipe_reader p;
+    char *line;
+    size_t len;
+    /* Buffer of 8 bytes: lines of up to 7 characters. */
+    open_text(&p, "1,2\n123456789012345678901234567890\n3,4\n", 8);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "1,2");
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_ESIZE);
+    ck_assert_uint_eq(p.r.line, 2);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "3,4");
+    ck_assert_uint_eq(p.r.line, 3);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_END);
+    close(p.fd);
+}
+END_TEST
+
+START_TEST(binary_input_is_refused)
+{
+    int fds[2];
+    char buf[32], *line;
+    size_t len;
+    fe_csv_reader r;
+    ck_assert_int_eq(pipe(fds), 0);
+    ck_assert_int_eq(write(fds[1], "1,2\n3\0004\n", 8), 8);
+    close(fds[1]);
+    fe_csv_reader_init(&r, fds[0], buf, sizeof buf);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_EPARSE);
+    ck_assert_uint_eq(r.line, 2);
+    close(fds[0]);
+}
+END_TEST
+
+START_TEST(split_commas_quotes_and_blanks)
+{
+    char line[] = "\"Time (s)\", x ,\"say \"\"hi\"\"\",,last";
+    fe_csv_field f[8];
+    size_t n = 0;
+    ck_assert_int_eq(fe_csv_guess_delimiter(line), ',');
+    ck_assert_int_eq(fe_csv_split(line, ',', f, 8, &n, NULL), FE_OK);
+    ck_assert_uint_eq(n, 5);
+    ck_assert_str_eq(f[0].text, "Time (s)");
+    ck_assert_uint_eq(f[0].column, 1);
+    ck_assert_str_eq(f[1].text, "x");
+    ck_assert_uint_eq(f[1].column, 13);
+    ck_assert_str_eq(f[2].text, "say \"hi\"");
+    ck_assert_str_eq(f[3].text, "");
+    ck_assert_str_eq(f[4].text, "last");
+}
+END_TEST
+
+START_TEST(split_white_space_and_errors)
+{
+    char ws[] = "  0.025\t-0.80  9.6 ";
+    char quote[] = "1,\"open";
+    char after[] = "1,\"a\"b,3";
+    char many[] = "1,2,3,4";
+    fe_csv_field f[3];
+    size_t n = 0, col = 0;
+    ck_assert_int_eq(fe_csv_guess_delimiter(ws), '\t');
+    ck_assert_int_eq(fe_csv_split(ws, FE_CSV_WHITESPACE, f, 3, &n, NULL), FE_OK);
+    ck_assert_uint_eq(n, 3);
+    ck_assert_str_eq(f[0].text, "0.025");
+    ck_assert_str_eq(f[2].text, "9.6");
+    ck_assert_int_eq(fe_csv_split(quote, ',', f, 3, &n, &col), FE_EPARSE);
+    ck_assert_uint_eq(col, 3);
+    ck_assert_int_eq(fe_csv_split(after, ',', f, 3, &n, &col), FE_EPARSE);
+    ck_assert_uint_eq(col, 6);
+    ck_assert_int_eq(fe_csv_split(many, ',', f, 3, &n, NULL), FE_ESIZE);
+    ck_assert_uint_eq(n, 4);
+}
+END_TEST
+
+START_TEST(numbers)
+{
+    struct { const char *text; int rc; double value; } cases[] = {
+        {"1.5", FE_OK, 1.5},        {"-2.372269500E-2", FE_OK, -2.372269500E-2},
+        {"15032", FE_OK, 15032},    {"", FE_EPARSE, 0},
+        {"x_a", FE_EPARSE, 0},      {"1.5abc", FE_EPARSE, 0},
+        {"nan", FE_ENONFINITE, 0},  {"-inf", FE_ENONFINITE, 0},
+        {"1e999", FE_ENONFINITE, 0}, {"1e-310", FE_OK, 1e-310},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char text[32];
+        fe_csv_field f = {text, 1};
+        double v = 12345;
+        strcpy(text, cases[i].text);
+        ck_assert_msg(fe_csv_number(&f, &v) == cases[i].rc, "case %s", cases[i].text);
+        if (cases[i].rc == FE_OK)
+            ck_assert_double_eq(v, cases[i].value);
+        else
+            ck_assert_double_eq(v, 12345);
+    }
+}
+END_TEST
+
+Suite *fe_csv_suite(void)
+{
+    Suite *s = suite_create("csv");
+    TCase *t = tcase_create("core");
+    tcase_add_test(t, lines_lf_crlf_and_last_without_newline);
+    tcase_add_test(t, too_long_line_is_reported_then_skipped);
+    tcase_add_test(t, binary_input_is_refused);
+    tcase_add_test(t, split_commas_quotes_and_blanks);
+    tcase_add_test(t, split_white_space_and_errors);
+    tcase_add_test(t, numbers);
+    suite_add_tcase(s, t);
+    return s;
+}
