@@ -129,10 +129,11 @@ check-plain: $(B)/tests/check_foldest all
 
 check-san: $(B)/tests/check_foldest_san
 	@echo "== tests (AddressSanitizer + UndefinedBehaviorSanitizer)"
-	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	FE_TEST_QUICK=1 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  $(B)/tests/check_foldest_san
 
-# Under valgrind the heavy statistical loops run smaller (FE_TEST_QUICK).
+# Under the sanitizers and valgrind the heavy statistical loops run smaller
+# (FE_TEST_QUICK): they check memory and behaviour, the plain run the statistics.
 check-valgrind: $(B)/tests/check_foldest
 	@echo "== tests (valgrind memcheck)"
 	CK_FORK=no FE_TEST_QUICK=1 valgrind -q --error-exitcode=99 --leak-check=full \

@@ -11,6 +11,10 @@
 #include "foldest/meanvar.h"
 #include "foldest/random.h"
 #include "foldest/csv.h"
+#include "foldest/special.h"
+#include "foldest/discover.h"
+#include "foldest/catalog.h"
+#include "foldest/synth.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

@@ -1,0 +1,144 @@
+/* Tangled from literate/discover.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/discover.org::Discovery Accumulation Declarations][Discovery Accumulation Declarations]] */
+#ifndef FOLDEST_DISCOVER_H
+#define FOLDEST_DISCOVER_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "foldest/fold.h"
+
+enum {
+    FE_DISCOVER_MAX_COLUMNS = 64,   /* term columns m */
+    FE_DISCOVER_MAX_GROUPS = 48,    /* candidate terms (groups of columns) */
+    FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
+    FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
+    FE_DISCOVER_MAX_STEPS = 12      /* forward-selection steps */
+};
+
+/* The accumulation: K block Gram matrices of the rows (phi, r), one for
+   held-out rows, the lag-one cross product, and the first and last rows.
+   Memory is the caller's: fe_discover_acc_doubles() doubles. */
+typedef struct fe_discover_acc {
+    size_t m;                   /* term columns; M = m + 1 with r */
+    size_t blocks;              /* K */
+    uint64_t fit_rows;          /* rows [0, fit_rows) are fitted, the rest held out */
+    uint64_t row0;              /* global index of this part's first row */
+    uint64_t n;                 /* rows folded into this part */
+    int have_prev;              /* the last row can be followed (no break) */
+    int first_linked;           /* the first row follows the previous part */
+    double *gram;               /* (K + 1) x M x M, upper triangles */
+    double *lag;                /* M x M, sum z_t z_{t-1}^T over fitted rows */
+    double *first, *last;       /* M each */
+    double *counts;             /* K + 1 row counts */
+} fe_discover_acc;
+
+/* fe_discover_acc_doubles: doubles of storage for m columns, K blocks. */
+size_t fe_discover_acc_doubles(size_t m, size_t blocks);
+
+/* fe_discover_acc_init: an empty accumulation over `storage` (at least
+   fe_discover_acc_doubles(m, blocks) doubles, owned by the caller).  The
+   whole stream has `fit_rows` fitted rows followed by held-out rows; this
+   part starts at global row `row0` (0 unless the stream is split).
+   Errors: FE_EINVAL, FE_ESIZE (m or blocks out of range), FE_ETOOFEW
+   (fewer fitted rows than 2 per block). */
+int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
+                         uint64_t fit_rows, uint64_t row0, double *storage,
+                         size_t storage_doubles);
+
+/* fe_discover_add: fold one row: m term values `phi` and the residual r =
+   recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
+   value is not finite.  Cost O(M^2). */
+int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
+
+/* fe_discover_break: the next row does not follow the last in time (a new
+   recording begins): no lag product is formed across. */
+void fe_discover_break(fe_discover_acc *a);
+
+/* fe_discover_merge: a <- a (+) b, where b holds the rows right after a's
+   (b->row0 == a->row0 + a->n).  FE_EMISMATCH otherwise or when the shapes
+   differ; a is then unchanged. */
+int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b);
+/* Discovery Accumulation Declarations ends here */
+/* [[file:../../literate/discover.org::Discovery Selection Declarations][Discovery Selection Declarations]] */
+/* A candidate term: a name and the columns it occupies. */
+typedef struct fe_discover_group {
+    const char *name;
+    size_t first, count;        /* columns first .. first + count - 1 */
+} fe_discover_group;
+
+typedef struct fe_discover_options {
+    double alpha;               /* family-wise level of a step: 0.05 */
+    size_t max_steps;           /* at most this many terms added: 8 */
+    const size_t *base;         /* groups always in the model (may be NULL) */
+    size_t nbase;
+} fe_discover_options;
+
+/* fe_discover_default_options: alpha 0.05, 8 steps, no base terms. */
+fe_discover_options fe_discover_default_options(void);
+
+/* One candidate's test at one step. */
+typedef struct fe_discover_rank {
+    size_t group;
+    double rss_drop;            /* Delta_J: the drop in RSS if added */
+    double statistic;           /* t (one column) or F (several) */
+    double p_value;             /* batch-means p-value */
+    double delta_bic;           /* BIC change if added (negative: better) */
+    int redundant;              /* already expressible by the model */
+} fe_discover_rank;
+
+/* A summary of a fitted model. */
+typedef struct fe_discover_fit {
+    double rss, rms;            /* fitted rows */
+    double bic;                 /* with the effective sample size */
+    double heldout_rms;         /* NaN when nothing is held out */
+    double lag1;                /* lag-one autocorrelation of the residual */
+    double n, n_eff, heldout_n;
+    size_t params;
+} fe_discover_fit;
+
+/* What discovery found. */
+typedef struct fe_discover_result {
+    size_t steps;                               /* terms added */
+    size_t added[FE_DISCOVER_MAX_STEPS];        /* their groups, in order */
+    fe_discover_rank added_rank[FE_DISCOVER_MAX_STEPS];
+    size_t alike[FE_DISCOVER_MAX_STEPS][FE_DISCOVER_MAX_GROUPS];
+    size_t nalike[FE_DISCOVER_MAX_STEPS];       /* indistinguishable groups */
+    /* The rankings: ranking[s][0..nranked[s]-1] before step s; the last
+       one (s = steps) is what was left when selection stopped. */
+    fe_discover_rank ranking[FE_DISCOVER_MAX_STEPS + 1][FE_DISCOVER_MAX_GROUPS];
+    size_t nranked[FE_DISCOVER_MAX_STEPS + 1];
+    /* The final model: its columns, coefficients and batch-means standard
+       errors (and those of the baseline, the base terms alone). */
+    size_t ncols;
+    size_t cols[FE_DISCOVER_MAX_COLUMNS];
+    double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
+    double t_critical;                          /* for 95% intervals */
+    fe_discover_fit baseline, final;
+} fe_discover_result;
+
+/* fe_discover_workspace_doubles: scratch needed by fe_discover_select. */
+size_t fe_discover_workspace_doubles(size_t m, size_t blocks);
+
+/* fe_discover_select: rank the `ngroups` candidate groups, add terms by
+   forward selection, fit them, and summarise baseline and final models,
+   all from the accumulation.  Errors: FE_EINVAL; FE_ETOOFEW (a block is
+   empty); FE_ESINGULAR (the base terms are collinear); FE_ESIZE
+   (workspace too small). */
+int fe_discover_select(const fe_discover_acc *a,
+                       const fe_discover_group *groups, size_t ngroups,
+                       const fe_discover_options *options,
+                       fe_discover_result *result, double *work,
+                       size_t work_doubles);
+
+/* fe_discover_fit_columns: least-squares fit of the given columns from
+   the accumulation: coefficients, batch-means standard errors and the
+   summary.  Used for the baseline and the final model, and by callers
+   who want a model of their own choosing. */
+int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
+                            size_t ncols, double *coef, double *stderr_,
+                            fe_discover_fit *fit, double *work,
+                            size_t work_doubles);
+
+#endif /* FOLDEST_DISCOVER_H */
+/* Discovery Selection Declarations ends here */

@@ -1,0 +1,206 @@
+/* Tangled from literate/catalog.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../literate/catalog.org::Catalog Includes][Catalog Includes]] */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "foldest/catalog.h"
+#include "foldest/error.h"
+/* Catalog Includes ends here */
+/* [[file:../literate/catalog.org::Evaluate the built-in terms][Evaluate the built-in terms]] */
+static double fe__kelvin(double t, int is_kelvin)
+{
+    return is_kelvin ? t : t + 273.15;
+}
+
+static double fe__bias(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)s; (void)c; (void)u; return 1.0; }
+static double fe__drift(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)u; return s->t - c->t_first; }
+static double fe__gain(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->sim; }
+static double fe__delay(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->dsim; }
+static double fe__viscous(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->velocity; }
+static double fe__quadratic(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->velocity * fabs(s->velocity); }
+static double fe__coulomb(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{
+    (void)u;
+    return c->vmax > 0.0 ? tanh(s->velocity / (0.002 * c->vmax)) : 0.0;
+}
+static double fe__linear(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->position; }
+static double fe__cubic(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->position * s->position * s->position; }
+static double fe__thermal(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)u; return s->temperature - c->temperature_first; }
+static double fe__newton(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{
+    (void)u;
+    return fe__kelvin(s->temperature, c->temperature_kelvin)
+           - fe__kelvin(s->ambient, c->ambient_kelvin);
+}
+static double fe__radiative(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{
+    double t = fe__kelvin(s->temperature, c->temperature_kelvin);
+    double a = fe__kelvin(s->ambient, c->ambient_kelvin);
+    (void)u;
+    return (t * t) * (t * t) - (a * a) * (a * a);
+}
+static double fe__input(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{ (void)c; (void)u; return s->input; }
+
+static const fe_term fe__builtin[] = {
+    {"bias", "constant sensor or actuator offset", fe__bias, 0, 0},
+    {"drift", "offset drifting with time", fe__drift, 0, 0},
+    {"gain", "scale-factor error", fe__gain, 0, 0},
+    {"delay", "time lag between simulation and recording", fe__delay, 0, 0},
+    {"viscous_friction", "force proportional to velocity (viscous damping, Stokes drag)",
+     fe__viscous, 0, FE_ROLE_VELOCITY},
+    {"quadratic_drag", "aerodynamic (turbulent) drag", fe__quadratic, 0, FE_ROLE_VELOCITY},
+    {"coulomb_friction", "dry friction", fe__coulomb, 0, FE_ROLE_VELOCITY},
+    {"linear_stiffness", "missing spring or restoring force", fe__linear, 0, FE_ROLE_POSITION},
+    {"cubic_stiffness", "hardening or softening spring", fe__cubic, 0, FE_ROLE_POSITION},
+    {"thermal_sensitivity", "temperature coefficient", fe__thermal, 0, FE_ROLE_TEMPERATURE},
+    {"newton_cooling", "convective heat loss", fe__newton, 0,
+     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
+    {"radiative_cooling", "thermal radiation", fe__radiative, 0,
+     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
+    {"input_gain", "actuator gain error", fe__input, 0, FE_ROLE_INPUT},
+};
+
+const fe_term *fe_catalog_builtin_terms(size_t *count)
+{
+    if (count != NULL)
+        *count = sizeof fe__builtin / sizeof fe__builtin[0];
+    return fe__builtin;
+}
+/* Evaluate the built-in terms ends here */
+/* [[file:../literate/catalog.org::Build and evaluate a catalog][Build and evaluate a catalog]] */
+int fe_catalog_scale_add(fe_catalog_scale *scale, const fe_sample *s)
+{
+    if (scale == NULL || s == NULL)
+        return FE_EINVAL;
+    if (scale->n == 0) {
+        scale->t_first = s->t;
+        scale->temperature_first = s->temperature;
+        scale->vmax = 0.0;
+    }
+    if (fabs(s->velocity) > scale->vmax)
+        scale->vmax = fabs(s->velocity);
+    scale->n++;
+    return FE_OK;
+}
+
+int fe_catalog_init(fe_catalog *c, unsigned roles, const fe_catalog_scale *scale)
+{
+    size_t nb;
+    const fe_term *b = fe_catalog_builtin_terms(&nb);
+    if (c == NULL || scale == NULL)
+        return FE_EINVAL;
+    memset(c, 0, sizeof *c);
+    c->roles = roles;
+    c->scale = *scale;
+    for (size_t i = 0; i < nb; i++)
+        if ((b[i].needs & roles) == b[i].needs)
+            c->terms[c->count++] = b[i];
+    return FE_OK;
+}
+
+long fe_catalog_find(const fe_catalog *c, const char *name)
+{
+    for (size_t i = 0; c != NULL && name != NULL && i < c->count; i++)
+        if (strcmp(c->terms[i].name, name) == 0)
+            return (long)i;
+    return -1;
+}
+
+int fe_catalog_add(fe_catalog *c, const char *name, const char *description,
+                   fe_term_fn *eval, void *user)
+{
+    if (c == NULL || name == NULL || eval == NULL || fe_catalog_find(c, name) >= 0)
+        return FE_EINVAL;
+    if (c->count >= FE_DISCOVER_MAX_GROUPS)
+        return FE_ESIZE;
+    c->terms[c->count].name = name;
+    c->terms[c->count].description = description != NULL ? description : "user term";
+    c->terms[c->count].eval = eval;
+    c->terms[c->count].user = user;
+    c->terms[c->count].needs = 0;
+    c->count++;
+    return FE_OK;
+}
+
+int fe_catalog_eval(const fe_catalog *c, const fe_sample *s, double *phi)
+{
+    if (c == NULL || s == NULL || phi == NULL)
+        return FE_EINVAL;
+    for (size_t j = 0; j < c->count; j++) {
+        phi[j] = c->terms[j].eval(s, &c->scale, c->terms[j].user);
+        if (!isfinite(phi[j]))
+            return FE_ENONFINITE;
+    }
+    return FE_OK;
+}
+
+void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups)
+{
+    for (size_t j = 0; j < c->count; j++) {
+        groups[j].name = c->terms[j].name;
+        groups[j].first = j;
+        groups[j].count = 1;
+    }
+}
+/* Build and evaluate a catalog ends here */
+/* [[file:../literate/catalog.org::Read a coefficient in words][Read a coefficient in words]] */
+int fe_catalog_explain(const char *name, double coef, double se, char *buf,
+                       size_t len)
+{
+    if (buf == NULL || len == 0)
+        return FE_EINVAL;
+    if (name == NULL)
+        name = "";
+    if (strcmp(name, "bias") == 0)
+        snprintf(buf, len, "constant offset of %.4g +/- %.2g (channel units)", coef, se);
+    else if (strcmp(name, "drift") == 0)
+        snprintf(buf, len, "offset drifting by %.4g +/- %.2g per time unit", coef, se);
+    else if (strcmp(name, "gain") == 0)
+        snprintf(buf, len, "scale-factor error: recording = (1 %+.4g) x simulation (%.3g%% +/- %.2g%%)",
+                 coef, 100 * coef, 100 * se);
+    else if (strcmp(name, "delay") == 0)
+        snprintf(buf, len, "time lag: the recording lags the simulation by %.4g +/- %.2g time units",
+                 -coef, se);
+    else if (strcmp(name, "viscous_friction") == 0)
+        snprintf(buf, len, "viscous damping: a = -b v with b = %.4g +/- %.2g (1/time)", -coef, se);
+    else if (strcmp(name, "quadratic_drag") == 0) {
+        int n = snprintf(buf, len, "quadratic drag: a = -k v|v| with k = %.4g +/- %.2g (1/length)",
+                         -coef, se);
+        if (-coef > 0 && n > 0 && (size_t)n < len)
+            snprintf(buf + n, len - (size_t)n,
+                     "; terminal speed sqrt(g/k) = %.3g m/s for an acceleration in m/s^2",
+                     sqrt(9.80665 / -coef));
+    } else if (strcmp(name, "coulomb_friction") == 0)
+        snprintf(buf, len, "dry friction: a = -mu sign(v) with mu = %.4g +/- %.2g (channel units)",
+                 -coef, se);
+    else if (strcmp(name, "linear_stiffness") == 0)
+        snprintf(buf, len, "missing spring: a = -kappa x with kappa = %.4g +/- %.2g (1/time^2)",
+                 -coef, se);
+    else if (strcmp(name, "cubic_stiffness") == 0)
+        snprintf(buf, len, "cubic spring: a = -kappa3 x^3 with kappa3 = %.4g +/- %.2g (%s)",
+                 -coef, se, -coef >= 0 ? "hardening" : "softening");
+    else if (strcmp(name, "thermal_sensitivity") == 0)
+        snprintf(buf, len, "temperature coefficient of %.4g +/- %.2g channel units per degree",
+                 coef, se);
+    else if (strcmp(name, "newton_cooling") == 0)
+        snprintf(buf, len, "convective loss: %.4g +/- %.2g per degree of T - T_ambient", coef, se);
+    else if (strcmp(name, "radiative_cooling") == 0)
+        snprintf(buf, len, "radiative loss: %.4g +/- %.2g per K^4 of T^4 - T_ambient^4", coef, se);
+    else if (strcmp(name, "input_gain") == 0)
+        snprintf(buf, len, "actuator gain error: %.4g +/- %.2g per input unit", coef, se);
+    else
+        snprintf(buf, len, "coefficient %.4g +/- %.2g", coef, se);
+    return FE_OK;
+}
+/* Read a coefficient in words ends here */

@@ -1,0 +1,600 @@
+/* Tangled from literate/discover.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../literate/discover.org::Discovery Includes][Discovery Includes]] */
+#include <math.h>
+#include <string.h>
+
+#include <lapacke.h>
+
+#include "foldest/discover.h"
+#include "foldest/error.h"
+#include "foldest/special.h"
+
+/* Element (i, j) of a symmetric matrix stored in its upper triangle. */
+static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
+{
+    return i <= j ? g[i * dim + j] : g[j * dim + i];
+}
+/* Discovery Includes ends here */
+/* [[file:../literate/discover.org::Fold a row into its block][Fold a row into its block]] */
+size_t fe_discover_acc_doubles(size_t m, size_t blocks)
+{
+    size_t dim = m + 1;
+    return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1;
+}
+
+int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
+                         uint64_t fit_rows, uint64_t row0, double *storage,
+                         size_t storage_doubles)
+{
+    size_t dim = m + 1, need;
+    if (a == NULL || storage == NULL)
+        return FE_EINVAL;
+    if (m == 0 || m > FE_DISCOVER_MAX_COLUMNS || blocks < 2
+        || blocks > FE_DISCOVER_MAX_BLOCKS)
+        return FE_ESIZE;
+    need = fe_discover_acc_doubles(m, blocks);
+    if (storage_doubles < need)
+        return FE_ESIZE;
+    if (fit_rows < 2 * (uint64_t)blocks)
+        return FE_ETOOFEW;
+    memset(storage, 0, need * sizeof *storage);
+    a->m = m;
+    a->blocks = blocks;
+    a->fit_rows = fit_rows;
+    a->row0 = row0;
+    a->n = 0;
+    a->have_prev = 0;
+    a->first_linked = 1;
+    a->gram = storage;
+    a->lag = a->gram + (blocks + 1) * dim * dim;
+    a->first = a->lag + dim * dim;
+    a->last = a->first + dim;
+    a->counts = a->last + dim;
+    return FE_OK;
+}
+
+static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
+{
+    if (row >= a->fit_rows)
+        return a->blocks;                       /* held out */
+    return (size_t)(row * a->blocks / a->fit_rows);
+}
+
+int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
+{
+    size_t dim, k;
+    uint64_t row;
+    double z[FE_DISCOVER_MAX_COLUMNS + 1], *g;
+
+    if (a == NULL || phi == NULL)
+        return FE_EINVAL;
+    dim = a->m + 1;
+    for (size_t i = 0; i < a->m; i++) {
+        if (!isfinite(phi[i]))
+            return FE_ENONFINITE;
+        z[i] = phi[i];
+    }
+    if (!isfinite(r))
+        return FE_ENONFINITE;
+    z[a->m] = r;
+    row = a->row0 + a->n;
+    k = fe__discover_block(a, row);
+    g = a->gram + k * dim * dim;
+    /* Add z z^T to the block's upper triangle. */
+    for (size_t i = 0; i < dim; i++) {
+        double zi = z[i];
+        double *gi = g + i * dim;
+        if (zi == 0.0)
+            continue;
+        for (size_t j = i; j < dim; j++)
+            gi[j] += zi * z[j];
+    }
+    a->counts[k] += 1.0;
+    /* Add z_t z_{t-1}^T when the previous row is a fitted neighbour. */
+    if (a->have_prev && k < a->blocks)
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = 0; j < dim; j++)
+                a->lag[i * dim + j] += z[i] * a->last[j];
+    if (a->n == 0)
+        memcpy(a->first, z, dim * sizeof *z);
+    memcpy(a->last, z, dim * sizeof *z);
+    a->have_prev = k < a->blocks;
+    a->n++;
+    return FE_OK;
+}
+
+void fe_discover_break(fe_discover_acc *a)
+{
+    if (a == NULL)
+        return;
+    a->have_prev = 0;
+    if (a->n == 0)
+        a->first_linked = 0;
+}
+/* Fold a row into its block ends here */
+/* [[file:../literate/discover.org::Merge consecutive accumulations][Merge consecutive accumulations]] */
+int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
+{
+    size_t dim, total;
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
+        || b->row0 != a->row0 + a->n)
+        return FE_EMISMATCH;
+    if (b->n == 0)
+        return FE_OK;
+    dim = a->m + 1;
+    total = (a->blocks + 1) * dim * dim;
+    for (size_t i = 0; i < total; i++)
+        a->gram[i] += b->gram[i];
+    for (size_t i = 0; i <= a->blocks; i++)
+        a->counts[i] += b->counts[i];
+    for (size_t i = 0; i < dim * dim; i++)
+        a->lag[i] += b->lag[i];
+    /* The lag product across the cut. */
+    if (a->n > 0 && a->have_prev && b->first_linked
+        && fe__discover_block(a, b->row0) < a->blocks)
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = 0; j < dim; j++)
+                a->lag[i * dim + j] += b->first[i] * a->last[j];
+    if (a->n == 0) {
+        memcpy(a->first, b->first, dim * sizeof *a->first);
+        a->first_linked = b->first_linked;
+    }
+    memcpy(a->last, b->last, dim * sizeof *a->last);
+    a->have_prev = b->have_prev;
+    a->n += b->n;
+    return FE_OK;
+}
+/* Merge consecutive accumulations ends here */
+/* [[file:../literate/discover.org::Workspace layout][Workspace layout]] */
+typedef struct fe__ws {
+    double *g;          /* M x M total Gram of fitted rows, full */
+    double *css;        /* S x S Cholesky factor of G_SS */
+    double *b;          /* S: G_SS^{-1} G_Sr */
+    double *aj;         /* S x d: G_SS^{-1} G_SJ */
+    double *sjj;        /* d x d Schur complement */
+    double *cj;         /* d */
+    double *ck;         /* K x d per-block shares */
+    double *v;          /* d x d covariance of the shares */
+    double *u;          /* K x S block gradients */
+    double *omega;      /* S x S */
+    double *tmp;        /* S x S */
+} fe__ws;
+
+size_t fe_discover_workspace_doubles(size_t m, size_t blocks)
+{
+    size_t dim = m + 1, d = FE_DISCOVER_MAX_GROUP_SIZE;
+    return dim * dim * 4 + dim * (d + 2) + d * d * 2 + d + blocks * d
+           + blocks * dim + 64;
+}
+
+static int fe__ws_carve(fe__ws *w, double *work, size_t len, size_t m,
+                        size_t blocks)
+{
+    size_t dim = m + 1, d = FE_DISCOVER_MAX_GROUP_SIZE;
+    if (work == NULL || len < fe_discover_workspace_doubles(m, blocks))
+        return FE_ESIZE;
+    w->g = work;
+    w->css = w->g + dim * dim;
+    w->omega = w->css + dim * dim;
+    w->tmp = w->omega + dim * dim;
+    w->b = w->tmp + dim * dim;
+    w->aj = w->b + dim;
+    w->sjj = w->aj + dim * d;
+    w->v = w->sjj + d * d;
+    w->cj = w->v + d * d;
+    w->ck = w->cj + d;
+    w->u = w->ck + blocks * d;
+    return FE_OK;
+}
+
+/* Sum the fitted blocks into a full symmetric matrix. */
+static void fe__total_gram(const fe_discover_acc *a, double *g)
+{
+    size_t dim = a->m + 1;
+    memset(g, 0, dim * dim * sizeof *g);
+    for (size_t k = 0; k < a->blocks; k++) {
+        const double *gk = a->gram + k * dim * dim;
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = i; j < dim; j++)
+                g[i * dim + j] += gk[i * dim + j];
+    }
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = 0; j < i; j++)
+            g[i * dim + j] = g[j * dim + i];
+}
+/* Workspace layout ends here */
+/* [[file:../literate/discover.org::Factorise the model's Gram matrix][Factorise the model's Gram matrix]] */
+typedef struct fe__model {
+    size_t n;
+    const size_t *cols;
+    double *chol;       /* scaled Cholesky factor, n x n, row-major upper */
+    double scale[FE_DISCOVER_MAX_COLUMNS];
+} fe__model;
+
+static int fe__factor(fe__model *mo, const double *g, size_t dim)
+{
+    for (size_t i = 0; i < mo->n; i++) {
+        double d = g[mo->cols[i] * dim + mo->cols[i]];
+        if (!(d > 0.0))
+            return FE_ESINGULAR;
+        mo->scale[i] = 1.0 / sqrt(d);
+    }
+    for (size_t i = 0; i < mo->n; i++)
+        for (size_t j = 0; j < mo->n; j++)
+            mo->chol[i * mo->n + j] = g[mo->cols[i] * dim + mo->cols[j]]
+                                      * mo->scale[i] * mo->scale[j];
+    if (mo->n == 0)
+        return FE_OK;
+    if (LAPACKE_dpotrf(LAPACK_ROW_MAJOR, 'U', (lapack_int)mo->n, mo->chol,
+                       (lapack_int)mo->n) != 0)
+        return FE_ESINGULAR;
+    for (size_t i = 0; i < mo->n; i++)
+        if (mo->chol[i * mo->n + i] < 1e-5)     /* pivot^2 < 1e-10 */
+            return FE_ESINGULAR;
+    return FE_OK;
+}
+
+/* x <- G_SS^{-1} x for `nrhs` right-hand sides stored as x[i * nrhs + r]. */
+static void fe__solve(const fe__model *mo, double *x, size_t nrhs)
+{
+    if (mo->n == 0)
+        return;
+    for (size_t i = 0; i < mo->n; i++)
+        for (size_t r = 0; r < nrhs; r++)
+            x[i * nrhs + r] *= mo->scale[i];
+    LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', (lapack_int)mo->n, (lapack_int)nrhs,
+                   mo->chol, (lapack_int)mo->n, x, (lapack_int)nrhs);
+    for (size_t i = 0; i < mo->n; i++)
+        for (size_t r = 0; r < nrhs; r++)
+            x[i * nrhs + r] *= mo->scale[i];
+}
+/* Factorise the model's Gram matrix ends here */
+/* [[file:../literate/discover.org::Fit a set of columns][Fit a set of columns]] */
+static double fe__quad_resid(const double *m, size_t dim, const size_t *cols,
+                             size_t n, const double *beta, size_t r, int sym)
+{
+    /* w^T X w with w = (-beta on cols, 1 on r); X full (sym = 0) or
+       upper-triangle symmetric (sym = 1). */
+    double s = sym ? fe__sym(m, dim, r, r) : m[r * dim + r];
+    for (size_t i = 0; i < n; i++) {
+        double xir = sym ? fe__sym(m, dim, cols[i], r) : m[cols[i] * dim + r];
+        double xri = sym ? xir : m[r * dim + cols[i]];
+        s -= beta[i] * (xir + xri);
+        for (size_t j = 0; j < n; j++)
+            s += beta[i] * beta[j]
+                 * (sym ? fe__sym(m, dim, cols[i], cols[j]) : m[cols[i] * dim + cols[j]]);
+    }
+    return s;
+}
+
+static int fe__fit(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
+                   size_t ncols, double *coef, double *se, fe_discover_fit *fit)
+{
+    size_t dim = a->m + 1, r = a->m, K = a->blocks;
+    fe__model mo = {ncols, cols, w->css, {0}};
+    double n = 0, num, den, rho;
+    int rc = fe__factor(&mo, w->g, dim);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t k = 0; k < K; k++)
+        n += a->counts[k];
+    for (size_t i = 0; i < ncols; i++)
+        coef[i] = w->g[cols[i] * dim + r];
+    fe__solve(&mo, coef, 1);
+    fit->rss = fe__quad_resid(w->g, dim, cols, ncols, coef, r, 0);
+    if (fit->rss < 0.0)
+        fit->rss = 0.0;
+    fit->n = n;
+    fit->params = ncols;
+    fit->rms = sqrt(fit->rss / n);
+    num = fe__quad_resid(a->lag, dim, cols, ncols, coef, r, 0);
+    den = fit->rss;
+    rho = den > 0.0 ? num / den : 0.0;
+    fit->lag1 = rho;
+    if (rho < 0.0)
+        rho = 0.0;
+    if (rho > 0.99)
+        rho = 0.99;
+    fit->n_eff = n * (1.0 - rho) / (1.0 + rho);
+    fit->bic = fit->n_eff * log(fit->rss > 0 ? fit->rss / n : 1e-300)
+               + (double)ncols * log(fit->n_eff);
+    fit->heldout_n = a->counts[K];
+    if (a->counts[K] > 0) {
+        double h = fe__quad_resid(a->gram + K * dim * dim, dim, cols, ncols, coef, r, 1);
+        fit->heldout_rms = sqrt((h > 0 ? h : 0) / a->counts[K]);
+    } else {
+        fit->heldout_rms = NAN;
+    }
+    /* Block sandwich standard errors. */
+    if (se != NULL && ncols > 0) {
+        memset(w->omega, 0, ncols * ncols * sizeof *w->omega);
+        for (size_t k = 0; k < K; k++) {
+            const double *gk = a->gram + k * dim * dim;
+            double *u = w->u;
+            for (size_t i = 0; i < ncols; i++) {
+                u[i] = fe__sym(gk, dim, cols[i], r);
+                for (size_t j = 0; j < ncols; j++)
+                    u[i] -= fe__sym(gk, dim, cols[i], cols[j]) * coef[j];
+            }
+            for (size_t i = 0; i < ncols; i++)
+                for (size_t j = 0; j < ncols; j++)
+                    w->omega[i * ncols + j] += u[i] * u[j];
+        }
+        for (size_t i = 0; i < ncols * ncols; i++)
+            w->omega[i] *= (double)K / (double)(K - 1);
+        /* tmp = G^{-1} Omega; then se_i^2 = (G^{-1} (G^{-1} Omega)^T)_ii. */
+        memcpy(w->tmp, w->omega, ncols * ncols * sizeof *w->tmp);
+        fe__solve(&mo, w->tmp, ncols);
+        for (size_t i = 0; i < ncols; i++)
+            for (size_t j = i + 1; j < ncols; j++) {
+                double t = w->tmp[i * ncols + j];
+                w->tmp[i * ncols + j] = w->tmp[j * ncols + i];
+                w->tmp[j * ncols + i] = t;
+            }
+        fe__solve(&mo, w->tmp, ncols);
+        for (size_t i = 0; i < ncols; i++)
+            se[i] = sqrt(fabs(w->tmp[i * ncols + i]));
+    }
+    return FE_OK;
+}
+
+int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
+                            size_t ncols, double *coef, double *stderr_,
+                            fe_discover_fit *fit, double *work,
+                            size_t work_doubles)
+{
+    fe__ws w;
+    int rc;
+    if (a == NULL || fit == NULL || (ncols > 0 && (cols == NULL || coef == NULL))
+        || ncols > a->m)
+        return FE_EINVAL;
+    for (size_t i = 0; i < ncols; i++)
+        if (cols[i] >= a->m)
+            return FE_EINVAL;
+    rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t k = 0; k < a->blocks; k++)
+        if (a->counts[k] < 1.0)
+            return FE_ETOOFEW;
+    fe__total_gram(a, w.g);
+    return fe__fit(a, &w, cols, ncols, coef, stderr_, fit);
+}
+/* Fit a set of columns ends here */
+/* [[file:../literate/discover.org::Score a candidate against the model][Score a candidate against the model]] */
+static void fe__score(const fe_discover_acc *a, const fe__ws *w,
+                      const fe__model *mo, const double *beta,
+                      const fe_discover_group *gr, double rss,
+                      const fe_discover_fit *cur, fe_discover_rank *out)
+{
+    size_t dim = a->m + 1, r = a->m, K = a->blocks, d = gr->count, s = mo->n;
+    double drop = 0.0, t2 = 0.0;
+    memset(out, 0, sizeof *out);
+    out->p_value = 1.0;
+    /* a_J = G_SS^{-1} G_SJ. */
+    for (size_t i = 0; i < s; i++)
+        for (size_t q = 0; q < d; q++)
+            w->aj[i * d + q] = w->g[mo->cols[i] * dim + gr->first + q];
+    fe__solve(mo, w->aj, d);
+    /* S_JJ and c_J. */
+    for (size_t p = 0; p < d; p++) {
+        size_t jp = gr->first + p;
+        w->cj[p] = w->g[jp * dim + r];
+        for (size_t i = 0; i < s; i++)
+            w->cj[p] -= w->g[jp * dim + mo->cols[i]] * beta[i];
+        for (size_t q = 0; q < d; q++) {
+            double v = w->g[jp * dim + gr->first + q];
+            for (size_t i = 0; i < s; i++)
+                v -= w->g[jp * dim + mo->cols[i]] * w->aj[i * d + q];
+            w->sjj[p * d + q] = v;
+        }
+    }
+    /* Delta_J = c^T S_JJ^{-1} c; a tiny Schur complement means the
+       candidate is already expressible by the model. */
+    {
+        double sc[FE_DISCOVER_MAX_GROUP_SIZE * FE_DISCOVER_MAX_GROUP_SIZE];
+        double x[FE_DISCOVER_MAX_GROUP_SIZE];
+        for (size_t p = 0; p < d; p++) {
+            double gjj = w->g[(gr->first + p) * dim + gr->first + p];
+            if (!(w->sjj[p * d + p] > 1e-9 * gjj)) {
+                out->redundant = 1;
+                return;
+            }
+        }
+        memcpy(sc, w->sjj, d * d * sizeof *sc);
+        memcpy(x, w->cj, d * sizeof *x);
+        if (LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', (lapack_int)d, 1, sc, (lapack_int)d,
+                          x, 1) != 0) {
+            out->redundant = 1;
+            return;
+        }
+        for (size_t p = 0; p < d; p++)
+            drop += w->cj[p] * x[p];
+    }
+    /* Per-block shares c_{J,k}. */
+    for (size_t k = 0; k < K; k++) {
+        const double *gk = a->gram + k * dim * dim;
+        for (size_t p = 0; p < d; p++) {
+            size_t jp = gr->first + p;
+            double v = fe__sym(gk, dim, jp, r);
+            for (size_t i = 0; i < s; i++) {
+                size_t ci = mo->cols[i];
+                double gsr = fe__sym(gk, dim, ci, r), gjs = fe__sym(gk, dim, jp, ci);
+                double gsb = 0.0;
+                for (size_t l = 0; l < s; l++)
+                    gsb += fe__sym(gk, dim, ci, mo->cols[l]) * beta[l];
+                v += -w->aj[i * d + p] * gsr - gjs * beta[i] + w->aj[i * d + p] * gsb;
+            }
+            w->ck[k * d + p] = v;
+        }
+    }
+    /* Hotelling's T^2 over the K shares. */
+    {
+        double mean[FE_DISCOVER_MAX_GROUP_SIZE] = {0};
+        double vv[FE_DISCOVER_MAX_GROUP_SIZE * FE_DISCOVER_MAX_GROUP_SIZE] = {0};
+        double x[FE_DISCOVER_MAX_GROUP_SIZE];
+        for (size_t k = 0; k < K; k++)
+            for (size_t p = 0; p < d; p++)
+                mean[p] += w->ck[k * d + p] / (double)K;
+        for (size_t k = 0; k < K; k++)
+            for (size_t p = 0; p < d; p++)
+                for (size_t q = 0; q < d; q++)
+                    vv[p * d + q] += (w->ck[k * d + p] - mean[p])
+                                     * (w->ck[k * d + q] - mean[q]) / (double)(K - 1);
+        memcpy(x, mean, d * sizeof *x);
+        if (K > d && LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', (lapack_int)d, 1, vv,
+                                   (lapack_int)d, x, 1) == 0) {
+            for (size_t p = 0; p < d; p++)
+                t2 += (double)K * mean[p] * x[p];
+            if (d == 1) {
+                out->statistic = (mean[0] >= 0 ? 1.0 : -1.0) * sqrt(t2);
+                out->p_value = fe_student_t_two_sided(out->statistic, (double)(K - 1));
+            } else {
+                out->statistic = (double)(K - d) / ((double)d * (double)(K - 1)) * t2;
+                out->p_value = fe_f_upper(out->statistic, (double)d, (double)(K - d));
+            }
+        } else {
+            /* Shares without spread: an exact fit; nothing to test. */
+            out->statistic = 0.0;
+            out->p_value = 1.0;
+        }
+    }
+    out->rss_drop = drop > 0.0 ? drop : 0.0;
+    {
+        double after = rss - out->rss_drop;
+        double n = cur->n, ne = cur->n_eff;
+        if (after < 1e-300)
+            after = 1e-300;
+        out->delta_bic = ne * log(after / n) + (double)(cur->params + d) * log(ne)
+                         - cur->bic;
+    }
+}
+/* Score a candidate against the model ends here */
+/* [[file:../literate/discover.org::Select terms by forward selection][Select terms by forward selection]] */
+fe_discover_options fe_discover_default_options(void)
+{
+    fe_discover_options o = {0.05, 8, NULL, 0};
+    return o;
+}
+
+static int fe__in_model(const size_t *added, size_t nadded, const size_t *base,
+                        size_t nbase, size_t g)
+{
+    for (size_t i = 0; i < nadded; i++)
+        if (added[i] == g)
+            return 1;
+    for (size_t i = 0; i < nbase; i++)
+        if (base[i] == g)
+            return 1;
+    return 0;
+}
+
+static size_t fe__model_columns(const fe_discover_group *groups,
+                                const size_t *base, size_t nbase,
+                                const size_t *added, size_t nadded, size_t *cols)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < nbase + nadded; i++) {
+        const fe_discover_group *g = &groups[i < nbase ? base[i] : added[i - nbase]];
+        for (size_t c = 0; c < g->count; c++)
+            cols[n++] = g->first + c;
+    }
+    return n;
+}
+
+int fe_discover_select(const fe_discover_acc *a,
+                       const fe_discover_group *groups, size_t ngroups,
+                       const fe_discover_options *options,
+                       fe_discover_result *res, double *work,
+                       size_t work_doubles)
+{
+    fe_discover_options o = options ? *options : fe_discover_default_options();
+    fe__ws w;
+    size_t cols[FE_DISCOVER_MAX_COLUMNS], ncols;
+    double beta[FE_DISCOVER_MAX_COLUMNS];
+    fe_discover_fit cur;
+    int rc;
+
+    if (a == NULL || groups == NULL || res == NULL || ngroups == 0
+        || ngroups > FE_DISCOVER_MAX_GROUPS || (o.nbase > 0 && o.base == NULL))
+        return FE_EINVAL;
+    for (size_t i = 0; i < ngroups; i++)
+        if (groups[i].count == 0 || groups[i].count > FE_DISCOVER_MAX_GROUP_SIZE
+            || groups[i].first + groups[i].count > a->m)
+            return FE_EINVAL;
+    for (size_t i = 0; i < o.nbase; i++)
+        if (o.base[i] >= ngroups)
+            return FE_EINVAL;
+    if (o.max_steps > FE_DISCOVER_MAX_STEPS)
+        o.max_steps = FE_DISCOVER_MAX_STEPS;
+    rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t k = 0; k < a->blocks; k++)
+        if (a->counts[k] < 1.0)
+            return FE_ETOOFEW;
+    memset(res, 0, sizeof *res);
+    fe__total_gram(a, w.g);
+    res->t_critical = fe_student_t_quantile(0.05, (double)(a->blocks - 1));
+
+    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, 0, cols);
+    rc = fe__fit(a, &w, cols, ncols, beta, NULL, &res->baseline);
+    if (rc != FE_OK)
+        return rc;
+    cur = res->baseline;
+    for (size_t step = 0;; step++) {
+        fe__model mo = {ncols, cols, w.css, {0}};
+        fe_discover_rank *rk = res->ranking[step];
+        size_t nr = 0, in_play = 0, best = (size_t)-1;
+        rc = fe__factor(&mo, w.g, a->m + 1);
+        if (rc != FE_OK)
+            return rc;
+        for (size_t g = 0; g < ngroups; g++) {
+            if (fe__in_model(res->added, res->steps, o.base, o.nbase, g))
+                continue;
+            fe__score(a, &w, &mo, beta, &groups[g], cur.rss, &cur, &rk[nr]);
+            rk[nr].group = g;
+            in_play += !rk[nr].redundant;
+            nr++;
+        }
+        res->nranked[step] = nr;
+        for (size_t i = 0; i < nr; i++) {
+            if (rk[i].redundant || !(rk[i].p_value < o.alpha / (double)in_play)
+                || !(rk[i].delta_bic < 0.0))
+                continue;
+            if (best == (size_t)-1 || rk[i].delta_bic < rk[best].delta_bic)
+                best = i;
+        }
+        /* Note the look-alikes of the previous pick, now that it is in. */
+        if (step > 0) {
+            size_t prev = step - 1;
+            const fe_discover_rank *before = res->ranking[prev];
+            for (size_t i = 0; i < res->nranked[prev]; i++) {
+                size_t g = before[i].group;
+                if (g == res->added[prev] || before[i].redundant)
+                    continue;
+                if (before[i].rss_drop < 0.8 * res->added_rank[prev].rss_drop)
+                    continue;
+                for (size_t j = 0; j < nr; j++)
+                    if (rk[j].group == g
+                        && (rk[j].redundant || rk[j].rss_drop <= 0.1 * before[i].rss_drop))
+                        res->alike[prev][res->nalike[prev]++] = g;
+            }
+        }
+        if (best == (size_t)-1 || step >= o.max_steps)
+            break;
+        res->added[res->steps] = rk[best].group;
+        res->added_rank[res->steps] = rk[best];
+        res->steps++;
+        ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
+        rc = fe__fit(a, &w, cols, ncols, beta, NULL, &cur);
+        if (rc != FE_OK)
+            return rc;
+    }
+    res->ncols = ncols;
+    memcpy(res->cols, cols, ncols * sizeof *cols);
+    return fe__fit(a, &w, cols, ncols, res->coef, res->stderr_, &res->final);
+}
+/* Select terms by forward selection ends here */

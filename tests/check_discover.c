@@ -1,0 +1,296 @@
+/* Discovery: the engine's algebra against brute force, merge, refusals, and
+   the acceptance suite on concealed synthetic cases (every catalog term as
+   the hidden effect, and null cases). */
+#include <stdint.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+/* Fold a synthetic case into an accumulation with K blocks, the last
+   `holdout` fraction held out; returns the generator's truth. */
+typedef struct {
+    fe_synth g;
+    fe_catalog c;
+    fe_discover_acc a;
+    double *storage, *work;
+    size_t nwork;
+    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
+    size_t base[4], nbase;
+} synth_case;
+
+static void fold_case(synth_case *sc, const char *effect, uint64_t seed, size_t rows,
+                      size_t K, double holdout)
+{
+    fe_synth_spec spec = fe_synth_default_spec(effect, seed);
+    fe_sample s;
+    double phi[FE_DISCOVER_MAX_COLUMNS];
+    size_t nst;
+    int rc = FE_OK;
+    if (rows > 0)
+        spec.rows = rows;
+    ck_assert_int_eq(fe_synth_init(&sc->g, &spec), FE_OK);
+    ck_assert_int_eq(fe_catalog_init(&sc->c, sc->g.roles, &sc->g.scale), FE_OK);
+    nst = fe_discover_acc_doubles(sc->c.count, K);
+    sc->storage = malloc(nst * sizeof *sc->storage);
+    sc->nwork = fe_discover_workspace_doubles(sc->c.count, K);
+    sc->work = malloc(sc->nwork * sizeof *sc->work);
+    ck_assert_ptr_nonnull(sc->storage);
+    ck_assert_ptr_nonnull(sc->work);
+    ck_assert_int_eq(fe_discover_acc_init(&sc->a, sc->c.count, K,
+                                          (uint64_t)((1.0 - holdout) * (double)spec.rows), 0,
+                                          sc->storage, nst), FE_OK);
+    while (fe_synth_next(&sc->g, &s) == FE_OK) {
+        rc |= fe_catalog_eval(&sc->c, &s, phi);
+        rc |= fe_discover_add(&sc->a, phi, s.real - s.sim);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    fe_catalog_groups(&sc->c, sc->groups);
+    sc->nbase = fe_synth_base(&sc->g, &sc->c, sc->base);
+}
+
+static void free_case(synth_case *sc)
+{
+    free(sc->storage);
+    free(sc->work);
+}
+
+START_TEST(fit_matches_brute_force)
+{
+    /* Coefficients, RSS, held-out RMS and lag-one autocorrelation from the
+       Gram matrices equal a direct computation over the rows. */
+    synth_case sc;
+    size_t cols[3];
+    double coef[3], se[3];
+    fe_discover_fit fit;
+    double rss = 0, hss = 0, lag = 0, prev = 0;
+    size_t i = 0, fitrows, nh = 0;
+    fe_sample s;
+    double phi[FE_DISCOVER_MAX_COLUMNS];
+    fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
+    cols[0] = (size_t)fe_catalog_find(&sc.c, "bias");
+    cols[1] = (size_t)fe_catalog_find(&sc.c, "gain");
+    cols[2] = (size_t)fe_catalog_find(&sc.c, "viscous_friction");
+    ck_assert_int_eq(fe_discover_fit_columns(&sc.a, cols, 3, coef, se, &fit, sc.work, sc.nwork), FE_OK);
+    fitrows = (size_t)sc.a.fit_rows;
+    fe_synth_rewind(&sc.g);
+    while (fe_synth_next(&sc.g, &s) == FE_OK) {
+        double e = s.real - s.sim;
+        fe_catalog_eval(&sc.c, &s, phi);
+        for (int j = 0; j < 3; j++)
+            e -= coef[j] * phi[cols[j]];
+        if (i < fitrows) {
+            rss += e * e;
+            if (i > 0)
+                lag += e * prev;
+            prev = e;
+        } else {
+            hss += e * e;
+            nh++;
+        }
+        i++;
+    }
+    FE_ASSERT_REL(fit.rss, rss, 1e-9);
+    FE_ASSERT_REL(fit.heldout_rms, sqrt(hss / (double)nh), 1e-9);
+    FE_ASSERT_REL(fit.lag1, lag / rss, 1e-8);
+    ck_assert(se[2] > 0 && isfinite(se[2]));
+    free_case(&sc);
+}
+END_TEST
+
+START_TEST(score_is_the_drop_in_rss)
+{
+    /* The ranking's rss_drop equals RSS(base) - RSS(base + j), for every j. */
+    synth_case sc;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fold_case(&sc, "coulomb_friction", 5, 20000, 20, 0.2);
+    o.base = sc.base;
+    o.nbase = sc.nbase;
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork), FE_OK);
+    ck_assert_uint_eq(r->steps, 0);
+    for (size_t i = 0; i < r->nranked[0]; i++) {
+        size_t cols[4];
+        double coef[4];
+        fe_discover_fit f;
+        memcpy(cols, sc.base, sc.nbase * sizeof *cols);
+        cols[sc.nbase] = r->ranking[0][i].group;
+        ck_assert_int_eq(fe_discover_fit_columns(&sc.a, cols, sc.nbase + 1, coef, NULL, &f,
+                                                 sc.work, sc.nwork), FE_OK);
+        ck_assert_double_eq_tol(r->ranking[0][i].rss_drop, r->baseline.rss - f.rss,
+                                1e-7 * r->baseline.rss);
+    }
+    free(r);
+    free_case(&sc);
+}
+END_TEST
+
+START_TEST(merge_of_consecutive_parts_equals_whole)
+{
+    /* Split the rows at awkward places, fold the parts, merge: the same
+       Gram matrices, counts and lag products as one fold. */
+    enum { N = 5000, M = 4, K = 10 };
+    static double phi[N][M], r[N];
+    fe_rng g = fe_rng_seed(9);
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *w = malloc(nst * sizeof *w), *p1 = malloc(nst * sizeof *w),
+           *p2 = malloc(nst * sizeof *w), *p3 = malloc(nst * sizeof *w);
+    fe_discover_acc whole, a, b, c;
+    const size_t cut1 = 1234, cut2 = 4001;       /* cut2 is in the held-out part */
+    int rc = FE_OK;
+    for (int i = 0; i < N; i++) {
+        for (int j = 0; j < M; j++)
+            phi[i][j] = fe_rng_normal(&g);
+        r[i] = fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(fe_discover_acc_init(&whole, M, K, 4000, 0, w, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 4000, 0, p1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, M, K, 4000, cut1, p2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&c, M, K, 4000, cut2, p3, nst), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        rc |= fe_discover_add(&whole, phi[i], r[i]);
+        rc |= fe_discover_add(i < cut1 ? &a : i < cut2 ? &b : &c, phi[i], r[i]);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    /* c cannot follow a directly. */
+    ck_assert_int_eq(fe_discover_merge(&a, &c), FE_EMISMATCH);
+    ck_assert_int_eq(fe_discover_merge(&b, &c), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);
+    ck_assert_uint_eq(a.n, N);
+    for (size_t i = 0; i < nst; i++)
+        ck_assert_double_eq_tol(p1[i], w[i], 1e-9 * (1 + fabs(w[i])));
+    free(w);
+    free(p1);
+    free(p2);
+    free(p3);
+}
+END_TEST
+
+START_TEST(refusals_leave_the_accumulation_unchanged)
+{
+    enum { M = 3, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *copy = malloc(nst * sizeof *st);
+    double phi[M] = {1, 2, 3}, bad[M] = {1, NAN, 3};
+    fe_discover_acc a, before;
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 7, 0, st, nst), FE_ETOOFEW);
+    ck_assert_int_eq(fe_discover_acc_init(&a, 0, K, 100, 0, st, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst - 1), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&a, phi, 0.5), FE_OK);
+    before = a;
+    memcpy(copy, st, nst * sizeof *st);
+    ck_assert_int_eq(fe_discover_add(&a, bad, 0.5), FE_ENONFINITE);
+    ck_assert_int_eq(fe_discover_add(&a, phi, INFINITY), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    free(st);
+    free(copy);
+}
+END_TEST
+
+START_TEST(selection_refuses_empty_blocks_and_collinear_base)
+{
+    enum { M = 3, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_acc a;
+    fe_discover_group g[3] = {{"one", 0, 1}, {"two", 1, 1}, {"twice_one", 2, 1}};
+    size_t base[2] = {0, 2};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_rng rng = fe_rng_seed(1);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
+    for (int i = 0; i < 20; i++) {
+        double x = fe_rng_normal(&rng), phi[M] = {x, fe_rng_normal(&rng), 2 * x};
+        fe_discover_add(&a, phi, fe_rng_normal(&rng));
+    }
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_ETOOFEW);
+    for (int i = 20; i < 100; i++) {
+        double x = fe_rng_normal(&rng), phi[M] = {x, fe_rng_normal(&rng), 2 * x};
+        fe_discover_add(&a, phi, fe_rng_normal(&rng));
+    }
+    o.base = base;
+    o.nbase = 2;
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_ESINGULAR);
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, 10), FE_ESIZE);
+    free(st);
+    free(w);
+    free(r);
+}
+END_TEST
+
+/* The acceptance suite of the discovery issue. */
+START_TEST(concealed_effects_are_found_and_nulls_are_not)
+{
+    size_t ncases, seeds = fe_test_quick() ? 2 : 20;
+    const char *const *effects = fe_synth_effects(&ncases);
+    unsigned runs = 0, first = 0, covered = 0, improved = 0, null_runs = 0, false_found = 0;
+    unsigned inflated = 0;
+    for (size_t e = 0; e < ncases; e++) {
+        int null_case = strncmp(effects[e], "none", 4) == 0;
+        unsigned case_first = 0;
+        for (uint64_t seed = 1; seed <= seeds; seed++) {
+            synth_case sc;
+            fe_discover_options o = fe_discover_default_options();
+            fe_discover_result *r = malloc(sizeof *r);
+            long truth;
+            fold_case(&sc, effects[e], seed, 0, 20, 0.3);
+            o.base = sc.base;
+            o.nbase = sc.nbase;
+            ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r,
+                                                sc.work, sc.nwork), FE_OK);
+            if (null_case) {
+                null_runs++;
+                false_found += r->steps > 0;
+            } else {
+                runs++;
+                truth = fe_catalog_find(&sc.c, effects[e]);
+                if (r->steps > 0 && (long)r->added[0] == truth) {
+                    first++;
+                    case_first++;
+                }
+                for (size_t i = 0; i < r->ncols; i++)
+                    if ((long)r->cols[i] == truth)
+                        covered += fabs(r->coef[i] - sc.g.coefficient)
+                                   <= r->t_critical * r->stderr_[i];
+                improved += r->final.heldout_rms < r->baseline.heldout_rms;
+                /* Concealment: the effect inflates the residual RMS by at
+                   most 5% over the noise alone (RMS of the fit without it). */
+                inflated += r->baseline.rms > 1.05 * r->final.rms;
+            }
+            free(r);
+            free_case(&sc);
+        }
+        if (!null_case)
+            fprintf(stderr, "discover acceptance: %-20s named first %u/%zu\n", effects[e],
+                    case_first, seeds);
+    }
+    fprintf(stderr, "discover acceptance: named first %u/%u, 95%% interval covers truth %u/%u, "
+            "held-out RMS improved %u/%u, false discoveries %u/%u null runs\n",
+            first, runs, covered, runs, improved, runs, false_found, null_runs);
+    ck_assert_uint_eq(inflated, 0);
+    ck_assert_msg(first >= 0.95 * runs, "named first %u/%u", first, runs);
+    ck_assert_msg(covered >= 0.90 * runs, "covered %u/%u", covered, runs);
+    ck_assert_msg(improved == runs, "held-out improved %u/%u", improved, runs);
+    ck_assert_msg(false_found <= 0.05 * null_runs, "false discoveries %u/%u", false_found, null_runs);
+}
+END_TEST
+
+Suite *fe_discover_suite(void)
+{
+    Suite *s = suite_create("discover");
+    TCase *t = tcase_create("engine");
+    TCase *acc = tcase_create("acceptance");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, fit_matches_brute_force);
+    tcase_add_test(t, score_is_the_drop_in_rss);
+    tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
+    tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, selection_refuses_empty_blocks_and_collinear_base);
+    tcase_set_timeout(acc, 900);
+    tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
+    suite_add_tcase(s, t);
+    suite_add_tcase(s, acc);
+    return s;
+}
