@@ -11,6 +11,7 @@
 #include "foldest/meanvar.h"
 #include "foldest/random.h"
 #include "foldest/lsq.h"
+#include "foldest/schur.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

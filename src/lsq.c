@@ -106,6 +106,55 @@ int fe_lsq_add_rows(fe_lsq *a, const double *J, size_t ldj, const double *r,
     return rc;
 }
 /* Fold one row ends here */
+/* [[file:../literate/lsq.org::Fold one sparse row][Fold one sparse row]] */
+int fe_lsq_add_sparse(fe_lsq *a, const size_t *idx, const double *val,
+                      size_t nnz, double r, double w)
+{
+    size_t d, s, t;
+    double *g;
+
+    if (a == NULL || a->g == NULL || (nnz > 0 && (idx == NULL || val == NULL)))
+        return FE_EINVAL;
+    if (!isfinite(w) || !isfinite(r))
+        return FE_ENONFINITE;
+    if (w < 0.0)
+        return FE_EINVAL;
+    d = a->p + 1;
+    g = a->g;
+    for (s = 0; s < nnz; s++) {
+        if (idx[s] >= a->p)
+            return FE_EINVAL;
+        for (t = 0; t < s; t++)
+            if (idx[t] == idx[s])
+                return FE_EINVAL;
+        if (!isfinite(val[s]))
+            return FE_ENONFINITE;
+    }
+    for (s = 0; s <= nnz; s++) {
+        size_t k = s < nnz ? idx[s] : a->p;
+        double v = s < nnz ? val[s] : r;
+        if (!(g[k * d + k] + w * v * v <= FE__LSQ_BIG))
+            return FE_ENONFINITE;
+    }
+    if (!(a->wsum + w <= FE__LSQ_BIG))
+        return FE_ENONFINITE;
+    for (s = 0; s <= nnz; s++) {
+        size_t k = s < nnz ? idx[s] : a->p;
+        double vs = s < nnz ? val[s] : r;
+        for (t = s; t <= nnz; t++) {
+            size_t l = t < nnz ? idx[t] : a->p;
+            double vt = t < nnz ? val[t] : r;
+            if (k <= l)
+                g[k * d + l] += (w * vs) * vt;
+            else
+                g[l * d + k] += (w * vt) * vs;
+        }
+    }
+    a->n++;
+    a->wsum += w;
+    return FE_OK;
+}
+/* Fold one sparse row ends here */
 /* [[file:../literate/lsq.org::Merge and copy accumulations][Merge and copy accumulations]] */
 int fe_lsq_merge(fe_lsq *a, const fe_lsq *b)
 {

@@ -470,6 +470,43 @@ START_TEST(exact_fit_has_zero_rss)
 }
 END_TEST
 
+START_TEST(sparse_rows_equal_dense_rows)
+{
+    enum { Q = 9, DQ = Q + 1 };
+    double gs[DQ * DQ], gd[DQ * DQ], row[Q], before[DQ * DQ];
+    const size_t idx[3] = {7, 2, 4}, rep[2] = {3, 3}, out[1] = {Q};
+    fe_rng rng = fe_rng_seed(11);
+    fe_lsq s, d, s0;
+    int rc = FE_OK;
+
+    fe_lsq_init(&s, Q, gs);
+    fe_lsq_init(&d, Q, gd);
+    for (int i = 0; i < 50; i++) {
+        double val[3], r = fe_rng_normal(&rng), w = 0.5 + fe_rng_uniform(&rng);
+        memset(row, 0, sizeof row);
+        for (int t = 0; t < 3; t++)
+            row[idx[t]] = val[t] = fe_rng_normal(&rng);
+        rc |= fe_lsq_add_sparse(&s, idx, val, 3, r, w);
+        rc |= fe_lsq_add(&d, row, r, w);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    /* The same products in the same order: equal bit for bit. */
+    ck_assert_mem_eq(gs, gd, sizeof gs);
+    ck_assert_uint_eq(s.n, d.n);
+    /* Refusals leave it unchanged. */
+    s0 = s;
+    memcpy(before, gs, sizeof gs);
+    ck_assert_int_eq(fe_lsq_add_sparse(&s, rep, row, 2, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_sparse(&s, out, row, 1, 1.0, 1.0), FE_EINVAL);
+    row[0] = NAN;
+    ck_assert_int_eq(fe_lsq_add_sparse(&s, idx, row, 3, 1.0, 1.0), FE_ENONFINITE);
+    row[0] = 1e300;
+    ck_assert_int_eq(fe_lsq_add_sparse(&s, idx, row, 3, 1.0, 1.0), FE_ENONFINITE);
+    ck_assert_mem_eq(gs, before, sizeof gs);
+    ck_assert_mem_eq(&s, &s0, sizeof s);
+}
+END_TEST
+
 Suite *fe_lsq_suite(void)
 {
     Suite *s = suite_create("lsq");
@@ -486,6 +523,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, bad_rows_are_refused_and_nothing_changes);
     tcase_add_test(t, empty_single_and_bad_arguments);
     tcase_add_test(t, exact_fit_has_zero_rss);
+    tcase_add_test(t, sparse_rows_equal_dense_rows);
     suite_add_tcase(s, t);
     return s;
 }

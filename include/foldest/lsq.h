@@ -56,6 +56,14 @@ int fe_lsq_add(fe_lsq *a, const double *j, double r, double w);
 int fe_lsq_add_rows(fe_lsq *a, const double *J, size_t ldj, const double *r,
                     const double *w, size_t m, size_t *done);
 
+/* fe_lsq_add_sparse: fold one row whose only nonzero regressors are
+   val[t] in columns idx[t], t < nnz (distinct, each < p), with response r
+   and weight w.  The same result as fe_lsq_add on the dense row, at cost
+   (nnz+1)(nnz+2)/2 instead of (p+1)(p+2)/2.  Errors as fe_lsq_add, and
+   FE_EINVAL for an index out of range or repeated; `a` then unchanged. */
+int fe_lsq_add_sparse(fe_lsq *a, const size_t *idx, const double *val,
+                      size_t nnz, double r, double w);
+
 /* fe_lsq_merge: a <- a + b (the rows of both).  FE_EMISMATCH if the
    column counts differ, FE_ENONFINITE if the sum would overflow; then `a`
    is unchanged.  `b` may not share storage with `a`. */
