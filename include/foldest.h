@@ -12,6 +12,7 @@
 #include "foldest/random.h"
 #include "foldest/lsq.h"
 #include "foldest/schur.h"
+#include "foldest/lm.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */
