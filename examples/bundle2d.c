@@ -27,7 +27,7 @@
    Usage: bundle2d [seeds]   (default 200)
 
    Build against an installed foldest:
-     cc bundle2d.c $(pkg-config --cflags --libs foldest) -o bundle2d */
+     cc bundle2d.c $(pkg-config --cflags --libs foldest) -lm -o bundle2d */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

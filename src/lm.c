@@ -15,6 +15,9 @@ enum { FE__LM_SPARSE_MAX = 64 };
 
 /* Damping beyond this means the problem cannot be made to descend. */
 #define FE__LM_LAMBDA_MAX 1e16
+
+/* Relative size of the rounding in a computed cost. */
+#define FE__LM_COST_NOISE (64 * DBL_EPSILON)
 /* Levenberg-Marquardt Includes ends here */
 /* [[file:../literate/lm.org::The sink][The sink]] */
 struct fe_lm_sink {
@@ -265,7 +268,7 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
 
     for (it = 1; res.stop == FE_LM_RUNNING; it++) {
         fe_lm_iteration row = {it, cost, 0.0, 0.0, lambda, 0.0, 0};
-        double gmax = 0.0, pred = 0.0, trial_cost = 0.0, hn, rho;
+        double gmax = 0.0, pred = 0.0, trial_cost = 0.0, hn, rho, noise;
         int trial_rc;
 
         /* Converged already? */
@@ -317,6 +320,11 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
                                                    : -1.0;
             row.ratio = rho;
             row.change = trial_rc == FE_OK ? cost - trial_cost : 0.0;
+            /* A reduction below the rounding of the cost cannot be judged:
+               take the step unless it is measurably worse. */
+            noise = FE__LM_COST_NOISE * cost;
+            if (trial_rc == FE_OK && pred <= noise && trial_cost <= cost + noise)
+                rho = 1.0;
             if (trial_rc == FE_OK && rho > 0.0) {
                 double t = 2.0 * rho - 1.0;
                 memcpy(x, xt, p * sizeof *x);
