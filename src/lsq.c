@@ -12,6 +12,9 @@
 
 /* Bound on the diagonal of G; off-diagonals are bounded by it. */
 #define FE__LSQ_BIG (DBL_MAX / 4)
+
+/* Rows per BLAS block in fe_lsq_add_rows. */
+enum { FE__LSQ_BLOCK = 256 };
 /* Least Squares Includes ends here */
 /* [[file:../literate/lsq.org::Bind, reset and read an accumulation][Bind, reset and read an accumulation]] */
 size_t fe_lsq_storage(size_t p)
@@ -83,21 +86,67 @@ int fe_lsq_add(fe_lsq *a, const double *j, double r, double w)
     a->wsum += w;
     return FE_OK;
 }
+/* Fold one row ends here */
+/* [[file:../literate/lsq.org::Fold an array of rows by blocks][Fold an array of rows by blocks]] */
+/* Fold rows i0 .. i0+mb-1 of an unweighted block at once, or return an
+   error without writing when any of them would be refused. */
+static int fe__lsq_add_block(fe_lsq *a, const double *J, size_t ldj,
+                             const double *r, size_t mb)
+{
+    size_t p = a->p, d = p + 1, i, k;
+    double rr = 0.0;
+    double *g = a->g;
+
+    /* Finite values, and the guard on every new diagonal entry (a NaN or
+       an infinity makes its column's sum fail the test). */
+    for (i = 0; i < mb; i++)
+        rr += r[i] * r[i];
+    if (!(g[p * d + p] + rr <= FE__LSQ_BIG) || !(a->wsum + (double)mb <= FE__LSQ_BIG))
+        return FE_ENONFINITE;
+    for (k = 0; k < p; k++) {
+        double ss = 0.0;
+        for (i = 0; i < mb; i++)
+            ss += J[i * ldj + k] * J[i * ldj + k];
+        if (!(g[k * d + k] + ss <= FE__LSQ_BIG))
+            return FE_ENONFINITE;
+    }
+    /* G_JJ += J'J, G_Jr += J'r, G_rr += r'r. */
+    cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)p, (int)mb, 1.0, J,
+                (int)ldj, 1.0, g, (int)d);
+    cblas_dgemv(CblasRowMajor, CblasTrans, (int)mb, (int)p, 1.0, J, (int)ldj, r, 1,
+                1.0, g + p, (int)d);
+    g[p * d + p] += rr;
+    a->n += mb;
+    a->wsum += (double)mb;
+    return FE_OK;
+}
 
 int fe_lsq_add_rows(fe_lsq *a, const double *J, size_t ldj, const double *r,
                     const double *w, size_t m, size_t *done)
 {
-    size_t i;
+    size_t i = 0;
     int rc = FE_OK;
 
     if (done != NULL)
         *done = 0;
-    if (a == NULL || (m > 0 && (r == NULL || (J == NULL && a->p > 0)))
+    if (a == NULL || a->g == NULL
+        || (m > 0 && (r == NULL || (J == NULL && a->p > 0)))
         || (m > 1 && ldj < a->p))
         return FE_EINVAL;
-    for (i = 0; i < m; i++) {
-        rc = fe_lsq_add(a, a->p > 0 ? J + i * ldj : NULL, r[i],
-                        w != NULL ? w[i] : 1.0);
+    while (i < m) {
+        size_t mb = m - i < FE__LSQ_BLOCK ? m - i : FE__LSQ_BLOCK, end;
+        /* Unweighted blocks go to BLAS when nothing in them is refused. */
+        if (w == NULL && a->p > 0 && ldj >= a->p
+            && fe__lsq_add_block(a, J + i * ldj, ldj, r + i, mb) == FE_OK) {
+            i += mb;
+            continue;
+        }
+        for (end = i + mb; i < end; i++) {
+            rc = fe_lsq_add(a, a->p > 0 ? J + i * ldj : NULL, r[i],
+                            w != NULL ? w[i] : 1.0);
+            if (rc != FE_OK)
+                break;
+        }
         if (rc != FE_OK)
             break;
     }
@@ -105,7 +154,7 @@ int fe_lsq_add_rows(fe_lsq *a, const double *J, size_t ldj, const double *r,
         *done = i;
     return rc;
 }
-/* Fold one row ends here */
+/* Fold an array of rows by blocks ends here */
 /* [[file:../literate/lsq.org::Fold one sparse row][Fold one sparse row]] */
 int fe_lsq_add_sparse(fe_lsq *a, const size_t *idx, const double *val,
                       size_t nnz, double r, double w)
