@@ -15,6 +15,9 @@
 #include "foldest/discover.h"
 #include "foldest/catalog.h"
 #include "foldest/synth.h"
+#include "foldest/lsq.h"
+#include "foldest/schur.h"
+#include "foldest/lm.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

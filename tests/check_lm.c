@@ -1,0 +1,571 @@
+/* Levenberg-Marquardt: known minima (Rosenbrock, a linear model against
+   the normal-equation solve), the 2-D bundle adjustment of EJML with the
+   dense and Schur paths agreeing, the iteration report, failures of the
+   model handled, multi-session magnetometer calibration on synthetic
+   sessions with known truth and on real recordings split into sessions. */
+#include <float.h>
+#include <stdint.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+static double *lm_work(const fe_lm_problem *p, int method)
+{
+    double *w = malloc(fe_lm_work(p, method) * sizeof *w);
+    ck_assert_ptr_nonnull(w);
+    return w;
+}
+
+/* ------------------------------------------------------------ Rosenbrock */
+
+static int rosenbrock(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double j1[2] = {-20.0 * x[0], 10.0}, j2[2] = {-1.0, 0.0};
+    (void)ctx;
+    fe_lm_emit(s, 10.0 * (x[1] - x[0] * x[0]), 1.0, j1, FE_SCHUR_NONE, NULL);
+    return fe_lm_emit(s, 1.0 - x[0], 1.0, j2, FE_SCHUR_NONE, NULL);
+}
+
+START_TEST(rosenbrock_dense_and_schur)
+{
+    fe_lm_problem p = {2, 0, 0, rosenbrock, NULL};
+    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
+        double x[2] = {-1.2, 1.0}, *w = lm_work(&p, method);
+        fe_lm_result r;
+        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
+        ck_assert_double_lt(r.cost, 1e-20);
+        ck_assert_double_eq_tol(x[0], 1.0, 1e-10);
+        ck_assert_double_eq_tol(x[1], 1.0, 1e-10);
+        ck_assert_double_eq_tol(r.initial_cost, 0.5 * (4.4 * 4.4 + 2.2 * 2.2), 1e-12);
+        ck_assert_int_gt(r.iterations, 1);
+        free(w);
+    }
+}
+END_TEST
+
+/* ------------------------------------------------- a linear model */
+
+enum { LN = 60, LP = 4 };
+struct linear { double J[LN][LP], y[LN]; };
+
+static int linear_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct linear *L = ctx;
+    for (int i = 0; i < LN; i++) {
+        double f = -L->y[i];
+        for (int k = 0; k < LP; k++)
+            f += L->J[i][k] * x[k];
+        fe_lm_emit(s, f, 1.0, L->J[i], FE_SCHUR_NONE, NULL);
+    }
+    return FE_OK;
+}
+
+START_TEST(linear_model_matches_normal_equations)
+{
+    static struct linear L;
+    fe_rng g = fe_rng_seed(3);
+    double gram[(LP + 1) * (LP + 1)], sw[(LP + 1) * (LP + 1)], want[LP], rss, x[LP] = {0};
+    fe_lsq a;
+    fe_lm_problem p = {LP, 0, 0, linear_model, &L};
+    double *w = lm_work(&p, FE_LM_DENSE);
+    fe_lm_result r;
+
+    fe_lsq_init(&a, LP, gram);
+    for (int i = 0; i < LN; i++) {
+        for (int k = 0; k < LP; k++)
+            L.J[i][k] = fe_rng_normal(&g) + (double)k;
+        L.y[i] = 1.0 + 2.0 * L.J[i][1] + 0.1 * fe_rng_normal(&g);
+        fe_lsq_add(&a, L.J[i], L.y[i], 1.0);
+    }
+    ck_assert_int_eq(fe_lsq_solve(&a, NULL, LP, want, &rss, NULL, sw), FE_OK);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, w, NULL, NULL, &r), FE_OK);
+    for (int k = 0; k < LP; k++)
+        ck_assert_double_eq_tol(x[k], want[k], 1e-10 * (1.0 + fabs(want[k])));
+    FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
+    free(w);
+}
+END_TEST
+
+/* ------------------------------------------------ 2-D bundle adjustment */
+
+enum { NC = 10, NLM = 40, BAP = 2 * NC + 2 * NLM };
+struct ba {
+    double cam[NC][2], land[NLM][2], theta[NC][NLM], cam0[2];
+};
+
+/* Camera 0 held at cam0; globals: cameras 1..9 (18); blocks: landmarks. */
+static int ba_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct ba *b = ctx;
+    const double pi = 3.14159265358979323846;
+    double jg[2 * NC - 2] = {0};
+    for (int i = 0; i < NC; i++) {
+        double cx = i == 0 ? b->cam0[0] : x[2 * i - 2];
+        double cy = i == 0 ? b->cam0[1] : x[2 * i - 1];
+        for (int j = 0; j < NLM; j++) {
+            const double *l = x + 2 * NC - 2 + 2 * j;
+            double dx = l[0] - cx, dy = l[1] - cy, q = dx * dx + dy * dy;
+            double f = atan2(dy, dx) - b->theta[i][j], jl[2] = {-dy / q, dx / q};
+            int rc;
+            f -= 2.0 * pi * floor(f / (2.0 * pi) + 0.5);
+            if (i > 0) {
+                jg[2 * i - 2] = dy / q;
+                jg[2 * i - 1] = -dx / q;
+            }
+            rc = fe_lm_emit(s, f, 1.0, jg, (size_t)j, jl);
+            if (i > 0)
+                jg[2 * i - 2] = jg[2 * i - 1] = 0.0;
+            if (rc != FE_OK)
+                return rc;
+        }
+    }
+    return FE_OK;
+}
+
+/* Truth and the start (truth + N(0, 5^2)) for one seed; x gets the start. */
+static void ba_setup(uint64_t seed, struct ba *b, double *x)
+{
+    fe_rng r = fe_rng_seed(seed);
+    for (int i = 0; i < NC; i++) {
+        b->cam[i][0] = 0.0;
+        b->cam[i][1] = 20.0 * fe_rng_uniform(&r) - 10.0;
+    }
+    for (int j = 0; j < NLM; j++) {
+        b->land[j][0] = 20.0;
+        b->land[j][1] = 20.0 * fe_rng_uniform(&r) - 10.0;
+    }
+    for (int i = 0; i < NC; i++)
+        for (int j = 0; j < NLM; j++)
+            b->theta[i][j] = atan((b->land[j][1] - b->cam[i][1]) / (b->land[j][0] - b->cam[i][0]));
+    b->cam0[0] = b->cam[0][0] + 5.0 * fe_rng_normal(&r);
+    b->cam0[1] = b->cam[0][1] + 5.0 * fe_rng_normal(&r);
+    for (int i = 1; i < NC; i++)
+        for (int c = 0; c < 2; c++)
+            x[2 * i - 2 + c] = b->cam[i][c] + 5.0 * fe_rng_normal(&r);
+    for (int j = 0; j < NLM; j++)
+        for (int c = 0; c < 2; c++)
+            x[2 * NC - 2 + 2 * j + c] = b->land[j][c] + 5.0 * fe_rng_normal(&r);
+}
+
+START_TEST(bundle_adjustment_dense_and_schur_agree)
+{
+    static struct ba b;
+    fe_lm_problem p = {2 * NC - 2, 2, NLM, ba_model, &b};
+    double *wd = lm_work(&p, FE_LM_DENSE), *ws = lm_work(&p, FE_LM_SCHUR);
+    int seeds = fe_test_quick() ? 3 : 20, bad = 0, max_iter = 0;
+    double worst_cost = 0.0, worst_diff = 0.0;
+
+    for (int seed = 1; seed <= seeds; seed++) {
+        double xd[BAP - 2], xs[BAP - 2];
+        fe_lm_result rd, rs;
+        int cd, cs;
+        ba_setup((uint64_t)seed, &b, xd);
+        memcpy(xs, xd, sizeof xd);
+        cd = fe_lm_solve(&p, FE_LM_DENSE, NULL, xd, wd, NULL, NULL, &rd);
+        cs = fe_lm_solve(&p, FE_LM_SCHUR, NULL, xs, ws, NULL, NULL, &rs);
+        bad += cd != FE_OK || cs != FE_OK || rd.iterations != rs.iterations;
+        worst_cost = fmax(worst_cost, fmax(rd.cost, rs.cost));
+        for (int k = 0; k < BAP - 2; k++)
+            worst_diff = fmax(worst_diff, fabs(xd[k] - xs[k]));
+        max_iter = rs.iterations > max_iter ? rs.iterations : max_iter;
+    }
+    ck_assert_int_eq(bad, 0);
+    ck_assert_double_lt(worst_cost, 1e-20);
+    ck_assert_double_lt(worst_diff, 1e-8);
+    ck_assert_int_le(max_iter, 30);
+    free(wd);
+    free(ws);
+}
+END_TEST
+
+/* ------------------------------------------------------ the report */
+
+struct table { int rows, accepted, stop_at; double last_cost; int increasing; };
+
+static int record(const fe_lm_iteration *it, void *ctx)
+{
+    struct table *t = ctx;
+    t->rows++;
+    t->accepted += it->accepted;
+    if (it->iteration != t->rows)
+        t->increasing = 1;
+    /* The cost never rises, except within its rounding (lm.org). */
+    if (it->cost > t->last_cost * (1.0 + 64 * DBL_EPSILON))
+        t->increasing = 1;
+    if (!it->accepted && it->change > 0.0 && it->ratio > 0.0)
+        t->increasing = 1;
+    t->last_cost = it->cost;
+    return t->stop_at > 0 && t->rows >= t->stop_at;
+}
+
+START_TEST(report_table_and_stop)
+{
+    static struct ba b;
+    fe_lm_problem p = {2 * NC - 2, 2, NLM, ba_model, &b};
+    double *w = lm_work(&p, FE_LM_SCHUR), x[BAP - 2];
+    struct table t = {0, 0, 0, INFINITY, 0};
+    fe_lm_result r;
+    fe_lm_params par = fe_lm_default_params();
+
+    ba_setup(7, &b, x);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, record, &t, &r), FE_OK);
+    ck_assert_int_eq(t.rows, r.iterations);
+    ck_assert_int_eq(t.accepted, r.accepted);
+    ck_assert_int_eq(t.increasing, 0);
+    ck_assert_double_eq(t.last_cost, r.cost);
+    ck_assert_int_eq(r.evaluations, 1 + r.iterations + r.accepted);
+    ck_assert(r.stop == FE_LM_XTOL || r.stop == FE_LM_FTOL);
+    /* A callback that says stop after two rows. */
+    ba_setup(7, &b, x);
+    t = (struct table){0, 0, 2, INFINITY, 0};
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, record, &t, &r), FE_ESTOPPED);
+    ck_assert_int_eq(r.iterations, 2);
+    ck_assert_int_eq(r.stop, FE_LM_STOPPED);
+    /* Too few iterations allowed. */
+    ba_setup(7, &b, x);
+    par.max_iter = 2;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, &par, x, w, NULL, NULL, &r), FE_ENOCONV);
+    ck_assert_int_eq(r.stop, FE_LM_MAXITER);
+    ck_assert_int_eq(r.iterations, 2);
+    ck_assert_double_lt(r.cost, r.initial_cost);
+    free(w);
+}
+END_TEST
+
+/* ------------------------------------------------ failures of the model */
+
+/* f = sqrt(x) - sqrt(2): the Gauss-Newton step from x = 100 lands at a
+   negative x, where the model fails (NaN); LM must reject it and go on. */
+static int sqrt_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double j = 0.5 / sqrt(x[0]);
+    (void)ctx;
+    return fe_lm_emit(s, sqrt(x[0]) - sqrt(2.0), 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+static int silent_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    (void)x;
+    (void)s;
+    (void)ctx;
+    return FE_OK;
+}
+
+static int bad_block_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double jg[1] = {1.0}, jl[1] = {1.0};
+    (void)ctx;
+    fe_lm_emit(s, x[0], 1.0, jg, 5, jl);     /* block 5 of 2: ignored error */
+    return FE_OK;
+}
+
+START_TEST(model_failures_are_handled)
+{
+    fe_lm_problem p = {1, 0, 0, sqrt_model, NULL};
+    double w[64], x[3] = {100.0, 0, 0};
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_result r;
+
+    par.lambda0 = 1e-9;                      /* take the bold step first */
+    ck_assert_uint_le(fe_lm_work(&p, FE_LM_DENSE), 64);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_double_eq_tol(x[0], 2.0, 1e-9);
+    ck_assert_int_gt(r.iterations, r.accepted);  /* at least one rejection */
+    /* Failure at the start is returned. */
+    x[0] = -1.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_ENONFINITE);
+    ck_assert_double_eq(x[0], -1.0);
+    /* No residuals; a bad block index even if the model ignores it. */
+    p.model = silent_model;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, w, NULL, NULL, &r), FE_ETOOFEW);
+    p = (fe_lm_problem){1, 1, 2, bad_block_model, NULL};
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, NULL, NULL, &r), FE_EINVAL);
+    /* Bad arguments. */
+    ck_assert_int_eq(fe_lm_solve(&p, 7, NULL, x, w, NULL, NULL, &r), FE_EINVAL);
+    ck_assert_uint_eq(fe_lm_work(&p, 7), 0);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, NULL, NULL, NULL, &r), FE_EINVAL);
+    p = (fe_lm_problem){0, 0, 0, sqrt_model, NULL};
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, w, NULL, NULL, &r), FE_EINVAL);
+    par = fe_lm_default_params();
+    par.lambda0 = 0.0;
+    p = (fe_lm_problem){1, 0, 0, sqrt_model, NULL};
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+}
+END_TEST
+
+/* --------------------------------- multi-session magnetometer calibration */
+
+/* Sessions of raw readings m; the model |S (m - o_s)| = 1 with S symmetric
+   (6 globals: s00 s01 s02 s11 s12 s22) and one offset o_s per session. */
+struct magcal {
+    size_t nsess;
+    const double *m[8];
+    size_t n[8];
+    int one_offset;          /* all sessions share block 0 */
+};
+
+static void sym(const double *s, double S[3][3])
+{
+    S[0][0] = s[0]; S[0][1] = S[1][0] = s[1]; S[0][2] = S[2][0] = s[2];
+    S[1][1] = s[3]; S[1][2] = S[2][1] = s[4]; S[2][2] = s[5];
+}
+
+static int magcal_model(const double *x, fe_lm_sink *sink, void *ctx)
+{
+    const struct magcal *c = ctx;
+    double S[3][3];
+    sym(x, S);
+    for (size_t b = 0; b < c->nsess; b++) {
+        size_t blk = c->one_offset ? 0 : b;
+        const double *o = x + 6 + 3 * blk;
+        for (size_t i = 0; i < c->n[b]; i++) {
+            const double *m = c->m[b] + 3 * i;
+            double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h[3], rho, jg[6], jl[3];
+            int rc;
+            for (int k = 0; k < 3; k++)
+                h[k] = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
+            rho = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+            jg[0] = h[0] * d[0] / rho;
+            jg[1] = (h[0] * d[1] + h[1] * d[0]) / rho;
+            jg[2] = (h[0] * d[2] + h[2] * d[0]) / rho;
+            jg[3] = h[1] * d[1] / rho;
+            jg[4] = (h[1] * d[2] + h[2] * d[1]) / rho;
+            jg[5] = h[2] * d[2] / rho;
+            for (int k = 0; k < 3; k++)
+                jl[k] = -(S[k][0] * h[0] + S[k][1] * h[1] + S[k][2] * h[2]) / rho;
+            rc = fe_lm_emit(sink, rho - 1.0, 1.0, jg, blk, jl);
+            if (rc != FE_OK)
+                return rc;
+        }
+    }
+    return FE_OK;
+}
+
+/* Start: S = I / (mean distance to the session centroid), o_s = centroid. */
+static void magcal_start(const struct magcal *c, double *x)
+{
+    double r = 0.0;
+    size_t total = 0;
+    memset(x, 0, (6 + 3 * (c->one_offset ? 1 : c->nsess)) * sizeof *x);
+    for (size_t b = 0; b < c->nsess; b++) {
+        double *o = x + 6 + 3 * (c->one_offset ? 0 : b);
+        double cen[3] = {0, 0, 0};
+        for (size_t i = 0; i < c->n[b]; i++)
+            for (int k = 0; k < 3; k++)
+                cen[k] += c->m[b][3 * i + k] / (double)c->n[b];
+        for (size_t i = 0; i < c->n[b]; i++) {
+            const double *m = c->m[b] + 3 * i;
+            r += sqrt((m[0] - cen[0]) * (m[0] - cen[0]) + (m[1] - cen[1]) * (m[1] - cen[1])
+                      + (m[2] - cen[2]) * (m[2] - cen[2]));
+        }
+        total += c->n[b];
+        for (int k = 0; k < 3; k++)
+            o[k] += cen[k] / (c->one_offset ? (double)c->nsess : 1.0);
+    }
+    r /= (double)total;
+    x[0] = x[3] = x[5] = 1.0 / r;
+}
+
+/* Root-mean-square of |S(m - o)| - 1 over session b. */
+static double magcal_rms(const struct magcal *c, const double *x, size_t b)
+{
+    double S[3][3], q = 0.0;
+    const double *o = x + 6 + 3 * (c->one_offset ? 0 : b);
+    sym(x, S);
+    for (size_t i = 0; i < c->n[b]; i++) {
+        const double *m = c->m[b] + 3 * i;
+        double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h2 = 0.0;
+        for (int k = 0; k < 3; k++) {
+            double h = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
+            h2 += h * h;
+        }
+        q += (sqrt(h2) - 1.0) * (sqrt(h2) - 1.0);
+    }
+    return sqrt(q / (double)c->n[b]);
+}
+
+static int magcal_fit(const struct magcal *c, double *x, fe_lm_result *r)
+{
+    fe_lm_problem p = {6, 3, c->one_offset ? 1 : c->nsess, magcal_model, (void *)c};
+    double *w = lm_work(&p, FE_LM_SCHUR);
+    int rc;
+    magcal_start(c, x);
+    rc = fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, NULL, NULL, r);
+    free(w);
+    return rc;
+}
+
+START_TEST(magnetometer_sessions_synthetic)
+{
+    enum { NS = 4, PER = 500 };
+    /* Truth: a soft-iron matrix A (readings = A u + o_s + noise, |u| = 1);
+       the calibration S is A^{-1}, symmetric when A is. */
+    const double A[3][3] = {{1.3, 0.2, -0.1}, {0.2, 0.8, 0.15}, {-0.1, 0.15, 1.1}};
+    const double off[NS][3] = {{0.3, -0.2, 0.5}, {1.5, 0.1, -0.4}, {-0.7, 0.9, 0.2}, {0.0, -1.2, 0.8}};
+    static double m[NS][PER * 3];
+    double x[6 + 3 * NS], S[3][3], err_off = 0.0, err_S = 0.0;
+    struct magcal c = {NS, {0}, {0}, 0};
+    fe_rng g = fe_rng_seed(21);
+    fe_lm_result r;
+
+    for (int noisy = 0; noisy < 2; noisy++) {
+        double sd = noisy ? 0.01 : 0.0;
+        for (int b = 0; b < NS; b++) {
+            for (int i = 0; i < PER; i++) {
+                double u[3], n;
+                do {
+                    for (int k = 0; k < 3; k++)
+                        u[k] = fe_rng_normal(&g);
+                    n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+                } while (n < 1e-9);
+                for (int k = 0; k < 3; k++)
+                    m[b][3 * i + k] = off[b][k] + sd * fe_rng_normal(&g)
+                                      + (A[k][0] * u[0] + A[k][1] * u[1] + A[k][2] * u[2]) / n;
+            }
+            c.m[b] = m[b];
+            c.n[b] = PER;
+        }
+        ck_assert_int_eq(magcal_fit(&c, x, &r), FE_OK);
+        /* S A = I and the offsets, to rounding (noise free) or to the
+           noise's reach (sd = 0.01, 2000 readings). */
+        sym(x, S);
+        err_S = err_off = 0.0;
+        for (int k = 0; k < 3; k++)
+            for (int l = 0; l < 3; l++) {
+                double sa = S[k][0] * A[0][l] + S[k][1] * A[1][l] + S[k][2] * A[2][l];
+                err_S = fmax(err_S, fabs(sa - (k == l ? 1.0 : 0.0)));
+            }
+        for (int b = 0; b < NS; b++)
+            for (int k = 0; k < 3; k++)
+                err_off = fmax(err_off, fabs(x[6 + 3 * b + k] - off[b][k]));
+        if (!noisy) {
+            ck_assert_double_lt(r.cost, 1e-20);
+            ck_assert_double_lt(err_S, 1e-9);
+            ck_assert_double_lt(err_off, 1e-9);
+        } else {
+            ck_assert_double_lt(err_S, 0.01);
+            ck_assert_double_lt(err_off, 0.01);
+            ck_assert_double_gt(err_off, 0.0);
+        }
+    }
+}
+END_TEST
+
+/* Read a QMC5883L recording: 3 header lines, then mx,my,mz; the first
+   3000 rows are static and skipped. */
+static double *read_qmc(const char *dir, const char *name, size_t *n)
+{
+    char path[4096], line[256];
+    size_t cap = 30000, k = 0, row = 0;
+    double *m = malloc(cap * 3 * sizeof *m);
+    FILE *f;
+    snprintf(path, sizeof path, "%s/qmc5883l_tomisuarez/%s", dir, name);
+    f = fopen(path, "r");
+    if (f == NULL || m == NULL) {
+        if (f != NULL)
+            fclose(f);
+        free(m);
+        return NULL;
+    }
+    while (fgets(line, sizeof line, f) != NULL) {
+        double a, b, c;
+        if (sscanf(line, "%lf,%lf,%lf", &a, &b, &c) != 3)
+            continue;
+        if (row++ < 3000 || k == cap)
+            continue;
+        m[3 * k] = a;
+        m[3 * k + 1] = b;
+        m[3 * k + 2] = c;
+        k++;
+    }
+    fclose(f);
+    *n = k;
+    return m;
+}
+
+START_TEST(magnetometer_sessions_real)
+{
+    const char *dir = fe_test_data_dir("magnetometer_sessions_real");
+    double *m1, *m2, xj[12], xc[9], xs[2][9], rms_joint[2], rms_sep[2], rms_common[2];
+    size_t n1 = 0, n2 = 0;
+    struct magcal joint = {2, {0}, {0}, 0}, common, one;
+    fe_lm_result r;
+
+    if (dir == NULL)
+        return;
+    m1 = read_qmc(dir, "filtered_raw_data.csv", &n1);
+    m2 = read_qmc(dir, "noisy_raw_data.csv", &n2);
+    ck_assert_ptr_nonnull(m1);
+    ck_assert_ptr_nonnull(m2);
+    ck_assert_uint_gt(n1, 15000);
+    ck_assert_uint_gt(n2, 15000);
+    if (fe_test_quick()) {           /* valgrind: every tenth reading */
+        for (size_t i = 0; 10 * i < n1; i++)
+            memmove(m1 + 3 * i, m1 + 30 * i, 3 * sizeof *m1);
+        for (size_t i = 0; 10 * i < n2; i++)
+            memmove(m2 + 3 * i, m2 + 30 * i, 3 * sizeof *m2);
+        n1 = (n1 + 9) / 10;
+        n2 = (n2 + 9) / 10;
+    }
+    joint.m[0] = m1;
+    joint.n[0] = n1;
+    joint.m[1] = m2;
+    joint.n[1] = n2;
+    common = joint;
+    common.one_offset = 1;
+    /* The joint fit: one soft-iron matrix, one offset per session. */
+    ck_assert_int_eq(magcal_fit(&joint, xj, &r), FE_OK);
+    /* Each session alone: its own matrix and offset (9 parameters each). */
+    for (int b = 0; b < 2; b++) {
+        one = (struct magcal){1, {joint.m[b]}, {joint.n[b]}, 0};
+        ck_assert_int_eq(magcal_fit(&one, xs[b], &r), FE_OK);
+        rms_sep[b] = magcal_rms(&one, xs[b], 0);
+        rms_joint[b] = magcal_rms(&joint, xj, (size_t)b);
+    }
+    /* One matrix and one offset for both. */
+    ck_assert_int_eq(magcal_fit(&common, xc, &r), FE_OK);
+    for (int b = 0; b < 2; b++)
+        rms_common[b] = magcal_rms(&common, xc, (size_t)b);
+    fprintf(stderr, "magnetometer sessions (QMC5883L filtered / noisy): radial RMS "
+                    "separate %.4f / %.4f, shared matrix %.4f / %.4f, shared matrix and offset "
+                    "%.4f / %.4f\n", rms_sep[0], rms_sep[1], rms_joint[0], rms_joint[1],
+            rms_common[0], rms_common[1]);
+    /* More parameters fit at least as well; the shared matrix costs little;
+       a shared offset costs more than the per-session offsets. */
+    for (int b = 0; b < 2; b++) {
+        ck_assert_double_le(rms_sep[b], rms_joint[b] * (1.0 + 1e-9));
+        ck_assert_double_lt(rms_joint[b], 1.5 * rms_sep[b]);
+    }
+    /* The per-session offsets are real: the F statistic of the 3 extra
+       parameters, (RSS_common - RSS_joint) / 3 over RSS_joint / (n - 12),
+       beyond its 1e-6 quantile (about 10.2 for 3 and many degrees of
+       freedom). */
+    {
+        double n = (double)(n1 + n2);
+        double rss_j = (double)n1 * rms_joint[0] * rms_joint[0] + (double)n2 * rms_joint[1] * rms_joint[1];
+        double rss_c = (double)n1 * rms_common[0] * rms_common[0] + (double)n2 * rms_common[1] * rms_common[1];
+        double F = (rss_c - rss_j) / 3.0 / (rss_j / (n - 12.0));
+        fprintf(stderr, "  offsets (counts): filtered (%.1f, %.1f, %.1f), noisy (%.1f, %.1f, %.1f);"
+                        " F = %.1f\n", xj[6], xj[7], xj[8], xj[9], xj[10], xj[11], F);
+        ck_assert_double_gt(F, 10.2);
+    }
+    free(m1);
+    free(m2);
+}
+END_TEST
+
+Suite *fe_lm_suite(void)
+{
+    Suite *s = suite_create("lm");
+    TCase *t = tcase_create("levenberg-marquardt");
+    tcase_set_timeout(t, 300);
+    tcase_add_test(t, rosenbrock_dense_and_schur);
+    tcase_add_test(t, linear_model_matches_normal_equations);
+    tcase_add_test(t, bundle_adjustment_dense_and_schur_agree);
+    tcase_add_test(t, report_table_and_stop);
+    tcase_add_test(t, model_failures_are_handled);
+    tcase_add_test(t, magnetometer_sessions_synthetic);
+    tcase_add_test(t, magnetometer_sessions_real);
+    suite_add_tcase(s, t);
+    return s;
+}

@@ -1,0 +1,277 @@
+/* Arrow-shaped least squares: the Schur elimination equals the dense solve
+   (and QR) of the same rows, damped or not; merge of every split equals the
+   whole; bad rows are refused and nothing changes; singular blocks are
+   reported, never NaN. */
+#include <float.h>
+#include <stdint.h>
+
+#include <lapacke.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+enum { NG = 4, NL = 3, NB = 6, NP = NG + NB * NL, ROWS = NB * 9 + 5 };
+
+/* Rows of an arrow problem: block i % (NB+1) (the last value means a
+   global-only row), Jacobian entries of different scales. */
+struct rows {
+    double jg[ROWS][NG], jl[ROWS][NL], r[ROWS], w[ROWS];
+    size_t block[ROWS];
+};
+
+static void make_rows(uint64_t seed, struct rows *R)
+{
+    fe_rng g = fe_rng_seed(seed);
+    for (size_t i = 0; i < ROWS; i++) {
+        R->block[i] = i % (NB + 1) == NB ? FE_SCHUR_NONE : i % (NB + 1);
+        for (size_t k = 0; k < NG; k++)
+            R->jg[i][k] = (1.0 + (double)k) * fe_rng_normal(&g);
+        for (size_t k = 0; k < NL; k++)
+            R->jl[i][k] = R->block[i] == FE_SCHUR_NONE ? 0.0 : 0.5 * fe_rng_normal(&g) + 0.1;
+        R->r[i] = fe_rng_normal(&g);
+        R->w[i] = 0.5 + fe_rng_uniform(&g);
+    }
+}
+
+/* The dense row of row i, in the full parameter vector. */
+static void dense_row(const struct rows *R, size_t i, double *j)
+{
+    memset(j, 0, NP * sizeof *j);
+    memcpy(j, R->jg[i], NG * sizeof *j);
+    if (R->block[i] != FE_SCHUR_NONE)
+        memcpy(j + NG + R->block[i] * NL, R->jl[i], NL * sizeof *j);
+}
+
+static double max_abs_diff(const double *a, const double *b, size_t n, double *scale)
+{
+    double e = 0.0, s = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        e = fmax(e, fabs(a[k] - b[k]));
+        s = fmax(s, fabs(b[k]));
+    }
+    *scale = s;
+    return e;
+}
+
+START_TEST(elimination_equals_dense_and_qr)
+{
+    static struct rows R;
+    static double st[NG * NG + 64 + NB * (NL * NL + NL + NL * NG) + 64];
+    static double gd[(NP + 1) * (NP + 1)], wd[(NP + 1) * (NP + 1)];
+    static double A[ROWS * NP], b[ROWS];
+    double x[NP], xd[NP], work[256], rss, rssd, rssq = 0.0, scale;
+    fe_schur a;
+    fe_lsq d;
+
+    make_rows(1, &R);
+    ck_assert_uint_le(fe_schur_storage(NG, NL, NB), sizeof st / sizeof st[0]);
+    ck_assert_uint_le(fe_schur_solve_work(NG, NL), 256);
+    ck_assert_int_eq(fe_schur_init(&a, NG, NL, NB, st), FE_OK);
+    ck_assert_int_eq(fe_lsq_init(&d, NP, gd), FE_OK);
+    for (size_t i = 0; i < ROWS; i++) {
+        double j[NP];
+        ck_assert_int_eq(fe_schur_add(&a, R.jg[i], R.block[i], R.jl[i], R.r[i], R.w[i]), FE_OK);
+        dense_row(&R, i, j);
+        ck_assert_int_eq(fe_lsq_add(&d, j, R.r[i], R.w[i]), FE_OK);
+        for (size_t k = 0; k < NP; k++)
+            A[i * NP + k] = sqrt(R.w[i]) * j[k];
+        b[i] = sqrt(R.w[i]) * R.r[i];
+    }
+    ck_assert_int_eq(fe_schur_solve(&a, 0.0, x, &rss, work), FE_OK);
+    ck_assert_int_eq(fe_lsq_solve(&d, NULL, NP, xd, &rssd, NULL, wd), FE_OK);
+    ck_assert_double_le(max_abs_diff(x, xd, NP, &scale), 1e-10 * scale);
+    FE_ASSERT_REL(rss, rssd, 1e-10);
+    /* And QR on the rows themselves. */
+    ck_assert_int_eq(LAPACKE_dgels(LAPACK_ROW_MAJOR, 'N', ROWS, NP, 1, A, NP, b, 1), 0);
+    for (size_t i = NP; i < ROWS; i++)
+        rssq += b[i] * b[i];
+    ck_assert_double_le(max_abs_diff(x, b, NP, &scale), 1e-10 * scale);
+    FE_ASSERT_REL(rss, rssq, 1e-10);
+}
+END_TEST
+
+START_TEST(damped_elimination_equals_damped_dense)
+{
+    static struct rows R;
+    static double st[2048], gd[(NP + 1) * (NP + 1)];
+    static double M[NP * NP];
+    double x[NP], rhs[NP], work[256], scale;
+    const double lambdas[3] = {1e-6, 0.3, 50.0};
+    fe_schur a;
+    fe_lsq d;
+
+    make_rows(2, &R);
+    fe_schur_init(&a, NG, NL, NB, st);
+    fe_lsq_init(&d, NP, gd);
+    for (size_t i = 0; i < ROWS; i++) {
+        double j[NP];
+        fe_schur_add(&a, R.jg[i], R.block[i], R.jl[i], R.r[i], R.w[i]);
+        dense_row(&R, i, j);
+        fe_lsq_add(&d, j, R.r[i], R.w[i]);
+    }
+    for (int t = 0; t < 3; t++) {
+        double lam = lambdas[t];
+        for (size_t k = 0; k < NP; k++) {
+            for (size_t l = 0; l < NP; l++)
+                M[k * NP + l] = fe_lsq_gram(&d, k, l);
+            M[k * NP + k] *= 1.0 + lam;
+            rhs[k] = fe_lsq_gram(&d, k, NP);
+        }
+        ck_assert_int_eq(LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', NP, 1, M, NP, rhs, 1), 0);
+        ck_assert_int_eq(fe_schur_solve(&a, lam, x, NULL, work), FE_OK);
+        ck_assert_double_le(max_abs_diff(x, rhs, NP, &scale), 1e-11 * scale);
+    }
+}
+END_TEST
+
+START_TEST(merge_every_split_equals_the_whole)
+{
+    static struct rows R;
+    enum { S = 2048 };
+    static double sw[S], sl[S], sr[S];
+    fe_schur whole, left, right;
+    fe_accumulator f = fe_schur_accumulator();
+    size_t n = fe_schur_storage(NG, NL, NB);
+    double err = 0.0, big = 0.0;
+    int rc = FE_OK;
+
+    make_rows(3, &R);
+    fe_schur_init(&whole, NG, NL, NB, sw);
+    for (size_t i = 0; i < ROWS; i++)
+        rc |= fe_schur_add(&whole, R.jg[i], R.block[i], R.jl[i], R.r[i], R.w[i]);
+    for (size_t k = 0; k < n; k++)
+        big = fmax(big, fabs(sw[k]));
+    for (size_t s = 0; s <= ROWS; s++) {
+        fe_schur_init(&left, NG, NL, NB, sl);
+        fe_schur_init(&right, NG, NL, NB, sr);
+        for (size_t i = 0; i < ROWS; i++) {
+            fe_schur_row row = {R.jg[i], R.block[i], R.jl[i], R.r[i], R.w[i]};
+            rc |= fe_step(&f, i < s ? &left : &right, &row);
+        }
+        rc |= fe_merge(&f, &left, &right);
+        if (left.global.n != ROWS)
+            rc |= 1000;
+        for (size_t k = 0; k < n; k++)
+            err = fmax(err, fabs(sl[k] - sw[k]));
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_double_le(err, 1e-13 * big);
+}
+END_TEST
+
+START_TEST(bad_rows_are_refused_and_nothing_changes)
+{
+    static struct rows R;
+    static double st[2048], before[2048];
+    fe_schur a, a0;
+    size_t n = fe_schur_storage(NG, NL, NB);
+    double jg[NG], jl[NL];
+    int wrong = 0;
+
+    make_rows(4, &R);
+    fe_schur_init(&a, NG, NL, NB, st);
+    for (size_t i = 0; i < ROWS; i++)
+        fe_schur_add(&a, R.jg[i], R.block[i], R.jl[i], R.r[i], R.w[i]);
+    a0 = a;
+    memcpy(before, st, n * sizeof *st);
+    for (size_t k = 0; k < NG + NL; k++) {
+        memcpy(jg, R.jg[0], sizeof jg);
+        memcpy(jl, R.jl[0], sizeof jl);
+        if (k < NG)
+            jg[k] = NAN;
+        else
+            jl[k - NG] = INFINITY;
+        wrong |= fe_schur_add(&a, jg, 2, jl, 1.0, 1.0) != FE_ENONFINITE;
+    }
+    wrong |= fe_schur_add(&a, R.jg[0], 2, R.jl[0], NAN, 1.0) != FE_ENONFINITE;
+    wrong |= fe_schur_add(&a, R.jg[0], 2, R.jl[0], 1.0, INFINITY) != FE_ENONFINITE;
+    wrong |= fe_schur_add(&a, R.jg[0], 2, R.jl[0], 1.0, -1.0) != FE_EINVAL;
+    wrong |= fe_schur_add(&a, R.jg[0], NB, R.jl[0], 1.0, 1.0) != FE_EINVAL;
+    wrong |= fe_schur_add(&a, R.jg[0], 1, NULL, 1.0, 1.0) != FE_EINVAL;
+    memcpy(jl, R.jl[0], sizeof jl);
+    jl[1] = 1e200;                                  /* finite, overflows V */
+    wrong |= fe_schur_add(&a, R.jg[0], 3, jl, 1.0, 1.0) != FE_ENONFINITE;
+    memcpy(jg, R.jg[0], sizeof jg);
+    jg[0] = 1e200;                                  /* finite, overflows U */
+    wrong |= fe_schur_add(&a, jg, 3, R.jl[0], 1.0, 1.0) != FE_ENONFINITE;
+    ck_assert_int_eq(wrong, 0);
+    ck_assert_mem_eq(&a, &a0, sizeof a);
+    ck_assert_mem_eq(st, before, n * sizeof *st);
+}
+END_TEST
+
+START_TEST(underdetermined_blocks_are_singular_never_nan)
+{
+    enum { B = 2 };
+    double st[256], x[NG + B * NL], work[256], rss = -1.0;
+    const double jl[NL] = {1.0, 2.0, 3.0}, jg1[NG] = {0.5, -1.0, 0.25, 2.0};
+    fe_rng g = fe_rng_seed(5);
+    fe_schur a;
+
+    fe_schur_init(&a, NG, NL, B, st);
+    ck_assert_int_eq(fe_schur_solve(&a, 0.0, x, &rss, work), FE_ETOOFEW);
+    /* Block 0 is seen often, block 1 only once: V_1 has rank 1. */
+    for (int i = 0; i < 40; i++) {
+        double jg[NG], j0[NL];
+        for (size_t k = 0; k < NG; k++)
+            jg[k] = fe_rng_normal(&g);
+        for (size_t k = 0; k < NL; k++)
+            j0[k] = fe_rng_normal(&g);
+        ck_assert_int_eq(fe_schur_add(&a, jg, 0, j0, fe_rng_normal(&g), 1.0), FE_OK);
+    }
+    ck_assert_int_eq(fe_schur_add(&a, jg1, 1, jl, 1.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_solve(&a, 0.0, x, &rss, work), FE_ESINGULAR);
+    ck_assert_double_eq(rss, -1.0);
+    /* Damping makes the system definite; the step is finite. */
+    ck_assert_int_eq(fe_schur_solve(&a, 1e-3, x, &rss, work), FE_OK);
+    for (size_t k = 0; k < NG + B * NL; k++)
+        ck_assert(isfinite(x[k]));
+    ck_assert_int_eq(fe_schur_solve(&a, -1.0, x, &rss, work), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_solve(&a, NAN, x, &rss, work), FE_EINVAL);
+}
+END_TEST
+
+START_TEST(shapes_and_degenerate_dimensions)
+{
+    double s1[256], s2[256], work[64], x[8], rss;
+    fe_schur a, b;
+    const double jl[2] = {1.0, 0.5}, jl2[2] = {-0.3, 2.0};
+
+    ck_assert_int_eq(fe_schur_init(&a, 0, 0, 3, s1), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_init(&a, 1, 2, 2, NULL), FE_EINVAL);
+    fe_schur_init(&a, 1, 2, 2, s1);
+    fe_schur_init(&b, 2, 2, 2, s2);
+    ck_assert_int_eq(fe_schur_merge(&a, &b), FE_EMISMATCH);
+    ck_assert_int_eq(fe_schur_copy(&a, &b), FE_EMISMATCH);
+    ck_assert_int_eq(fe_schur_merge(&a, &a), FE_EINVAL);
+    /* No global parameters: independent blocks, each solved alone. */
+    fe_schur_init(&a, 0, 2, 2, s1);
+    ck_assert_int_eq(fe_schur_add(&a, NULL, 0, jl, 1.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&a, NULL, 0, jl2, 2.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&a, NULL, 1, jl, 3.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&a, NULL, 1, jl2, 4.0, 1.0), FE_OK);
+    ck_assert_uint_le(fe_schur_solve_work(0, 2), 64);
+    ck_assert_int_eq(fe_schur_solve(&a, 0.0, x, &rss, work), FE_OK);
+    /* [1 .5; -.3 2] x = [1 2] and [3 4]: exact fits. */
+    ck_assert_double_eq_tol(x[0] * 1.0 + x[1] * 0.5, 1.0, 1e-13);
+    ck_assert_double_eq_tol(-0.3 * x[0] + 2.0 * x[1], 2.0, 1e-13);
+    ck_assert_double_eq_tol(x[2] * 1.0 + x[3] * 0.5, 3.0, 1e-13);
+    ck_assert_double_eq_tol(-0.3 * x[2] + 2.0 * x[3], 4.0, 1e-13);
+    ck_assert_double_le(rss, 64 * DBL_EPSILON * 30.0);   /* r'r = 30 */
+}
+END_TEST
+
+Suite *fe_schur_suite(void)
+{
+    Suite *s = suite_create("schur");
+    TCase *t = tcase_create("arrow");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, elimination_equals_dense_and_qr);
+    tcase_add_test(t, damped_elimination_equals_damped_dense);
+    tcase_add_test(t, merge_every_split_equals_the_whole);
+    tcase_add_test(t, bad_rows_are_refused_and_nothing_changes);
+    tcase_add_test(t, underdetermined_blocks_are_singular_never_nan);
+    tcase_add_test(t, shapes_and_degenerate_dimensions);
+    suite_add_tcase(s, t);
+    return s;
+}
