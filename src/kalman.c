@@ -820,14 +820,90 @@ static double fe__normal_quantile(double p)
          / (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
 }
 
+/* log Gamma(x), x > 0 (Lanczos, g = 7). */
+static double fe__log_gamma(double x)
+{
+    static const double c[9] = {0.99999999999980993, 676.5203681218851,
+                                -1259.1392167224028, 771.32342877765313,
+                                -176.61502916214059, 12.507343278686905,
+                                -0.13857109526572012, 9.9843695780195716e-6,
+                                1.5056327351493116e-7};
+    double s, t;
+    if (x < 0.5)
+        return fe__log_gamma(x + 1.0) - log(x);
+    x -= 1.0;
+    s = c[0];
+    for (int i = 1; i < 9; i++)
+        s += c[i] / (x + (double)i);
+    t = x + 7.5;
+    return 0.9189385332046728 + (x + 0.5) * log(t) - t + log(s);
+}
+
+/* The regularised lower incomplete gamma function P(a, x). */
+static double fe__gamma_p(double a, double x)
+{
+    double front;
+    if (x <= 0.0)
+        return 0.0;
+    front = exp(-x + a * log(x) - fe__log_gamma(a));
+    if (x < a + 1.0) {
+        double ap = a, del = 1.0 / a, sum = del;
+        for (int i = 0; i < 1000 && fabs(del) > 1e-17 * fabs(sum); i++) {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+        }
+        return sum * front;
+    } else {
+        const double tiny = 1e-300;
+        double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+        for (int i = 1; i < 1000; i++) {
+            double an = -(double)i * ((double)i - a), del;
+            b += 2.0;
+            d = an * d + b;
+            if (fabs(d) < tiny)
+                d = tiny;
+            c = b + an / c;
+            if (fabs(c) < tiny)
+                c = tiny;
+            d = 1.0 / d;
+            del = d * c;
+            h *= del;
+            if (fabs(del - 1.0) < 1e-16)
+                break;
+        }
+        return 1.0 - front * h;
+    }
+}
+
 double fe_kalman_chi2_quantile(double q, double dof)
 {
-    double h, t;
+    double a, h, t, x, lo = 0.0, hi = INFINITY, lognorm;
     if (!(q > 0.0 && q < 1.0) || !(dof > 0.0) || !isfinite(dof))
         return NAN;
+    a = 0.5 * dof;
     h = 2.0 / (9.0 * dof);
     t = 1.0 - h + fe__normal_quantile(q) * sqrt(h);
-    return t > 0.0 ? dof * t * t * t : 0.0;
+    x = t > 0.0 ? dof * t * t * t : 0.0;
+    if (!(x > 1e-300))
+        x = 1e-300 + dof * 1e-6;
+    lognorm = a * log(2.0) + fe__log_gamma(a);
+    for (int it = 0; it < 200; it++) {
+        double F = fe__gamma_p(a, 0.5 * x) - q;
+        double f = exp((a - 1.0) * log(x) - 0.5 * x - lognorm);
+        double xn;
+        if (F < 0.0)
+            lo = x;
+        else
+            hi = x;
+        xn = f > 0.0 ? x - F / f : NAN;
+        if (!(xn > lo && xn < hi))
+            xn = isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * x;
+        if (fabs(xn - x) <= 1e-15 * x)
+            return xn;
+        x = xn;
+    }
+    return x;
 }
 
 int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
