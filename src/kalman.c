@@ -26,7 +26,7 @@ static size_t fe__kalman_work_doubles(size_t n, size_t b)
     return n + 2 * n * n + n * b + b * b + b * (n + 1) + b;
 }
 
-static struct fe__kalman_ws fe__kalman_layout(const fe_kalman *k)
+static inline struct fe__kalman_ws fe__kalman_layout(const fe_kalman *k)
 {
     size_t n = k->n, b = k->bmax;
     struct fe__kalman_ws w;
@@ -67,7 +67,7 @@ int fe_kalman_init(fe_kalman *k, size_t n, size_t bmax, double *mem,
 }
 /* Lay out the workspace ends here */
 /* [[file:../literate/kalman.org::Check finiteness and symmetrise][Check finiteness and symmetrise]] */
-static int fe__finite(const double *v, size_t len)
+static inline int fe__finite(const double *v, size_t len)
 {
     int ok = 1;
     for (size_t i = 0; i < len; i++)
@@ -85,14 +85,15 @@ static void fe__symmetrise(double *M, size_t n)
         }
 }
 
-static int fe__kalman_usable(const fe_kalman *k)
+static inline int fe__kalman_usable(const fe_kalman *k)
 {
     return k != NULL && k->x != NULL && k->P != NULL && k->work != NULL
         && k->n > 0 && k->bmax > 0 && k->n <= FE_KALMAN_MAX_DIM
         && k->bmax <= FE_KALMAN_MAX_DIM;
 }
 
-static int fe__kalman_check_obs(size_t n, size_t bmax, const fe_kalman_obs *o)
+static inline int fe__kalman_check_obs(size_t n, size_t bmax,
+                                       const fe_kalman_obs *o)
 {
     if (o == NULL || o->b == 0 || o->A == NULL || o->z == NULL || o->Z == NULL)
         return FE_EINVAL;
@@ -236,17 +237,28 @@ static int fe__kalman_solve_update(size_t n, const fe_kalman_obs *o,
     return FE_OK;
 }
 /* Update by solving with the Kalman denominator ends here */
-/* [[file:../literate/kalman.org::Update by sequential scalar steps][Update by sequential scalar steps]] */
-static int fe__kalman_seq_update(size_t n, const fe_kalman_obs *o, double *x,
-                                 double *P, const struct fe__kalman_ws *w,
-                                 fe_kalman_report *r)
+/* [[file:../literate/kalman.org::Decorrelate a packet][Decorrelate a packet]] */
+/* A packet as decorrelated scalar rows: row i is (A[i], z[i]) with noise
+   variance var[i * var_stride], or 1 when var is NULL. */
+struct fe__rows {
+    size_t b;
+    const double *A;
+    const double *z;
+    const double *var;
+    size_t var_stride;
+    double log_det;     /* 2 sum log (L_Z)_ii: the whitening's share */
+};
+
+static int fe__kalman_decorrelate(size_t n, const fe_kalman_obs *o,
+                                  const double *x, const double *P,
+                                  const struct fe__kalman_ws *w,
+                                  fe_kalman_report *r, struct fe__rows *p)
 {
     const size_t b = o->b;
     const double *A = o->A, *Z = o->Z, *z = o->z;
     double *L = w->D, *Aw = w->R, *zw = w->nu, *g = w->PAT;
-    double nis = 0.0, log_det = 0.0;
+    int diagonal = 1;
 
-    /* Report extras from the prior state. */
     if (r != NULL && r->innovation != NULL)
         for (size_t i = 0; i < b; i++) {
             double s = z[i];
@@ -269,6 +281,21 @@ static int fe__kalman_seq_update(size_t n, const fe_kalman_obs *o, double *x,
                 r->D[i * b + j] = r->D[j * b + i] = s;
             }
         }
+    p->b = b;
+    p->log_det = 0.0;
+    for (size_t i = 1; i < b && diagonal; i++)
+        for (size_t j = 0; j < i; j++)
+            diagonal &= Z[i * b + j] == 0.0;
+    if (diagonal) {
+        for (size_t i = 0; i < b; i++)
+            if (!(Z[i * b + i] > 0.0))
+                return FE_ENOTPD;
+        p->A = A;
+        p->z = z;
+        p->var = Z;
+        p->var_stride = b + 1;
+        return FE_OK;
+    }
     /* Z = L L^T, from the lower triangle of Z. */
     for (size_t j = 0; j < b; j++) {
         double s = Z[j * b + j];
@@ -283,57 +310,156 @@ static int fe__kalman_seq_update(size_t n, const fe_kalman_obs *o, double *x,
                 t -= L[i * b + e] * L[j * b + e];
             L[i * b + j] = t / L[j * b + j];
         }
+        if (r != NULL)
+            p->log_det += 2.0 * log(L[j * b + j]);
     }
     /* Whiten: Aw = L^{-1} A, zw = L^{-1} z. */
     for (size_t i = 0; i < b; i++) {
-        double lii = L[i * b + i];
+        double inv = 1.0 / L[i * b + i];
         double t = z[i];
         for (size_t e = 0; e < i; e++)
             t -= L[i * b + e] * zw[e];
-        zw[i] = t / lii;
+        zw[i] = t * inv;
         for (size_t c = 0; c < n; c++) {
             double s = A[i * n + c];
             for (size_t e = 0; e < i; e++)
                 s -= L[i * b + e] * Aw[e * n + c];
-            Aw[i * n + c] = s / lii;
+            Aw[i * n + c] = s * inv;
         }
     }
-    /* One scalar update per whitened row. */
-    for (size_t i = 0; i < b; i++) {
-        const double *a = Aw + i * n;
-        double d = 1.0, res = zw[i], inv, gain;
-        for (size_t c = 0; c < n; c++) {
-            double s = 0.0;
-            for (size_t e = 0; e < n; e++)
-                s += P[c * n + e] * a[e];
-            g[c] = s;
-            d += a[c] * s;
-            res -= a[c] * x[c];
-        }
-        if (!(d > 0.0) || !isfinite(d))
-            return FE_ENOTPD;
-        inv = 1.0 / d;
-        gain = res * inv;
+    p->A = Aw;
+    p->z = zw;
+    p->var = NULL;
+    p->var_stride = 0;
+    return FE_OK;
+}
+/* Decorrelate a packet ends here */
+/* [[file:../literate/kalman.org::Update by sequential scalar steps][Update by sequential scalar steps]] */
+#if defined(__GNUC__)
+#define FE__ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define FE__ALWAYS_INLINE inline
+#endif
+
+enum { FE__KALMAN_SMALL = 8 };
+
+/* One scalar update of (xs, Ps) into (x, P) (the same arrays for an update
+   in place): row a, value z, noise variance v.  Returns 0 when d is not a
+   positive finite number, else d; *res receives the innovation. */
+static FE__ALWAYS_INLINE double fe__kalman_row(const size_t n, const double *xs,
+                                               const double *Ps, double *x,
+                                               double *P, double *g,
+                                               const double *a, double z,
+                                               double v, double *res)
+{
+    double d = v, nu = z, inv, gain;
+    /* g = P a, by rows of P (= columns: P is symmetric). */
+    for (size_t c = 0; c < n; c++)
+        g[c] = 0.0;
+    for (size_t e = 0; e < n; e++)
         for (size_t c = 0; c < n; c++)
-            x[c] += g[c] * gain;
-        for (size_t c = 0; c < n; c++) {
-            double gc = g[c] * inv;
-            for (size_t e = c; e < n; e++) {
-                double v = P[c * n + e] - gc * g[e];
-                P[c * n + e] = v;
-                P[e * n + c] = v;
-            }
-        }
+            g[c] += Ps[e * n + c] * a[e];
+    for (size_t c = 0; c < n; c++) {
+        d += a[c] * g[c];
+        nu -= a[c] * xs[c];
+    }
+    if (!(d > 0.0) || !isfinite(d))
+        return 0.0;
+    inv = 1.0 / d;
+    gain = nu * inv;
+    for (size_t c = 0; c < n; c++)
+        x[c] = xs[c] + g[c] * gain;
+    /* (g_c g_e) inv is the same number as (g_e g_c) inv: the full square
+       keeps P exactly symmetric. */
+    for (size_t c = 0; c < n; c++)
+        for (size_t e = 0; e < n; e++)
+            P[c * n + e] = Ps[c * n + e] - (g[c] * g[e]) * inv;
+    *res = nu;
+    return d;
+}
+
+/* Fold the rows of p into (x, P), the first from (xs, Ps). */
+static FE__ALWAYS_INLINE int fe__kalman_rows(const size_t n, const double *xs,
+                                             const double *Ps, double *x,
+                                             double *P, double *g,
+                                             const struct fe__rows *p,
+                                             fe_kalman_report *r)
+{
+    double nis = 0.0, log_det = p->log_det;
+    for (size_t i = 0; i < p->b; i++) {
+        double v = p->var != NULL ? p->var[i * p->var_stride] : 1.0, res = 0.0;
+        double d = i == 0
+            ? fe__kalman_row(n, xs, Ps, x, P, g, p->A, p->z[0], v, &res)
+            : fe__kalman_row(n, x, P, x, P, g, p->A + i * n, p->z[i], v, &res);
+        if (d == 0.0)
+            return FE_ENOTPD;
         if (r != NULL) {
-            nis += res * gain;
-            log_det += log(d) + 2.0 * log(L[i * b + i]);
+            nis += res * res / d;
+            log_det += log(d);
             if (r->whitened != NULL)
-                r->whitened[i] = res * sqrt(inv);
+                r->whitened[i] = res / sqrt(d);
         }
     }
     if (r != NULL)
-        fe__kalman_fill_report(r, b, nis, log_det);
+        fe__kalman_fill_report(r, p->b, nis, log_det);
     return FE_OK;
+}
+
+/* Run time n, in place (on the workspace copy). */
+static int fe__kalman_rows_any(size_t n, double *x, double *P, double *g,
+                               const struct fe__rows *p, fe_kalman_report *r)
+{
+    return fe__kalman_rows(n, x, P, x, P, g, p, r);
+}
+
+/* Compile-time n: the new state goes to locals, committed only when finite. */
+#define FE__KALMAN_SMALL_KERNEL(N)                                           \
+    static int fe__kalman_small##N(double *x, double *P,                     \
+                                   const struct fe__rows *p,                 \
+                                   fe_kalman_report *r)                      \
+    {                                                                        \
+        double xl[N], Pl[N * N], g[N];                                       \
+        int ok = 1, rc;                                                      \
+        rc = fe__kalman_rows(N, x, P, xl, Pl, g, p, r);                      \
+        if (rc != FE_OK)                                                     \
+            return rc;                                                       \
+        for (size_t i = 0; i < N; i++)                                       \
+            ok &= isfinite(xl[i]) != 0;                                      \
+        for (size_t i = 0; i < N * N; i++)                                   \
+            ok &= isfinite(Pl[i]) != 0;                                      \
+        if (!ok)                                                             \
+            return FE_ENONFINITE;                                            \
+        memcpy(x, xl, sizeof xl);                                            \
+        memcpy(P, Pl, sizeof Pl);                                            \
+        return FE_OK;                                                        \
+    }
+FE__KALMAN_SMALL_KERNEL(1)
+FE__KALMAN_SMALL_KERNEL(2)
+FE__KALMAN_SMALL_KERNEL(3)
+FE__KALMAN_SMALL_KERNEL(4)
+FE__KALMAN_SMALL_KERNEL(5)
+FE__KALMAN_SMALL_KERNEL(6)
+FE__KALMAN_SMALL_KERNEL(7)
+FE__KALMAN_SMALL_KERNEL(8)
+
+typedef int fe__kalman_small_fn(double *, double *, const struct fe__rows *,
+                                fe_kalman_report *);
+
+static fe__kalman_small_fn *const fe__kalman_small[FE__KALMAN_SMALL + 1] = {
+    0, fe__kalman_small1, fe__kalman_small2, fe__kalman_small3,
+    fe__kalman_small4, fe__kalman_small5, fe__kalman_small6,
+    fe__kalman_small7, fe__kalman_small8};
+
+/* The sequential update in place on (x, P) in the workspace. */
+static int fe__kalman_seq_update(size_t n, const fe_kalman_obs *o, double *x,
+                                 double *P, const struct fe__kalman_ws *w,
+                                 fe_kalman_report *r)
+{
+    struct fe__rows p;
+    int rc = fe__kalman_decorrelate(n, o, x, P, w, r, &p);
+    if (rc != FE_OK)
+        return rc;
+    return fe__kalman_rows_any(n, x, P, w->PAT, &p, r);
 }
 /* Update by sequential scalar steps ends here */
 /* [[file:../literate/kalman.org::Predict into the workspace][Predict into the workspace]] */
@@ -427,9 +553,36 @@ int fe_kalman_update(fe_kalman *k, const fe_kalman_obs *o,
 int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
                           fe_kalman_report *r)
 {
-    if (o == NULL)
+    struct fe__kalman_ws w;
+    struct fe__rows p;
+    int rc;
+    if (o == NULL || !fe__kalman_usable(k))
         return FE_EINVAL;
-    return fe__kalman_step(k, NULL, o, r, 1);
+    if (k->n > FE__KALMAN_SMALL)
+        return fe__kalman_step(k, NULL, o, r, 1);
+    /* Small n: decorrelate, then the fixed-size kernel.  A scalar packet
+       without report extras is its own decorrelation. */
+    if ((rc = fe__kalman_check_obs(k->n, k->bmax, o)) != FE_OK)
+        return rc;
+    if (o->b == 1 && (r == NULL || (r->innovation == NULL && r->D == NULL))) {
+        if (!(o->Z[0] > 0.0))
+            return FE_ENOTPD;
+        p.b = 1;
+        p.A = o->A;
+        p.z = o->z;
+        p.var = o->Z;
+        p.var_stride = 1;
+        p.log_det = 0.0;
+    } else {
+        w = fe__kalman_layout(k);
+        rc = fe__kalman_decorrelate(k->n, o, k->x, k->P, &w, r, &p);
+        if (rc != FE_OK)
+            return rc;
+    }
+    rc = fe__kalman_small[k->n](k->x, k->P, &p, r);
+    if (rc == FE_OK)
+        k->count++;
+    return rc;
 }
 
 int fe_kalman_predict(fe_kalman *k, const fe_kalman_model *m)
