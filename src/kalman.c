@@ -69,10 +69,17 @@ int fe_kalman_init(fe_kalman *k, size_t n, size_t bmax, double *mem,
 /* [[file:../literate/kalman.org::Check finiteness and symmetrise][Check finiteness and symmetrise]] */
 static inline int fe__finite(const double *v, size_t len)
 {
-    int ok = 1;
-    for (size_t i = 0; i < len; i++)
-        ok &= isfinite(v[i]) != 0;
-    return ok;
+    /* v * 0 is 0 for a finite v and NaN otherwise; two independent sums
+       let the compiler pair them in one vector register. */
+    double s0 = 0.0, s1 = 0.0;
+    size_t i = 0;
+    for (; i + 2 <= len; i += 2) {
+        s0 += v[i] * 0.0;
+        s1 += v[i + 1] * 0.0;
+    }
+    if (i < len)
+        s0 += v[i] * 0.0;
+    return s0 + s1 == 0.0;
 }
 
 static void fe__symmetrise(double *M, size_t n)
@@ -386,7 +393,8 @@ static FE__ALWAYS_INLINE int fe__kalman_rows(const size_t n, const double *xs,
                                              fe_kalman_report *r)
 {
     double nis = 0.0, log_det = p->log_det;
-    for (size_t i = 0; i < p->b; i++) {
+    /* p->b >= 1: the first row always runs, from (xs, Ps). */
+    for (size_t i = 0; i == 0 || i < p->b; i++) {
         double v = p->var != NULL ? p->var[i * p->var_stride] : 1.0, res = 0.0;
         double d = i == 0
             ? fe__kalman_row(n, xs, Ps, x, P, g, p->A, p->z[0], v, &res)
@@ -419,15 +427,10 @@ static int fe__kalman_rows_any(size_t n, double *x, double *P, double *g,
                                    fe_kalman_report *r)                      \
     {                                                                        \
         double xl[N], Pl[N * N], g[N];                                       \
-        int ok = 1, rc;                                                      \
-        rc = fe__kalman_rows(N, x, P, xl, Pl, g, p, r);                      \
+        int rc = fe__kalman_rows(N, x, P, xl, Pl, g, p, r);                  \
         if (rc != FE_OK)                                                     \
             return rc;                                                       \
-        for (size_t i = 0; i < N; i++)                                       \
-            ok &= isfinite(xl[i]) != 0;                                      \
-        for (size_t i = 0; i < N * N; i++)                                   \
-            ok &= isfinite(Pl[i]) != 0;                                      \
-        if (!ok)                                                             \
+        if (!fe__finite(xl, N) || !fe__finite(Pl, N * N))                    \
             return FE_ENONFINITE;                                            \
         memcpy(x, xl, sizeof xl);                                            \
         memcpy(P, Pl, sizeof Pl);                                            \
@@ -560,25 +563,36 @@ int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
         return FE_EINVAL;
     if (k->n > FE__KALMAN_SMALL)
         return fe__kalman_step(k, NULL, o, r, 1);
-    /* Small n: decorrelate, then the fixed-size kernel.  A scalar packet
-       without report extras is its own decorrelation. */
-    if ((rc = fe__kalman_check_obs(k->n, k->bmax, o)) != FE_OK)
-        return rc;
+    /* Small n: decorrelate, then the fixed-size kernel. */
+    if (o->b == 0 || o->A == NULL || o->z == NULL || o->Z == NULL)
+        return FE_EINVAL;
+    if (o->b > k->bmax)
+        return FE_ESIZE;
     if (o->b == 1 && (r == NULL || (r->innovation == NULL && r->D == NULL))) {
-        if (!(o->Z[0] > 0.0))
-            return FE_ENOTPD;
+        /* A scalar packet is its own decorrelation.  Its finiteness is
+           checked only when the kernel refuses it: a NaN or infinity in
+           A or Z makes d non-finite, one in z makes the result so. */
         p.b = 1;
         p.A = o->A;
         p.z = o->z;
         p.var = o->Z;
         p.var_stride = 1;
         p.log_det = 0.0;
-    } else {
-        w = fe__kalman_layout(k);
-        rc = fe__kalman_decorrelate(k->n, o, k->x, k->P, &w, r, &p);
-        if (rc != FE_OK)
-            return rc;
+        rc = o->Z[0] > 0.0 ? fe__kalman_small[k->n](k->x, k->P, &p, r)
+                           : FE_ENOTPD;
+        if (rc == FE_OK)
+            k->count++;
+        else if (!fe__finite(o->A, k->n) || !isfinite(o->z[0])
+                 || !isfinite(o->Z[0]))
+            rc = FE_ENONFINITE;
+        return rc;
     }
+    if ((rc = fe__kalman_check_obs(k->n, k->bmax, o)) != FE_OK)
+        return rc;
+    w = fe__kalman_layout(k);
+    rc = fe__kalman_decorrelate(k->n, o, k->x, k->P, &w, r, &p);
+    if (rc != FE_OK)
+        return rc;
     rc = fe__kalman_small[k->n](k->x, k->P, &p, r);
     if (rc == FE_OK)
         k->count++;

@@ -499,6 +499,26 @@ START_TEST(bad_packets_are_refused_and_nothing_changes)
         ASSERT_UNCHANGED(f, snap, desc);
         ck_assert_int_eq(upd(&f.k, &big, NULL), FE_ESIZE);
         ASSERT_UNCHANGED(f, snap, desc);
+        {   /* Scalar packets with a NaN or an infinity anywhere. */
+            const double Anan[3] = {1, NAN, 0}, Ainf[3] = {INFINITY, 0, 0};
+            const double one = 1.0, nanv = NAN, infv = INFINITY;
+            fe_kalman_obs s1 = {1, Anan, &z1, &one}, s2 = {1, Ainf, &z1, &one},
+                          s3 = {1, A1, &nanv, &one}, s4 = {1, A1, &infv, &one},
+                          s5 = {1, A1, &z1, &nanv}, s6 = {1, A1, &z1, &infv};
+            ck_assert_int_eq(upd(&f.k, &s1, NULL), FE_ENONFINITE);
+            ck_assert_int_eq(upd(&f.k, &s2, NULL), FE_ENONFINITE);
+            ck_assert_int_eq(upd(&f.k, &s3, NULL), FE_ENONFINITE);
+            ck_assert_int_eq(upd(&f.k, &s4, NULL), FE_ENONFINITE);
+            ck_assert_int_eq(upd(&f.k, &s5, NULL), FE_ENONFINITE);
+            ck_assert_int_eq(upd(&f.k, &s6, NULL), FE_ENONFINITE);
+            ASSERT_UNCHANGED(f, snap, desc);
+        }
+        {   /* An update whose result overflows is refused too. */
+            const double huge = 1e300, tiny = 1e-300, Ahuge[3] = {1e-300, 0, 0};
+            fe_kalman_obs ov = {1, Ahuge, &huge, &tiny};
+            ck_assert_int_eq(upd(&f.k, &ov, NULL), FE_ENONFINITE);
+            ASSERT_UNCHANGED(f, snap, desc);
+        }
         ck_assert_int_eq(upd(&f.k, &zero, NULL), FE_EINVAL);
         ck_assert_int_eq(upd(&f.k, &null, NULL), FE_EINVAL);
         ck_assert_int_eq(upd(&f.k, NULL, NULL), FE_EINVAL);
