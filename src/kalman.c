@@ -161,6 +161,13 @@ int fe_kalman_set_prior_scaled(fe_kalman *k, const double *x0, double p0)
     return FE_OK;
 }
 
+double fe_kalman_sigma(const fe_kalman *k, size_t i)
+{
+    if (k == NULL || k->P == NULL || i >= k->n)
+        return NAN;
+    return sqrt(k->P[i * k->n + i]);
+}
+
 int fe_kalman_copy(fe_kalman *dst, const fe_kalman *src)
 {
     if (!fe__kalman_usable(dst) || !fe__kalman_usable(src))

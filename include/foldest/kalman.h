@@ -71,6 +71,10 @@ int fe_kalman_set_prior(fe_kalman *k, const double *x0, const double *P0);
 /* fe_kalman_set_prior_scaled: x <- x0 (NULL: zero), P <- p0 I, p0 >= 0. */
 int fe_kalman_set_prior_scaled(fe_kalman *k, const double *x0, double p0);
 
+/* fe_kalman_sigma: the standard deviation sqrt(P_ii) of component i
+   (NAN when i >= n): the 1-sigma bound of x[i]. */
+double fe_kalman_sigma(const fe_kalman *k, size_t i);
+
 /* fe_kalman_copy: dst's x, P and count <- src's.  Same n required
    (FE_EMISMATCH); bmax may differ. */
 int fe_kalman_copy(fe_kalman *dst, const fe_kalman *src);
