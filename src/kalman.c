@@ -900,8 +900,10 @@ int fe_kalman_monitor_add(fe_kalman_monitor *m, const fe_kalman_report *r)
     double bd, lu, ld;
     if (m == NULL || r == NULL || r->b == 0 || !fe__monitor_params_ok(&m->par))
         return FE_EINVAL;
-    if (!isfinite(r->nis) || r->nis < 0.0)
-        return r->nis < 0.0 ? FE_EINVAL : FE_ENONFINITE;
+    if (!isfinite(r->nis) || !isfinite(r->log_det_D))
+        return FE_ENONFINITE;
+    if (r->nis < 0.0)
+        return FE_EINVAL;
     if (r->whitened != NULL) {
         size_t dim = r->b < FE_KALMAN_MONITOR_DIM ? r->b : FE_KALMAN_MONITOR_DIM;
         if (!fe__finite(r->whitened, dim))

@@ -89,11 +89,13 @@ int fe_kalman_copy(fe_kalman *dst, const fe_kalman *src);
 int fe_kalman_update(fe_kalman *k, const fe_kalman_obs *o,
                      fe_kalman_report *r);
 
-/* fe_kalman_update_fast: the same update as sequential scalar updates after
-   decorrelating the packet by a hand-written Cholesky of Z; equal to
+/* fe_kalman_update_fast: the same update as sequential scalar updates of
+   decorrelated rows (Z diagonal: as given; otherwise whitened by a
+   hand-written Cholesky of Z), with fixed-size kernels for n <= 8; equal to
    fe_kalman_update to rounding (tested to 1e-12).  Requires Z positive
-   definite (FE_ENOTPD otherwise, even when D would be).  Cost
-   O(n^2 b + n b^2 + b^3) flops, no library calls. */
+   definite (FE_ENOTPD otherwise, even when D would be).  Errors and the
+   unchanged-on-error promise as fe_kalman_update.  Cost
+   O(n^2 b + n b^2 + b^3) flops, no library calls, allocates nothing. */
 int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
                           fe_kalman_report *r);
 /* Kalman Filter Declarations ends here */
