@@ -18,6 +18,7 @@
 #include "foldest/lsq.h"
 #include "foldest/schur.h"
 #include "foldest/lm.h"
+#include "foldest/kalman.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */
