@@ -18,11 +18,12 @@ CC           ?= cc
 CFLAGS       ?= -O2 -g
 WARN         := -std=c11 -Wall -Wextra -Werror -pedantic
 SAN          := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+TSAN         := -fsanitize=thread -fno-omit-frame-pointer
 B            := build
 
 # pkg-config is read when a recipe runs (after `deps`), hence `=` not `:=`.
 EXT_CFLAGS    = $(shell pkg-config --cflags lapacke blas)
-EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm
+EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm -pthread
 BENCH_LIBS    = $(shell pkg-config --libs gsl)
 CHECK_CFLAGS  = $(shell pkg-config --cflags check)
 CHECK_LIBS    = $(shell pkg-config --libs check)
@@ -37,6 +38,7 @@ BENCHES      := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 
 LIB_OBJ      := $(patsubst src/%.c,$(B)/obj/%.o,$(LIB_SRC))
 SAN_OBJ      := $(patsubst src/%.c,$(B)/san/%.o,$(LIB_SRC))
+TSAN_OBJ     := $(patsubst src/%.c,$(B)/tsan/%.o,$(LIB_SRC))
 CLI_OBJ      := $(patsubst src/cli/%.c,$(B)/obj/cli/%.o,$(CLI_SRC))
 STATIC       := $(B)/lib/libfoldest.a
 SHARED       := $(B)/lib/libfoldest.so.$(VERSION)
@@ -48,7 +50,8 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo bench install uninstall clean
+        check-install check-tangle tangle doc demo bench install uninstall clean \
+        check-tsan check-mpi bench-mpi
 
 all: lib cli examples
 
@@ -117,6 +120,15 @@ $(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tes
 	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
+# The parallel folds again, library and tests built with ThreadSanitizer.
+$(B)/tsan/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
+
+$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(TSAN_OBJ)
+	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+	  tests/main.c $(TEST_SRC) $(TSAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
+
 tests: $(B)/tests/check_foldest $(B)/tests/check_foldest_san
 
 check: check-plain check-san check-valgrind check-install
@@ -136,6 +148,10 @@ check-valgrind: $(B)/tests/check_foldest
 	CK_FORK=no FE_TEST_QUICK=1 valgrind -q --error-exitcode=99 --leak-check=full \
 	  --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible \
 	  $(B)/tests/check_foldest
+
+check-tsan: $(B)/tests/check_foldest_tsan
+	@echo "== parallel tests (ThreadSanitizer)"
+	CK_RUN_SUITE=parallel FE_TEST_QUICK=1 TSAN_OPTIONS=halt_on_error=1 $(B)/tests/check_foldest_tsan
 
 # Install into a scratch DESTDIR and build every example from it with pkg-config.
 check-install: lib

@@ -10,6 +10,7 @@
 #include "foldest/stream.h"
 #include "foldest/meanvar.h"
 #include "foldest/random.h"
+#include "foldest/parallel.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */
