@@ -101,6 +101,30 @@ $(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
 bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
+# ---------------------------------------------------------------- MPI (optional)
+# Only these targets need Open MPI (mpicc, mpirun); libfoldest never links
+# it.  examples/mpi/*.c and bench/mpi/*.c include <foldest/mpi.h>; they are
+# outside the examples/*.c and bench/*.c wildcards on purpose.
+MPICC        ?= mpicc
+MPI_NP       ?= 2
+MPIRUN        = mpirun -np $(MPI_NP) --oversubscribe $(if $(filter 0,$(shell id -u)),--allow-run-as-root)
+MPI_PROGS    := $(patsubst examples/mpi/%.c,$(B)/mpi/%,$(wildcard examples/mpi/*.c))
+
+$(B)/mpi/%: examples/mpi/%.c include/foldest/mpi.h $(STATIC)
+	@mkdir -p $(@D)
+	$(MPICC) $(WARN) $(CFLAGS) -Iinclude -o $@ $< $(STATIC) $(EXT_LIBS)
+
+$(B)/mpi-bench/%: bench/mpi/%.c include/foldest/mpi.h bench/bench.h $(STATIC)
+	@mkdir -p $(@D)
+	$(MPICC) $(WARN) -D_POSIX_C_SOURCE=200809L -O3 -march=native -g -Iinclude -Ibench -o $@ $< $(STATIC) $(EXT_LIBS)
+
+check-mpi: $(MPI_PROGS)
+	@echo "== MPI examples on $(MPI_NP) ranks (each checks itself against the serial fold)"
+	sh examples/mpi/check.sh $(B) "$(MPIRUN)"
+
+bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
+	@for b in $^; do echo "== $$b"; OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 $(MPIRUN) $$b || exit 1; done
+
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
 # `Suite *fe_<module>_suite(void)`, listed into suites.h at build time.

@@ -76,14 +76,32 @@ static double run(const row *w, const void *z, size_t n, unsigned T,
     return best;
 }
 
+/* The 1-minute load average before the run (from /proc/loadavg; -1 when
+   unknown): a busy machine cannot show a parallel speed-up. */
+static double load_average(void)
+{
+    double l = -1.0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f != NULL) {
+        if (fscanf(f, "%lf", &l) != 1)
+            l = -1.0;
+        fclose(f);
+    }
+    return l;
+}
+
 int main(int argc, char **argv)
 {
     size_t n = argc > 1 ? (size_t)strtod(argv[1], NULL) : 100000000;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    double load = load_average();
     int ok = 1;
 
     printf("parallel folds over data in memory (ns per observation, best of 5); %ld cores online\n",
            cores);
+    if (load > 0.5)
+        printf("  NOTE: load average %.2f before the run: other processes share the cores,\n"
+               "  so the speed-ups below are pessimistic; rerun on a quiet machine\n", load);
     for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
         const row *w = &rows[k];
         fe_accumulator f = w->make();
