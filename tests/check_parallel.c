@@ -387,7 +387,7 @@ START_TEST(first_refusal_has_the_lowest_index)
     for (int i = 0; i < N; i++)
         x[i] = 2.0 + fe_rng_normal(&r);
     for (size_t k = 0; k < sizeof first / sizeof first[0]; k++) {
-        size_t p = first[k], q = p + (N - p) / 2 + 1;
+        size_t p = first[k], q = p + (N - p) / 2;     /* p < q < N */
         fe_meanvar serial = FE_MEANVAR_EMPTY;
         double xp = x[p], xq = x[q];
         x[p] = NAN;
