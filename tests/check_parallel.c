@@ -630,6 +630,40 @@ static int range_generate(void *obs, size_t index, void *ctx)
     return FE_OK;
 }
 
+/* A generator whose read fails at its local index 3. */
+static int failing_generate(void *obs, size_t index, void *ctx)
+{
+    if (index == 3)
+        return FE_EIO;
+    return range_generate(obs, index, ctx);
+}
+
+START_TEST(a_failing_source_is_a_refusal)
+{
+    /* Source 1 fails reading its fourth observation; source 2 is fine but
+       comes later: FE_EIO, *done = length of source 0 + 3. */
+    fe_accumulator f = fe_meanvar_accumulator();
+    struct range_gen g[3] = {{0, 100}, {100, 200}, {200, 300}}, whole = {0, 103};
+    fe_generator_source st[3], wst;
+    fe_source src[3], wsrc;
+    fe_source *sp[3] = {&src[0], &src[1], &src[2]};
+    double slots[3], wslot;
+    fe_meanvar a = FE_MEANVAR_EMPTY, serial = FE_MEANVAR_EMPTY, parts[2];
+    void *pp[2] = {&parts[0], &parts[1]};
+    size_t done = 0;
+    fe_source_from_generator(&src[0], &st[0], range_generate, &g[0], &slots[0], sizeof(double));
+    fe_source_from_generator(&src[1], &st[1], failing_generate, &g[1], &slots[1], sizeof(double));
+    fe_source_from_generator(&src[2], &st[2], range_generate, &g[2], &slots[2], sizeof(double));
+    fe_source_from_generator(&wsrc, &wst, range_generate, &whole, &wslot, sizeof(double));
+    ck_assert_int_eq(fe_fold_source(&f, &serial, &wsrc, NULL), FE_OK);
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 3, pp, &done), FE_EIO);
+    ck_assert_uint_eq(done, 103);
+    ck_assert_uint_eq(a.n, 103);
+    FE_ASSERT_REL(a.mean, serial.mean, 1e-12);
+    FE_ASSERT_REL(a.m2, serial.m2, 1e-12);
+}
+END_TEST
+
 START_TEST(generators_per_thread_equal_one_generator)
 {
     /* Each thread generates its own range of one long stream. */
@@ -683,6 +717,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, chunks_cover_the_array);
     tcase_add_test(t, sources_fold_their_concatenation);
     tcase_add_test(t, generators_per_thread_equal_one_generator);
+    tcase_add_test(t, a_failing_source_is_a_refusal);
     suite_add_tcase(s, t);
     return s;
 }
