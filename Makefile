@@ -18,11 +18,12 @@ CC           ?= cc
 CFLAGS       ?= -O2 -g
 WARN         := -std=c11 -Wall -Wextra -Werror -pedantic
 SAN          := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+TSAN         := -fsanitize=thread -fno-omit-frame-pointer
 B            := build
 
 # pkg-config is read when a recipe runs (after `deps`), hence `=` not `:=`.
 EXT_CFLAGS    = $(shell pkg-config --cflags lapacke blas)
-EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm
+EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm -pthread
 BENCH_LIBS    = $(shell pkg-config --libs gsl)
 CHECK_CFLAGS  = $(shell pkg-config --cflags check)
 CHECK_LIBS    = $(shell pkg-config --libs check)
@@ -37,6 +38,7 @@ BENCHES      := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
 
 LIB_OBJ      := $(patsubst src/%.c,$(B)/obj/%.o,$(LIB_SRC))
 SAN_OBJ      := $(patsubst src/%.c,$(B)/san/%.o,$(LIB_SRC))
+TSAN_OBJ     := $(patsubst src/%.c,$(B)/tsan/%.o,$(LIB_SRC))
 CLI_OBJ      := $(patsubst src/cli/%.c,$(B)/obj/cli/%.o,$(CLI_SRC))
 STATIC       := $(B)/lib/libfoldest.a
 SHARED       := $(B)/lib/libfoldest.so.$(VERSION)
@@ -48,7 +50,8 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo bench install uninstall clean
+        check-install check-tangle tangle doc demo bench install uninstall clean \
+        check-tsan check-mpi bench-mpi
 
 all: lib cli examples
 
@@ -98,6 +101,30 @@ $(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
 bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
+# ---------------------------------------------------------------- MPI (optional)
+# Only these targets need Open MPI (mpicc, mpirun); libfoldest never links
+# it.  examples/mpi/*.c and bench/mpi/*.c include <foldest/mpi.h>; they are
+# outside the examples/*.c and bench/*.c wildcards on purpose.
+MPICC        ?= mpicc
+MPI_NP       ?= 2
+MPIRUN        = mpirun -np $(MPI_NP) --oversubscribe $(if $(filter 0,$(shell id -u)),--allow-run-as-root)
+MPI_PROGS    := $(patsubst examples/mpi/%.c,$(B)/mpi/%,$(wildcard examples/mpi/*.c))
+
+$(B)/mpi/%: examples/mpi/%.c include/foldest/mpi.h $(STATIC)
+	@mkdir -p $(@D)
+	$(MPICC) $(WARN) $(CFLAGS) -Iinclude -o $@ $< $(STATIC) $(EXT_LIBS)
+
+$(B)/mpi-bench/%: bench/mpi/%.c include/foldest/mpi.h bench/bench.h $(STATIC)
+	@mkdir -p $(@D)
+	$(MPICC) $(WARN) -D_POSIX_C_SOURCE=200809L -O3 -march=native -g -Iinclude -Ibench -o $@ $< $(STATIC) $(EXT_LIBS)
+
+check-mpi: $(MPI_PROGS)
+	@echo "== MPI examples on $(MPI_NP) ranks (each checks itself against the serial fold)"
+	sh examples/mpi/check.sh $(B) "$(MPIRUN)"
+
+bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
+	@for b in $^; do echo "== $$b"; OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 $(MPIRUN) $$b || exit 1; done
+
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
 # `Suite *fe_<module>_suite(void)`, listed into suites.h at build time.
@@ -119,6 +146,15 @@ $(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tes
 	$(CC) $(WARN) -O1 -g $(SAN) $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
+# The parallel folds again, library and tests built with ThreadSanitizer.
+$(B)/tsan/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
+
+$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(TSAN_OBJ)
+	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+	  tests/main.c $(TEST_SRC) $(TSAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
+
 tests: $(B)/tests/check_foldest $(B)/tests/check_foldest_san
 
 check: check-plain check-san check-valgrind check-install
@@ -139,6 +175,10 @@ check-valgrind: $(B)/tests/check_foldest
 	CK_FORK=no FE_TEST_QUICK=1 valgrind -q --error-exitcode=99 --leak-check=full \
 	  --errors-for-leak-kinds=definite,indirect,possible --show-leak-kinds=definite,indirect,possible \
 	  $(B)/tests/check_foldest
+
+check-tsan: $(B)/tests/check_foldest_tsan
+	@echo "== parallel tests (ThreadSanitizer)"
+	CK_RUN_SUITE=parallel FE_TEST_QUICK=1 TSAN_OPTIONS=halt_on_error=1 $(B)/tests/check_foldest_tsan
 
 # Install into a scratch DESTDIR and build every example from it with pkg-config.
 check-install: lib

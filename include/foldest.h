@@ -19,6 +19,7 @@
 #include "foldest/schur.h"
 #include "foldest/lm.h"
 #include "foldest/kalman.h"
+#include "foldest/parallel.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

@@ -1,0 +1,723 @@
+/* Parallel folds: equal to the serial fold for every mergeable accumulator,
+   for 1..8 threads and awkward sizes; deterministic; the first refusal (the
+   lowest index) wins; bad arguments fold nothing.  Also run under
+   ThreadSanitizer by `make check-tsan`. */
+#include <float.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+enum { MAX_T = 8 };
+
+/* Sizes that cut badly: empty, fewer items than threads, one over a
+   multiple of 8, several meanvar blocks plus a remainder. */
+static const size_t sizes[] = {0, 1, 2, 3, 5, 7, 8, 9, 17, 64, 1000, 4099, 100003};
+enum { NSIZES = sizeof sizes / sizeof sizes[0] };
+
+static size_t size_at(size_t i)
+{
+    /* Under valgrind the largest size shrinks (still not a multiple of 8). */
+    return sizes[i] == 100003 && fe_test_quick() ? 10007 : sizes[i];
+}
+
+/* ------------------------------------------------------------------------
+   An exact, associative, NON-commutative accumulator: the polynomial hash
+   h = sum z_i B^(n-1-i) mod P of a sequence.  Merge: h = h_a B^(n_b) + h_b.
+   Any change in the order of the merges changes the result, and there is
+   no rounding, so the parallel fold must equal the serial fold exactly. */
+#define HASH_P 4294967291u              /* the largest prime below 2^32 */
+#define HASH_B 1000003u
+
+typedef struct { uint64_t n, h, pow; } hash_acc;
+
+static int hash_init(void *acc, void *ctx)
+{
+    hash_acc *a = acc;
+    (void)ctx;
+    a->n = 0;
+    a->h = 0;
+    a->pow = 1;
+    return FE_OK;
+}
+
+/* Observations are uint64_t; the value UINT64_MAX is refused. */
+static int hash_step(void *acc, const void *obs, void *ctx)
+{
+    hash_acc *a = acc;
+    uint64_t z = *(const uint64_t *)obs;
+    (void)ctx;
+    if (z == UINT64_MAX)
+        return FE_EINVAL;
+    a->h = (a->h * HASH_B + z % HASH_P) % HASH_P;
+    a->pow = a->pow * HASH_B % HASH_P;
+    a->n++;
+    return FE_OK;
+}
+
+static int hash_merge(void *acc, const void *other, void *ctx)
+{
+    hash_acc *a = acc;
+    const hash_acc *b = other;
+    (void)ctx;
+    a->h = (a->h * b->pow + b->h) % HASH_P;
+    a->pow = a->pow * b->pow % HASH_P;
+    a->n += b->n;
+    return FE_OK;
+}
+
+static fe_accumulator hash_accumulator(void)
+{
+    fe_accumulator f = {"hash", sizeof(hash_acc), sizeof(uint64_t), hash_init,
+                        hash_step, NULL, hash_merge, NULL, NULL};
+    return f;
+}
+
+/* ------------------------------------------------------------------------
+   The table of flat mergeable accumulators.  A new accumulator is one row:
+   how to make it, how to generate an observation, and the largest relative
+   difference between two of its accumulations (+inf when counts differ). */
+typedef struct pcase {
+    const char *name;
+    fe_accumulator (*make)(void);
+    void (*generate)(void *obs, fe_rng *r);
+    double (*distance)(const void *a, const void *b);
+} pcase;
+
+static double rel(double got, double want)
+{
+    double s = fabs(want) > 1e-300 ? fabs(want) : 1e-300;
+    return fabs(got - want) / s;
+}
+
+/* Rounding in any fold of the variance grows like (|mean| / stddev) *
+   DBL_EPSILON; two folds in different orders agree to 1e-12 only when that
+   ratio is below about 1e3.  Here it is 333; ill-conditioned data are
+   compared with the exact answer in precision_at_large_offset. */
+static void meanvar_generate(void *obs, fe_rng *r)
+{
+    *(double *)obs = 1e3 + 3.0 * fe_rng_normal(r);
+}
+
+static double meanvar_distance(const void *a, const void *b)
+{
+    const fe_meanvar *p = a, *q = b;
+    double d;
+    if (p->n != q->n)
+        return INFINITY;
+    d = rel(p->mean, q->mean);
+    return fmax(d, rel(p->m2, q->m2));
+}
+
+static void hash_generate(void *obs, fe_rng *r)
+{
+    *(uint64_t *)obs = fe_rng_next(r) >> 1;     /* never UINT64_MAX */
+}
+
+static double hash_distance(const void *a, const void *b)
+{
+    return memcmp(a, b, sizeof(hash_acc)) == 0 ? 0.0 : INFINITY;
+}
+
+static const pcase cases[] = {
+    {"meanvar", fe_meanvar_accumulator, meanvar_generate, meanvar_distance},
+    {"hash (exact, non-commutative)", hash_accumulator, hash_generate, hash_distance},
+    /* Add a row here for each new mergeable accumulator. */
+};
+enum { NCASES = sizeof cases / sizeof cases[0] };
+
+/* Storage for one accumulation of any flat accumulator under test. */
+typedef union { max_align_t align; unsigned char bytes[512]; } slot;
+
+/* Fill n observations of case c. */
+static unsigned char *generate(const pcase *c, const fe_accumulator *f,
+                               size_t n, uint64_t seed)
+{
+    unsigned char *z = malloc(n * f->obs_size + 1);
+    fe_rng r = fe_rng_seed(seed);
+    for (size_t i = 0; i < n; i++)
+        c->generate(z + i * f->obs_size, &r);
+    return z;
+}
+
+START_TEST(flat_accumulators_equal_serial)
+{
+    /* Every case, size and thread count: the parallel fold equals the
+       serial one to 1e-12 relative (the hash: exactly), folds everything,
+       is bit-identical on a second run, and with 1 thread is fe_fold to
+       the bit. */
+    double worst = 0.0;
+    int bad_rc = 0, not_all = 0, not_repeatable = 0, not_fe_fold = 0;
+    char where[256] = "";
+    for (int ci = 0; ci < NCASES; ci++) {
+        const pcase *c = &cases[ci];
+        fe_accumulator f = c->make();
+        ck_assert_uint_le(f.acc_size, sizeof(slot));
+        for (size_t si = 0; si < NSIZES; si++) {
+            size_t n = size_at(si), done = 0;
+            unsigned char *z = generate(c, &f, n, 100 + si);
+            slot serial, par, again, parts[MAX_T];
+            void *pp[MAX_T];
+            for (int t = 0; t < MAX_T; t++)
+                pp[t] = &parts[t];
+            bad_rc |= fe_init(&f, &serial);
+            bad_rc |= fe_fold(&f, &serial, z, n, NULL);
+            for (unsigned T = 1; T <= MAX_T; T++) {
+                double d;
+                memset(&par, 0, sizeof par);
+                memset(&again, 0, sizeof again);
+                bad_rc |= fe_init(&f, &par);
+                bad_rc |= fe_init(&f, &again);
+                bad_rc |= fe_parallel_fold(&f, &par, z, n, T, pp, &done);
+                not_all |= done != n;
+                bad_rc |= fe_parallel_fold(&f, &again, z, n, T, pp, NULL);
+                not_repeatable |= memcmp(&par, &again, f.acc_size) != 0;
+                if (T == 1)
+                    not_fe_fold |= memcmp(&par, &serial, f.acc_size) != 0;
+                d = c->distance(&par, &serial);
+                if (!(d <= worst)) {
+                    worst = d;
+                    snprintf(where, sizeof where, "%s, n = %zu, %u threads",
+                             c->name, n, T);
+                }
+            }
+            free(z);
+        }
+    }
+    ck_assert_int_eq(bad_rc, FE_OK);
+    ck_assert_msg(!not_all, "a parallel fold did not fold every observation");
+    ck_assert_msg(!not_repeatable, "a parallel fold is not deterministic");
+    ck_assert_msg(!not_fe_fold, "one thread is not exactly fe_fold");
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g at %s", worst, where);
+    if (getenv("FE_TEST_VERBOSE"))
+        fprintf(stderr, "parallel vs serial: worst relative difference %.3g at %s\n", worst, where);
+}
+END_TEST
+
+START_TEST(folds_onto_a_nonempty_accumulation)
+{
+    /* acc on entry already holds a fold: the parallel fold continues it,
+       as fe_fold does. */
+    enum { N = 5003 };
+    fe_accumulator f = fe_meanvar_accumulator();
+    unsigned char *z = generate(&cases[0], &f, N, 7);
+    const double *x = (const double *)z;
+    fe_meanvar serial = FE_MEANVAR_EMPTY, par = FE_MEANVAR_EMPTY, parts[3];
+    void *pp[3] = {&parts[0], &parts[1], &parts[2]};
+    ck_assert_int_eq(fe_fold(&f, &serial, x, N, NULL), FE_OK);
+    ck_assert_int_eq(fe_fold(&f, &par, x, 100, NULL), FE_OK);
+    ck_assert_int_eq(fe_parallel_fold(&f, &par, x + 100, N - 100, 4, pp, NULL), FE_OK);
+    ck_assert_uint_eq(par.n, N);
+    FE_ASSERT_REL(par.mean, serial.mean, 1e-12);
+    FE_ASSERT_REL(par.m2, serial.m2, 1e-12);
+    free(z);
+}
+END_TEST
+
+START_TEST(precision_at_large_offset)
+{
+    /* 1e9 + N(0,1): the merges must re-centre (Chan), or the variance is
+       noise (merging raw sums of squares leaves no correct digit).  The
+       reference is the two-pass formula in long double.  The conditioning
+       |mean| / stddev = 1e9 puts the rounding floor of any double fold
+       near 1e9 * DBL_EPSILON = 2e-7; the serial blocked fold measures about
+       1e-9 here and Welford's serial fold 4e-9 to 3e-8.  Every thread count
+       must stay below 1e-8, twenty times under that floor. */
+    size_t n = fe_test_quick() ? 200003 : 2000003;
+    double *x = malloc(n * sizeof *x);
+    fe_rng r = fe_rng_seed(99);
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar parts[MAX_T];
+    void *pp[MAX_T];
+    long double sum = 0, ss = 0, mean;
+    double worst = 0.0;
+    for (int t = 0; t < MAX_T; t++)
+        pp[t] = &parts[t];
+    for (size_t i = 0; i < n; i++) {
+        x[i] = 1e9 + fe_rng_normal(&r);
+        sum += x[i];
+    }
+    mean = sum / (long double)n;
+    for (size_t i = 0; i < n; i++)
+        ss += (x[i] - mean) * (x[i] - mean);
+    for (unsigned T = 2; T <= MAX_T; T++) {
+        fe_meanvar a = FE_MEANVAR_EMPTY;
+        ck_assert_int_eq(fe_parallel_fold(&f, &a, x, n, T, pp, NULL), FE_OK);
+        worst = fmax(worst, rel(fe_meanvar_variance(&a), (double)(ss / (long double)(n - 1))));
+        worst = fmax(worst, rel(a.mean, (double)mean));
+    }
+    ck_assert_msg(worst <= 1e-8, "relative error %.3g at offset 1e9", worst);
+    free(x);
+}
+END_TEST
+
+/* ------------------------------------------------------------------------
+   The product of accumulators: mean/variance of x and of y, side by side.
+   Not flat: each partial is prepared with its own storage.  The product has
+   no step_many, so its serial fold is Welford one step at a time, whose
+   relative error grows like (|mean| / stddev) * DBL_EPSILON: comparing it
+   with the parallel fold at 1e-12 is only meaningful for data with
+   |mean| / stddev up to about 1e3 (here 100).  Ill-conditioned data are
+   compared with the exact answer instead (precision_at_large_offset). */
+typedef struct { double x, y; } pair;
+
+typedef struct {
+    fe_meanvar m[2], spare[2];
+    void *accs[2], *spares[2];
+    fe_product_acc acc;
+} product_store;
+
+static void product_store_prepare(product_store *s)
+{
+    for (int i = 0; i < 2; i++) {
+        s->accs[i] = &s->m[i];
+        s->spares[i] = &s->spare[i];
+    }
+    s->acc.accs = s->accs;
+    s->acc.spare = s->spares;
+}
+
+START_TEST(product_equals_serial)
+{
+    fe_accumulator mv = fe_meanvar_accumulator(), prod;
+    const fe_product_part parts[2] = {{&mv, offsetof(pair, x)}, {&mv, offsetof(pair, y)}};
+    const fe_product spec = {parts, 2};
+    double worst = 0.0;
+    int bad_rc = 0, not_all = 0;
+    char where[128] = "";
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, sizeof(pair)), FE_OK);
+    for (size_t si = 0; si < NSIZES; si++) {
+        size_t n = size_at(si);
+        pair *z = malloc((n + 1) * sizeof *z);
+        fe_rng r = fe_rng_seed(300 + si);
+        product_store serial, par, ps[MAX_T];
+        void *pp[MAX_T];
+        for (size_t i = 0; i < n; i++) {
+            z[i].x = -5.0 + fe_rng_normal(&r);
+            z[i].y = 50.0 + 0.5 * fe_rng_normal(&r);
+        }
+        product_store_prepare(&serial);
+        bad_rc |= fe_init(&prod, &serial.acc);
+        bad_rc |= fe_fold(&prod, &serial.acc, z, n, NULL);
+        for (int t = 0; t < MAX_T; t++) {
+            product_store_prepare(&ps[t]);
+            pp[t] = &ps[t].acc;
+        }
+        for (unsigned T = 1; T <= MAX_T; T++) {
+            size_t done = 0;
+            product_store_prepare(&par);
+            bad_rc |= fe_init(&prod, &par.acc);
+            bad_rc |= fe_parallel_fold(&prod, &par.acc, z, n, T, pp, &done);
+            not_all |= done != n;
+            for (int i = 0; i < 2; i++) {
+                double d = meanvar_distance(&par.m[i], &serial.m[i]);
+                if (!(d <= worst)) {
+                    worst = d;
+                    snprintf(where, sizeof where, "component %d, n = %zu, %u threads", i, n, T);
+                }
+            }
+        }
+        free(z);
+    }
+    ck_assert_int_eq(bad_rc, FE_OK);
+    ck_assert(!not_all);
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g at %s", worst, where);
+    if (getenv("FE_TEST_VERBOSE"))
+        fprintf(stderr, "product parallel vs serial: worst relative difference %.3g at %s\n", worst, where);
+}
+END_TEST
+
+START_TEST(product_partial_refusal_is_rolled_back)
+{
+    /* y = NaN refused by the second component after the first took x: the
+       parallel fold stops there with both components equal to the serial
+       fold of what precedes. */
+    enum { N = 3001, BAD = 2222 };
+    fe_accumulator mv = fe_meanvar_accumulator(), prod;
+    const fe_product_part parts[2] = {{&mv, offsetof(pair, x)}, {&mv, offsetof(pair, y)}};
+    const fe_product spec = {parts, 2};
+    static pair z[N];
+    fe_rng r = fe_rng_seed(17);
+    product_store serial, par, ps[3];
+    void *pp[3] = {&ps[0].acc, &ps[1].acc, &ps[2].acc};
+    size_t done = 0, sdone = 0;
+    for (int i = 0; i < N; i++) {
+        z[i].x = fe_rng_normal(&r);
+        z[i].y = fe_rng_normal(&r);
+    }
+    z[BAD].y = NAN;
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, sizeof(pair)), FE_OK);
+    product_store_prepare(&serial);
+    product_store_prepare(&par);
+    for (int t = 0; t < 3; t++)
+        product_store_prepare(&ps[t]);
+    fe_init(&prod, &serial.acc);
+    fe_init(&prod, &par.acc);
+    ck_assert_int_eq(fe_fold(&prod, &serial.acc, z, N, &sdone), FE_ENONFINITE);
+    ck_assert_int_eq(fe_parallel_fold(&prod, &par.acc, z, N, 4, pp, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(sdone, BAD);
+    ck_assert_uint_eq(done, BAD);
+    for (int i = 0; i < 2; i++) {
+        ck_assert_uint_eq(par.m[i].n, BAD);
+        FE_ASSERT_REL(par.m[i].mean, serial.m[i].mean, 1e-12);
+        FE_ASSERT_REL(par.m[i].m2, serial.m[i].m2, 1e-12);
+    }
+}
+END_TEST
+
+/* ------------------------------------------------------------------------
+   Errors. */
+
+START_TEST(first_refusal_has_the_lowest_index)
+{
+    /* Two NaNs; the earlier one is reported whatever the chunk it falls
+       in, and the result is the serial fold of everything before it. */
+    enum { N = 10007 };
+    static double x[N];
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar parts[MAX_T];
+    void *pp[MAX_T];
+    const size_t first[] = {0, 1, 1250, 2501, 5003, 9000, N - 2};
+    double worst = 0.0;
+    int wrong = 0;
+    fe_rng r = fe_rng_seed(3);
+    for (int t = 0; t < MAX_T; t++)
+        pp[t] = &parts[t];
+    for (int i = 0; i < N; i++)
+        x[i] = 2.0 + fe_rng_normal(&r);
+    for (size_t k = 0; k < sizeof first / sizeof first[0]; k++) {
+        size_t p = first[k], q = p + (N - p) / 2;     /* p < q < N */
+        fe_meanvar serial = FE_MEANVAR_EMPTY;
+        double xp = x[p], xq = x[q];
+        x[p] = NAN;
+        x[q] = -INFINITY;
+        fe_fold(&f, &serial, x, p, NULL);
+        for (unsigned T = 1; T <= MAX_T; T++) {
+            fe_meanvar a = FE_MEANVAR_EMPTY;
+            size_t done = 12345;
+            int rc = fe_parallel_fold(&f, &a, x, N, T, pp, &done);
+            wrong |= rc != FE_ENONFINITE || done != p || a.n != p;
+            worst = fmax(worst, meanvar_distance(&a, &serial));
+        }
+        x[p] = xp;
+        x[q] = xq;
+    }
+    ck_assert_msg(!wrong, "wrong code, index or count after a refusal");
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g", worst);
+}
+END_TEST
+
+START_TEST(exact_prefix_after_refusal)
+{
+    /* With the exact hash, "the fold of everything before the refusal" is
+       checked to the bit, for every thread count and refusal position. */
+    enum { N = 997 };
+    static uint64_t z[N];
+    fe_accumulator f = hash_accumulator();
+    hash_acc parts[MAX_T];
+    void *pp[MAX_T];
+    int wrong = 0;
+    fe_rng r = fe_rng_seed(8);
+    for (int t = 0; t < MAX_T; t++)
+        pp[t] = &parts[t];
+    for (int i = 0; i < N; i++)
+        z[i] = fe_rng_next(&r) >> 1;
+    for (size_t p = 0; p < N; p += 37) {
+        hash_acc serial;
+        hash_init(&serial, NULL);
+        fe_fold(&f, &serial, z, p, NULL);
+        z[p] = UINT64_MAX;
+        for (unsigned T = 2; T <= MAX_T; T++) {
+            hash_acc a;
+            size_t done = 0;
+            hash_init(&a, NULL);
+            wrong |= fe_parallel_fold(&f, &a, z, N, T, pp, &done) != FE_EINVAL;
+            wrong |= done != p || memcmp(&a, &serial, sizeof a) != 0;
+        }
+        z[p] = 1;
+    }
+    ck_assert_msg(!wrong, "a refusal did not leave the exact prefix fold");
+}
+END_TEST
+
+START_TEST(merge_refusal_reports_the_chunk)
+{
+    /* Two halves with means +1e300 and -1e300: each folds, their merge
+       overflows.  Serially the first -1e300 is refused; in parallel the
+       merge is, and *done is where the second chunk starts: here the same
+       index. */
+    enum { N = 1000 };
+    static double x[N];
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY, s = FE_MEANVAR_EMPTY, part;
+    void *pp[1] = {&part};
+    size_t done = 0, sdone = 0;
+    for (int i = 0; i < N; i++)
+        x[i] = i < N / 2 ? 1e300 : -1e300;
+    ck_assert_int_eq(fe_fold(&f, &s, x, N, &sdone), FE_ENONFINITE);
+    ck_assert_int_eq(fe_parallel_fold(&f, &a, x, N, 2, pp, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(sdone, N / 2);
+    ck_assert_uint_eq(done, N / 2);
+    ck_assert_uint_eq(a.n, s.n);
+    FE_ASSERT_REL(a.mean, s.mean, 1e-15);
+    FE_ASSERT_REL(a.m2, s.m2, 1e-12);
+}
+END_TEST
+
+START_TEST(partial_init_refusal_reports_the_chunk)
+{
+    /* A product partial without storage cannot be initialised: the fold of
+       the chunks before it is kept and *done is where its chunk starts. */
+    enum { N = 90 };
+    fe_accumulator mv = fe_meanvar_accumulator(), prod;
+    const fe_product_part parts[1] = {{&mv, 0}};
+    const fe_product spec = {parts, 1};
+    double x[N];
+    fe_meanvar m, sp, mserial = FE_MEANVAR_EMPTY;
+    void *accs[1] = {&m}, *spare[1] = {&sp};
+    fe_product_acc a = {accs, spare}, broken = {NULL, NULL}, fine;
+    product_store ok;
+    void *pp[2];
+    size_t done = 0;
+    for (int i = 0; i < N; i++)
+        x[i] = i;
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, sizeof(double)), FE_OK);
+    product_store_prepare(&ok);
+    fine = ok.acc;
+    pp[0] = &fine;
+    pp[1] = &broken;
+    ck_assert_int_eq(fe_init(&prod, &a), FE_OK);
+    ck_assert_int_eq(fe_parallel_fold(&prod, &a, x, N, 3, pp, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 60);
+    fe_fold(&mv, &mserial, x, 60, NULL);
+    ck_assert_uint_eq(m.n, 60);
+    FE_ASSERT_REL(m.mean, mserial.mean, 1e-15);
+    FE_ASSERT_REL(m.m2, mserial.m2, 1e-14);
+}
+END_TEST
+
+START_TEST(bad_arguments_fold_nothing)
+{
+    const double x[4] = {1, 2, 3, 4};
+    fe_accumulator f = fe_meanvar_accumulator(), nomerge = f;
+    fe_meanvar a = {3, 1.5, 0.25}, before = a, parts[FE_PARALLEL_MAX_THREADS + 1];
+    void *pp[FE_PARALLEL_MAX_THREADS + 1];
+    size_t done = 9;
+    int wrong = 0;
+    for (int t = 0; t <= FE_PARALLEL_MAX_THREADS; t++)
+        pp[t] = &parts[t];
+    nomerge.merge = NULL;
+    wrong |= fe_parallel_fold(NULL, &a, x, 4, 2, pp, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold(&f, NULL, x, 4, 2, pp, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold(&f, &a, NULL, 4, 2, pp, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold(&f, &a, x, 4, 0, pp, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold(&f, &a, x, 4, 2, NULL, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold(&f, &a, x, 4, FE_PARALLEL_MAX_THREADS + 1, pp, &done) != FE_ESIZE;
+    wrong |= fe_parallel_fold(&nomerge, &a, x, 4, 2, pp, &done) != FE_ENOTSUP;
+    ck_assert_msg(!wrong, "a bad argument was not refused with the right code");
+    ck_assert_uint_eq(done, 0);
+    /* Aliased partials: with the result, and with each other. */
+    pp[1] = &a;
+    ck_assert_int_eq(fe_parallel_fold(&f, &a, x, 4, 3, pp, &done), FE_EINVAL);
+    pp[1] = pp[0];
+    ck_assert_int_eq(fe_parallel_fold(&f, &a, x, 4, 3, pp, &done), FE_EINVAL);
+    pp[1] = NULL;
+    ck_assert_int_eq(fe_parallel_fold(&f, &a, x, 4, 3, pp, &done), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    /* One thread needs neither partials nor a merge. */
+    ck_assert_int_eq(fe_parallel_fold(&nomerge, &a, x, 4, 1, NULL, &done), FE_OK);
+    ck_assert_uint_eq(done, 4);
+    ck_assert_uint_eq(a.n, 7);
+}
+END_TEST
+
+START_TEST(chunks_cover_the_array)
+{
+    /* The cut: consecutive, covering, sizes differing by at most one. */
+    int wrong = 0;
+    size_t b, e;
+    for (size_t n = 0; n < 50; n++)
+        for (unsigned T = 1; T <= 9; T++) {
+            size_t expect = 0, lo = SIZE_MAX, hi = 0;
+            for (unsigned t = 0; t < T; t++) {
+                wrong |= fe_parallel_chunk(n, T, t, &b, &e) != FE_OK;
+                wrong |= b != expect || e < b;
+                lo = e - b < lo ? e - b : lo;
+                hi = e - b > hi ? e - b : hi;
+                expect = e;
+            }
+            wrong |= expect != n || hi - lo > 1;
+        }
+    ck_assert(!wrong);
+    /* No overflow for a huge n. */
+    ck_assert_int_eq(fe_parallel_chunk(SIZE_MAX, 7, 6, &b, &e), FE_OK);
+    ck_assert_uint_eq(e, SIZE_MAX);
+    ck_assert(e - b == SIZE_MAX / 7 || e - b == SIZE_MAX / 7 + 1);
+    ck_assert_int_eq(fe_parallel_chunk(5, 0, 0, &b, &e), FE_EINVAL);
+    ck_assert_int_eq(fe_parallel_chunk(5, 2, 2, &b, &e), FE_EINVAL);
+}
+END_TEST
+
+/* ------------------------------------------------------------------------
+   Per-thread sources. */
+
+START_TEST(sources_fold_their_concatenation)
+{
+    /* Array sources of awkward lengths (one empty) and a generator: the
+       result is the serial fold of the concatenation, exactly for the
+       hash; *done counts the concatenation. */
+    enum { N = 3000 };
+    static uint64_t z[N];
+    static const size_t cut[] = {0, 5, 5, 1200, 1201, N};
+    fe_accumulator f = hash_accumulator();
+    fe_array_source st[5];
+    fe_source src[5];
+    fe_source *sp[5];
+    hash_acc serial, a, parts[4];
+    void *pp[4] = {&parts[0], &parts[1], &parts[2], &parts[3]};
+    size_t done = 0;
+    fe_rng r = fe_rng_seed(21);
+    for (int i = 0; i < N; i++)
+        z[i] = fe_rng_next(&r) >> 2;
+    for (int t = 0; t < 5; t++) {
+        ck_assert_int_eq(fe_source_from_array(&src[t], &st[t], z + cut[t],
+                                              cut[t + 1] - cut[t], sizeof z[0]), FE_OK);
+        sp[t] = &src[t];
+    }
+    hash_init(&serial, NULL);
+    hash_init(&a, NULL);
+    ck_assert_int_eq(fe_fold(&f, &serial, z, N, NULL), FE_OK);
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    ck_assert_mem_eq(&a, &serial, sizeof a);
+
+    /* A refusal inside the fourth source. */
+    z[1500] = UINT64_MAX;
+    for (int t = 0; t < 5; t++)
+        fe_source_rewind(&src[t]);
+    hash_init(&serial, NULL);
+    hash_init(&a, NULL);
+    fe_fold(&f, &serial, z, 1500, NULL);
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 1500);
+    ck_assert_mem_eq(&a, &serial, sizeof a);
+
+    /* A source with the wrong observation size, or twice the same source,
+       folds nothing. */
+    hash_init(&a, NULL);
+    sp[1] = &src[0];
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    sp[1] = &src[1];
+    src[2].obs_size = 4;
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    ck_assert_uint_eq(a.n, 0);
+}
+END_TEST
+
+/* A generator of 1e4 + noise over indices [begin, end) of one stream. */
+struct range_gen { size_t begin, end; };
+
+static int range_generate(void *obs, size_t index, void *ctx)
+{
+    const struct range_gen *g = ctx;
+    size_t k = g->begin + index;
+    fe_rng r;
+    if (k >= g->end)
+        return FE_END;
+    r = fe_rng_seed(k);                 /* observation k depends on k only */
+    *(double *)obs = 1e4 + fe_rng_normal(&r);
+    return FE_OK;
+}
+
+/* A generator whose read fails at its local index 3. */
+static int failing_generate(void *obs, size_t index, void *ctx)
+{
+    if (index == 3)
+        return FE_EIO;
+    return range_generate(obs, index, ctx);
+}
+
+START_TEST(a_failing_source_is_a_refusal)
+{
+    /* Source 1 fails reading its fourth observation; source 2 is fine but
+       comes later: FE_EIO, *done = length of source 0 + 3. */
+    fe_accumulator f = fe_meanvar_accumulator();
+    struct range_gen g[3] = {{0, 100}, {100, 200}, {200, 300}}, whole = {0, 103};
+    fe_generator_source st[3], wst;
+    fe_source src[3], wsrc;
+    fe_source *sp[3] = {&src[0], &src[1], &src[2]};
+    double slots[3], wslot;
+    fe_meanvar a = FE_MEANVAR_EMPTY, serial = FE_MEANVAR_EMPTY, parts[2];
+    void *pp[2] = {&parts[0], &parts[1]};
+    size_t done = 0;
+    fe_source_from_generator(&src[0], &st[0], range_generate, &g[0], &slots[0], sizeof(double));
+    fe_source_from_generator(&src[1], &st[1], failing_generate, &g[1], &slots[1], sizeof(double));
+    fe_source_from_generator(&src[2], &st[2], range_generate, &g[2], &slots[2], sizeof(double));
+    fe_source_from_generator(&wsrc, &wst, range_generate, &whole, &wslot, sizeof(double));
+    ck_assert_int_eq(fe_fold_source(&f, &serial, &wsrc, NULL), FE_OK);
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 3, pp, &done), FE_EIO);
+    ck_assert_uint_eq(done, 103);
+    ck_assert_uint_eq(a.n, 103);
+    FE_ASSERT_REL(a.mean, serial.mean, 1e-12);
+    FE_ASSERT_REL(a.m2, serial.m2, 1e-12);
+}
+END_TEST
+
+START_TEST(generators_per_thread_equal_one_generator)
+{
+    /* Each thread generates its own range of one long stream. */
+    size_t n = fe_test_quick() ? 20000 : 200000;
+    fe_accumulator f = fe_meanvar_accumulator();
+    struct range_gen whole = {0, n}, g[MAX_T];
+    fe_generator_source gst, st[MAX_T];
+    fe_source wsrc, src[MAX_T];
+    fe_source *sp[MAX_T];
+    double slot, slots[MAX_T];
+    fe_meanvar serial = FE_MEANVAR_EMPTY, parts[MAX_T];
+    void *pp[MAX_T];
+    double worst = 0.0;
+    int bad = 0;
+    fe_source_from_generator(&wsrc, &gst, range_generate, &whole, &slot, sizeof slot);
+    ck_assert_int_eq(fe_fold_source(&f, &serial, &wsrc, NULL), FE_OK);
+    for (unsigned T = 1; T <= MAX_T; T++) {
+        fe_meanvar a = FE_MEANVAR_EMPTY;
+        size_t done = 0;
+        for (unsigned t = 0; t < T; t++) {
+            fe_parallel_chunk(n, T, t, &g[t].begin, &g[t].end);
+            fe_source_from_generator(&src[t], &st[t], range_generate, &g[t],
+                                     &slots[t], sizeof slots[t]);
+            sp[t] = &src[t];
+            pp[t] = &parts[t];
+        }
+        bad |= fe_parallel_fold_sources(&f, &a, sp, T, pp, &done) != FE_OK;
+        bad |= done != n;
+        worst = fmax(worst, meanvar_distance(&a, &serial));
+    }
+    ck_assert(!bad);
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g", worst);
+}
+END_TEST
+
+Suite *fe_parallel_suite(void)
+{
+    Suite *s = suite_create("parallel");
+    TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, flat_accumulators_equal_serial);
+    tcase_add_test(t, folds_onto_a_nonempty_accumulation);
+    tcase_add_test(t, precision_at_large_offset);
+    tcase_add_test(t, product_equals_serial);
+    tcase_add_test(t, product_partial_refusal_is_rolled_back);
+    tcase_add_test(t, first_refusal_has_the_lowest_index);
+    tcase_add_test(t, exact_prefix_after_refusal);
+    tcase_add_test(t, merge_refusal_reports_the_chunk);
+    tcase_add_test(t, partial_init_refusal_reports_the_chunk);
+    tcase_add_test(t, bad_arguments_fold_nothing);
+    tcase_add_test(t, chunks_cover_the_array);
+    tcase_add_test(t, sources_fold_their_concatenation);
+    tcase_add_test(t, generators_per_thread_equal_one_generator);
+    tcase_add_test(t, a_failing_source_is_a_refusal);
+    suite_add_tcase(s, t);
+    return s;
+}
