@@ -575,7 +575,7 @@ int fe_discover_select(const fe_discover_acc *a,
                 size_t g = before[i].group;
                 if (g == res->added[prev] || before[i].redundant)
                     continue;
-                if (before[i].rss_drop < 0.8 * res->added_rank[prev].rss_drop)
+                if (before[i].delta_bic - res->added_rank[prev].delta_bic >= 6.0)
                     continue;
                 for (size_t j = 0; j < nr; j++)
                     if (rk[j].group == g

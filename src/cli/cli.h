@@ -36,6 +36,7 @@ typedef struct fe_cli_table {
     int fd;
     fe_csv_reader reader;
     char *buffer;
+    char *scratch;              /* a copy of a looked-ahead line to split */
     char delimiter;
     size_t ncols;
     char **names;               /* ncols column names */

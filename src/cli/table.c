@@ -95,8 +95,9 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode))
         t->size = st.st_size;
     t->buffer = malloc(FE_CLI_LINE_MAX);
+    t->scratch = malloc(FE_CLI_LINE_MAX);
     t->fields = malloc(FE_CLI_FIELDS_MAX * sizeof *t->fields);
-    if (t->buffer == NULL || t->fields == NULL) {
+    if (t->buffer == NULL || t->scratch == NULL || t->fields == NULL) {
         snprintf(err, errlen, "%s: out of memory", t->name);
         fe_cli_table_close(t);
         return FE_CLI_IO;
@@ -269,7 +270,9 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
 
     for (;;) {
         if (t->next_pending < t->npending) {
-            line = t->pending[t->next_pending];
+            /* Split a copy: the looked-ahead line is replayed after a rewind. */
+            line = t->scratch;
+            strcpy(line, t->pending[t->next_pending]);
             t->line = t->pending_line[t->next_pending++];
         } else {
             rc = fe_csv_next_line(&t->reader, &line, &len);
@@ -340,6 +343,8 @@ void fe_cli_table_close(fe_cli_table *t)
     free(t->pending_line);
     free(t->fields);
     free(t->buffer);
+    free(t->scratch);
+    t->scratch = NULL;
     t->names = NULL;
     t->pending = NULL;
     t->pending_line = NULL;

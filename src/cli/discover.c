@@ -1,0 +1,1095 @@
+/* Tangled from literate/cli_discover.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli_discover.org::Discover Command Includes][Discover Command Includes]] */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+enum { FE__MAX_PAIRS = 64, FE__ROLES = 5, FE__PLOT_POINTS = 4000 };
+
+static const char *const fe__role_names[FE__ROLES] = {
+    "position", "velocity", "temperature", "ambient", "input"};
+/* Discover Command Includes ends here */
+/* [[file:../../literate/cli_discover.org::Align a recording with its simulation][Align a recording with its simulation]] */
+/* One simulation row: time, channel and the role columns. */
+typedef struct fe__simrow {
+    double t, s, role[FE__ROLES];
+    int valid;
+} fe__simrow;
+
+typedef struct fe__pair {
+    const char *real_path, *sim_path;
+    fe_cli_table real, sim;
+    size_t real_cols[2];            /* time, channel */
+    size_t sim_cols[2 + FE__ROLES]; /* time, channel, roles present */
+    int role_col[FE__ROLES];        /* index into sim_cols, -1 absent */
+    fe__simrow w[4];
+    double min_step, last_real_t;
+    int started;
+    size_t skipped;
+} fe__pair;
+
+/* Read the next simulation row into w[3], shifting the window left. */
+static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
+{
+    double v[2 + FE__ROLES];
+    size_t k = 2;
+    int rc;
+    p->w[0] = p->w[1];
+    p->w[1] = p->w[2];
+    p->w[2] = p->w[3];
+    p->w[3].valid = 0;
+    for (int r = 0; r < FE__ROLES; r++)
+        if (p->role_col[r] >= 0)
+            k = (size_t)p->role_col[r] + 1 > k ? (size_t)p->role_col[r] + 1 : k;
+    rc = fe_cli_table_next(&p->sim, p->sim_cols, k, v, err, errlen);
+    if (rc == FE_END)
+        return FE_CLI_OK;
+    if (rc != FE_OK)
+        return rc;
+    p->w[3].t = v[0];
+    p->w[3].s = v[1];
+    for (int r = 0; r < FE__ROLES; r++)
+        p->w[3].role[r] = p->role_col[r] >= 0 ? v[p->role_col[r]] : 0.0;
+    p->w[3].valid = 1;
+    if (p->w[2].valid) {
+        double step = p->w[3].t - p->w[2].t;
+        if (!(step > 0.0)) {
+            snprintf(err, errlen, "%s:%zu: simulation time does not increase (%.17g after %.17g)",
+                     p->sim.name, p->sim.line, p->w[3].t, p->w[2].t);
+            return FE_CLI_INPUT;
+        }
+        if (p->min_step == 0.0 || step < p->min_step)
+            p->min_step = step;
+    }
+    return FE_CLI_OK;
+}
+
+static int fe__linked(const fe__pair *p, const fe__simrow *a, const fe__simrow *b)
+{
+    return a->valid && b->valid && b->t - a->t <= 5.0 * p->min_step;
+}
+
+/* d(sim)/dt at window row i (1 or 2): central inside a segment. */
+static double fe__dsim(const fe__pair *p, int i)
+{
+    const fe__simrow *a = fe__linked(p, &p->w[i - 1], &p->w[i]) ? &p->w[i - 1] : &p->w[i];
+    const fe__simrow *b = fe__linked(p, &p->w[i], &p->w[i + 1]) ? &p->w[i + 1] : &p->w[i];
+    return b->t > a->t ? (b->s - a->s) / (b->t - a->t) : 0.0;
+}
+
+/* The next recording row that the simulation covers, as a sample.
+   Returns FE_OK, FE_END, or an exit status with a message. */
+static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
+{
+    double v[2];
+    int rc;
+    if (!p->started) {
+        for (int i = 0; i < 3; i++)
+            if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
+                return rc;
+        p->started = 1;
+        p->last_real_t = -INFINITY;
+    }
+    for (;;) {
+        double t, lambda;
+        rc = fe_cli_table_next(&p->real, p->real_cols, 2, v, err, errlen);
+        if (rc != FE_OK)
+            return rc;
+        t = v[0];
+        if (!(t > p->last_real_t)) {
+            snprintf(err, errlen, "%s:%zu: time does not increase (%.17g after %.17g)",
+                     p->real.name, p->real.line, t, p->last_real_t);
+            return FE_CLI_INPUT;
+        }
+        p->last_real_t = t;
+        while (p->w[2].valid && p->w[2].t < t)
+            if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
+                return rc;
+        if (!p->w[1].valid || t < p->w[1].t
+            || (!p->w[2].valid && t != p->w[1].t)
+            || (p->w[2].valid && !fe__linked(p, &p->w[1], &p->w[2]) && t != p->w[1].t)) {
+            p->skipped++;
+            continue;
+        }
+        memset(out, 0, sizeof *out);
+        out->t = t;
+        out->real = v[1];
+        if (!p->w[2].valid || t == p->w[1].t) {
+            out->sim = p->w[1].s;
+            out->dsim = fe__dsim(p, 1);
+            for (int r = 0; r < FE__ROLES; r++)
+                (&out->position)[r] = p->w[1].role[r];
+        } else {
+            lambda = (t - p->w[1].t) / (p->w[2].t - p->w[1].t);
+            out->sim = p->w[1].s + lambda * (p->w[2].s - p->w[1].s);
+            out->dsim = fe__dsim(p, 1) + lambda * (fe__dsim(p, 2) - fe__dsim(p, 1));
+            for (int r = 0; r < FE__ROLES; r++)
+                (&out->position)[r] = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
+        }
+        return FE_OK;
+    }
+}
+
+static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
+{
+    int rc = fe_cli_table_rewind(&p->real, err, errlen);
+    if (rc == FE_CLI_OK)
+        rc = fe_cli_table_rewind(&p->sim, err, errlen);
+    memset(p->w, 0, sizeof p->w);
+    p->started = 0;
+    p->skipped = 0;
+    p->min_step = 0.0;
+    return rc;
+}
+/* Align a recording with its simulation ends here */
+/* [[file:../../literate/cli_discover.org::Region statistics][Region statistics]] */
+typedef struct fe__stat {
+    double n, sum0, sq0, sum1, sq1;
+    double t0, t1;              /* first and last time */
+    int pair;                   /* recording of the first row */
+} fe__stat;
+
+static void fe__stat_add(fe__stat *s, double t, int pair, double before, double after)
+{
+    if (s->n == 0) {
+        s->t0 = t;
+        s->pair = pair;
+    }
+    s->t1 = t;
+    s->n += 1;
+    s->sum0 += before;
+    s->sq0 += before * before;
+    s->sum1 += after;
+    s->sq1 += after * after;
+}
+
+static int fe__cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+typedef struct fe__located {
+    int is_time;
+    double t0, t1;
+    int pair;
+    const char *variable;
+    char region[64];
+    double n, z, t, mean_before, mean_after, ms_ratio_before, ms_ratio_after;
+} fe__located;
+/* Region statistics ends here */
+/* [[file:../../literate/cli_discover.org::Discover Options][Discover Options]] */
+static const char fe__discover_help[] =
+    "usage: foldest discover --real REAL.csv --sim SIM.csv --channel NAME [options]\n"
+    "\n"
+    "Find what a simulation left out: locate where recording and simulation\n"
+    "differ, name the missing physics from a catalog of candidate terms, fit it,\n"
+    "and show the fit improve, also on held-out rows.\n"
+    "\n"
+    "  --real FILE, --sim FILE  a recording and its simulation (CSV, with a time\n"
+    "                         column each); repeat the pair for several recordings\n"
+    "  --channel NAME         the measured channel, a column of both files\n"
+    "  --time NAME            the time column (default: 'time', else the first)\n"
+    "  --role COLUMN=ROLE     a simulation column's role: position, velocity,\n"
+    "                         temperature, ambient, input (temperatures in degrees C\n"
+    "                         unless the name ends in _K); other columns are ignored\n"
+    "  --base TERM,...        terms always fitted (the model's own parameters),\n"
+    "                         e.g. bias,gain; default none\n"
+    "  --holdout F            keep the last fraction F of rows out of selection and\n"
+    "                         fitting, and report the RMS on them (default 0.2; 0: none)\n"
+    "  --blocks K             time blocks for the batch-means tests (default 20)\n"
+    "  --alpha A              family-wise false discovery level (default 0.05)\n"
+    "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
+    "  --json                 print one JSON object instead of the story\n"
+    "\n"
+    "Terms (recording - simulation = sum of coefficient x term + noise):\n";
+
+typedef struct fe__discover_args {
+    fe__pair *pairs;
+    size_t npairs;
+    const char *channel, *time, *report, *base;
+    const char *role_column[FE__ROLES];
+    double holdout, alpha;
+    long blocks;
+    int json;
+} fe__discover_args;
+
+static void fe__discover_usage(FILE *out)
+{
+    size_t n;
+    const fe_term *t = fe_catalog_builtin_terms(&n);
+    fputs(fe__discover_help, out);
+    for (size_t i = 0; i < n; i++)
+        fprintf(out, "  %-20s %s\n", t[i].name, t[i].description);
+    fputs("\nExit status: 0 success (whatever the verdict), 1 the data cannot be\n"
+          "analysed (too few rows, collinear base), 2 usage, 3 malformed input, 4 I/O.\n",
+          out);
+}
+
+static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
+                              char *err, size_t errlen)
+{
+    size_t nreal = 0, nsim = 0;
+    memset(a, 0, sizeof *a);
+    a->pairs = calloc(FE__MAX_PAIRS, sizeof *a->pairs);
+    a->holdout = 0.2;
+    a->alpha = 0.05;
+    a->blocks = 20;
+    if (a->pairs == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int rc = FE_CLI_OK;
+        if (strcmp(o, "--json") == 0) {
+            a->json = 1;
+            continue;
+        }
+        if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0)
+            return -1;
+        if (v == NULL) {
+            snprintf(err, errlen, "%s needs a value", o);
+            return FE_CLI_USAGE;
+        }
+        i++;
+        if (strcmp(o, "--real") == 0 || strcmp(o, "--sim") == 0) {
+            size_t *n = o[2] == 'r' ? &nreal : &nsim;
+            if (*n >= FE__MAX_PAIRS) {
+                snprintf(err, errlen, "at most %d pairs", FE__MAX_PAIRS);
+                return FE_CLI_USAGE;
+            }
+            if (o[2] == 'r')
+                a->pairs[(*n)++].real_path = v;
+            else
+                a->pairs[(*n)++].sim_path = v;
+        } else if (strcmp(o, "--channel") == 0) {
+            a->channel = v;
+        } else if (strcmp(o, "--time") == 0) {
+            a->time = v;
+        } else if (strcmp(o, "--base") == 0) {
+            a->base = v;
+        } else if (strcmp(o, "--report") == 0) {
+            a->report = v;
+        } else if (strcmp(o, "--holdout") == 0) {
+            rc = fe_cli_parse_double(o, v, &a->holdout, err, errlen);
+            if (rc == FE_CLI_OK && !(a->holdout >= 0.0 && a->holdout < 0.9)) {
+                snprintf(err, errlen, "--holdout: %s is not in [0, 0.9)", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--alpha") == 0) {
+            rc = fe_cli_parse_double(o, v, &a->alpha, err, errlen);
+            if (rc == FE_CLI_OK && !(a->alpha > 0.0 && a->alpha < 0.5)) {
+                snprintf(err, errlen, "--alpha: %s is not in (0, 0.5)", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--blocks") == 0) {
+            rc = fe_cli_parse_long(o, v, &a->blocks, err, errlen);
+            if (rc == FE_CLI_OK && (a->blocks < 4 || a->blocks > FE_DISCOVER_MAX_BLOCKS)) {
+                snprintf(err, errlen, "--blocks: %s is not in [4, %d]", v, FE_DISCOVER_MAX_BLOCKS);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--role") == 0) {
+            const char *eq = strchr(v, '=');
+            int found = 0;
+            for (int r = 0; eq != NULL && r < FE__ROLES; r++)
+                if (strcmp(eq + 1, fe__role_names[r]) == 0) {
+                    a->role_column[r] = v;      /* "COLUMN=ROLE"; cut below */
+                    found = 1;
+                }
+            if (!found) {
+                snprintf(err, errlen, "--role %s: want COLUMN=ROLE with ROLE one of "
+                         "position, velocity, temperature, ambient, input", v);
+                rc = FE_CLI_USAGE;
+            } else {
+                argv[i][eq - v] = '\0';
+            }
+        } else {
+            snprintf(err, errlen, "unknown option '%s'", o);
+            rc = FE_CLI_USAGE;
+        }
+        if (rc != FE_CLI_OK)
+            return rc;
+    }
+    if (nreal == 0 || nreal != nsim) {
+        snprintf(err, errlen, nreal == 0 ? "--real and --sim are required"
+                                         : "give as many --sim files as --real files");
+        return FE_CLI_USAGE;
+    }
+    if (a->channel == NULL) {
+        snprintf(err, errlen, "--channel is required");
+        return FE_CLI_USAGE;
+    }
+    a->npairs = nreal;
+    return FE_CLI_OK;
+}
+/* Discover Options ends here */
+/* [[file:../../literate/cli_discover.org::Open a pair and find its columns][Open a pair and find its columns]] */
+static int fe__time_column(const fe_cli_table *t, const char *name, size_t *col,
+                           char *err, size_t errlen)
+{
+    if (name != NULL)
+        return fe_cli_table_column(t, name, col, err, errlen);
+    if (fe_cli_table_column(t, "time", col, err, errlen) == FE_CLI_OK)
+        return FE_CLI_OK;
+    *col = 0;
+    return FE_CLI_OK;
+}
+
+static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *roles,
+                         int *kelvin, char *err, size_t errlen)
+{
+    int rc;
+    size_t k = 2;
+    if (strcmp(p->real_path, "-") == 0 || strcmp(p->sim_path, "-") == 0) {
+        snprintf(err, errlen, "discover reads each file three times: give files, not '-'");
+        return FE_CLI_USAGE;
+    }
+    rc = fe_cli_table_open(&p->real, p->real_path, -1, err, errlen);
+    if (rc != FE_CLI_OK)
+        return rc;
+    rc = fe_cli_table_open(&p->sim, p->sim_path, -1, err, errlen);
+    if (rc != FE_CLI_OK)
+        return rc;
+    if ((rc = fe__time_column(&p->real, a->time, &p->real_cols[0], err, errlen)) != FE_CLI_OK
+        || (rc = fe_cli_table_column(&p->real, a->channel, &p->real_cols[1], err, errlen)) != FE_CLI_OK
+        || (rc = fe__time_column(&p->sim, a->time, &p->sim_cols[0], err, errlen)) != FE_CLI_OK
+        || (rc = fe_cli_table_column(&p->sim, a->channel, &p->sim_cols[1], err, errlen)) != FE_CLI_OK)
+        return rc;
+    *roles = 0;
+    for (int r = 0; r < FE__ROLES; r++) {
+        p->role_col[r] = -1;
+        if (a->role_column[r] == NULL)
+            continue;
+        rc = fe_cli_table_column(&p->sim, a->role_column[r], &p->sim_cols[k], err, errlen);
+        if (rc != FE_CLI_OK)
+            return rc;
+        {
+            const char *nm = p->sim.names[p->sim_cols[k]];
+            size_t l = strlen(nm);
+            if (l >= 2 && strcmp(nm + l - 2, "_K") == 0)
+                kelvin[r] = 1;
+        }
+        p->role_col[r] = (int)k++;
+        *roles |= 1u << r;
+    }
+    return FE_CLI_OK;
+}
+/* Open a pair and find its columns ends here */
+/* [[file:../../literate/cli_discover.org::Read the pairs as one stream][Read the pairs as one stream]] */
+typedef struct fe__stream {
+    fe__discover_args *a;
+    size_t cur;
+    size_t skipped;
+} fe__stream;
+
+/* Returns FE_OK, FE_END, or an exit status; *new_pair is set when the
+   sample starts another recording. */
+static int fe__stream_next(fe__stream *st, fe_sample *s, int *new_pair, char *err, size_t errlen)
+{
+    *new_pair = 0;
+    while (st->cur < st->a->npairs) {
+        fe__pair *p = &st->a->pairs[st->cur];
+        int rc = fe__pair_next(p, s, err, errlen);
+        if (rc == FE_OK)
+            return FE_OK;
+        if (rc != FE_END)
+            return rc;
+        st->skipped += p->skipped;
+        st->cur++;
+        *new_pair = 1;
+    }
+    return FE_END;
+}
+
+static int fe__stream_rewind(fe__stream *st, char *err, size_t errlen)
+{
+    st->cur = 0;
+    st->skipped = 0;
+    for (size_t i = 0; i < st->a->npairs; i++) {
+        int rc = fe__pair_rewind(&st->a->pairs[i], err, errlen);
+        if (rc != FE_CLI_OK)
+            return rc;
+    }
+    return FE_CLI_OK;
+}
+/* Read the pairs as one stream ends here */
+/* [[file:../../literate/cli_discover.org::Print the story][Print the story]] */
+typedef struct fe__outcome {
+    const fe_catalog *c;
+    const fe_discover_result *r;
+    const size_t *base;
+    size_t nbase;
+    double baseline_coef[FE_DISCOVER_MAX_COLUMNS];
+    size_t rows, skipped, fit, heldout, blocks;
+    double alpha;
+    fe__located located[128];
+    size_t nlocated;
+    const char *verdict;
+} fe__outcome;
+
+static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (r->cols[i] == col) {
+            if (se != NULL)
+                *se = r->stderr_[i];
+            return r->coef[i];
+        }
+    if (se != NULL)
+        *se = 0.0;
+    return 0.0;
+}
+
+static void fe__json_number(FILE *f, double x)
+{
+    if (isfinite(x))
+        fprintf(f, "%.10g", x);
+    else
+        fprintf(f, "null");
+}
+
+static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
+{
+    fprintf(f, "\"%s\": {\"rms\": ", name);
+    fe__json_number(f, fit->rms);
+    fprintf(f, ", \"bic\": ");
+    fe__json_number(f, fit->bic);
+    fprintf(f, ", \"heldout_rms\": ");
+    fe__json_number(f, fit->heldout_rms);
+    fprintf(f, ", \"lag1\": ");
+    fe__json_number(f, fit->lag1);
+    fprintf(f, ", \"params\": %zu}", fit->params);
+}
+
+static void fe__print_json(FILE *f, const fe__outcome *o)
+{
+    const fe_discover_result *r = o->r;
+    fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
+    fprintf(f, "\"rows\": {\"compared\": %zu, \"outside_simulation\": %zu, \"fit\": %zu, "
+               "\"heldout\": %zu}, ", o->rows, o->skipped, o->fit, o->heldout);
+    fprintf(f, "\"base\": [");
+    for (size_t i = 0; i < o->nbase; i++) {
+        fprintf(f, "%s", i ? ", " : "");
+        fe_cli_json_string(f, o->c->terms[o->base[i]].name);
+    }
+    fprintf(f, "], ");
+    fe__json_fit(f, "baseline", &r->baseline);
+    fprintf(f, ", ");
+    fe__json_fit(f, "final", &r->final);
+    fprintf(f, ", \"located\": [");
+    for (size_t i = 0; i < o->nlocated; i++) {
+        const fe__located *l = &o->located[i];
+        fprintf(f, "%s{\"kind\": \"%s\", ", i ? ", " : "", l->is_time ? "time" : "state");
+        if (l->is_time) {
+            fprintf(f, "\"recording\": %d, \"start\": ", l->pair + 1);
+            fe__json_number(f, l->t0);
+            fprintf(f, ", \"end\": ");
+            fe__json_number(f, l->t1);
+        } else {
+            fprintf(f, "\"variable\": \"%s\", \"region\": ", l->variable);
+            fe_cli_json_string(f, l->region);
+        }
+        fprintf(f, ", \"rows\": %.0f, \"statistic\": ", l->n);
+        fe__json_number(f, fabs(l->z) > fabs(l->t) ? l->z : l->t);
+        fprintf(f, ", \"mean_residual_before\": ");
+        fe__json_number(f, l->mean_before);
+        fprintf(f, ", \"mean_residual_after\": ");
+        fe__json_number(f, l->mean_after);
+        fprintf(f, ", \"ms_ratio_before\": ");
+        fe__json_number(f, l->ms_ratio_before);
+        fprintf(f, ", \"ms_ratio_after\": ");
+        fe__json_number(f, l->ms_ratio_after);
+        fprintf(f, "}");
+    }
+    fprintf(f, "], \"discovered\": [");
+    for (size_t s = 0; s < r->steps; s++) {
+        const fe_term *t = &o->c->terms[r->added[s]];
+        double se, coef = fe__coef_of(r, r->added[s], &se);
+        char words[512];
+        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fprintf(f, "%s{\"name\": \"%s\", \"description\": ", s ? ", " : "", t->name);
+        fe_cli_json_string(f, t->description);
+        fprintf(f, ", \"coefficient\": ");
+        fe__json_number(f, coef);
+        fprintf(f, ", \"stderr\": ");
+        fe__json_number(f, se);
+        fprintf(f, ", \"interval95\": [");
+        fe__json_number(f, coef - r->t_critical * se);
+        fprintf(f, ", ");
+        fe__json_number(f, coef + r->t_critical * se);
+        fprintf(f, "], \"statistic\": ");
+        fe__json_number(f, r->added_rank[s].statistic);
+        fprintf(f, ", \"p_value\": ");
+        fe__json_number(f, r->added_rank[s].p_value);
+        fprintf(f, ", \"rss_drop\": ");
+        fe__json_number(f, r->added_rank[s].rss_drop);
+        fprintf(f, ", \"explanation\": ");
+        fe_cli_json_string(f, words);
+        fprintf(f, ", \"indistinguishable_from\": [");
+        for (size_t j = 0; j < r->nalike[s]; j++) {
+            fprintf(f, "%s", j ? ", " : "");
+            fe_cli_json_string(f, o->c->terms[r->alike[s][j]].name);
+        }
+        fprintf(f, "]}");
+    }
+    fprintf(f, "], \"ranking\": [");
+    for (size_t i = 0; i < r->nranked[0]; i++) {
+        const fe_discover_rank *k = &r->ranking[0][i];
+        fprintf(f, "%s{\"name\": \"%s\", \"rss_drop\": ", i ? ", " : "",
+                o->c->terms[k->group].name);
+        fe__json_number(f, k->rss_drop);
+        fprintf(f, ", \"statistic\": ");
+        fe__json_number(f, k->statistic);
+        fprintf(f, ", \"p_value\": ");
+        fe__json_number(f, k->p_value);
+        fprintf(f, ", \"redundant\": %s}", k->redundant ? "true" : "false");
+    }
+    fprintf(f, "]}\n");
+}
+
+static int fe__cmp_rank(const void *a, const void *b)
+{
+    const fe_discover_rank *x = a, *y = b;
+    return (x->p_value > y->p_value) - (x->p_value < y->p_value);
+}
+
+static void fe__print_story(FILE *f, const fe__outcome *o)
+{
+    const fe_discover_result *r = o->r;
+    fe_discover_rank sorted[FE_DISCOVER_MAX_GROUPS];
+    double rel;
+    fprintf(f, "compared %zu rows (%zu outside the simulation): %zu fitted, %zu held out\n",
+            o->rows, o->skipped, o->fit, o->heldout);
+    fprintf(f, "baseline (simulation");
+    for (size_t i = 0; i < o->nbase; i++)
+        fprintf(f, " + %s", o->c->terms[o->base[i]].name);
+    fprintf(f, "): RMS %.5g, held-out RMS %.5g, lag-1 autocorrelation %.2f\n",
+            r->baseline.rms, r->baseline.heldout_rms, r->baseline.lag1);
+    fprintf(f, "\nwhere they differ:\n");
+    if (o->nlocated == 0)
+        fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
+    for (size_t i = 0; i < o->nlocated; i++) {
+        const fe__located *l = &o->located[i];
+        if (l->is_time)
+            fprintf(f, "  time %.4g to %.4g (recording %d): mean residual %+.3g, mean square "
+                       "%.2fx typical (z = %.1f, t = %.1f); after: %+.3g, %.2fx\n",
+                    l->t0, l->t1, l->pair + 1, l->mean_before, l->ms_ratio_before, l->z, l->t,
+                    l->mean_after, l->ms_ratio_after);
+        else
+            fprintf(f, "  %s %s: %.0f rows, mean residual %+.3g (t = %.1f); after: %+.3g\n",
+                    l->variable, l->region, l->n, l->mean_before, l->t, l->mean_after);
+    }
+    fprintf(f, "\ncandidates, first step (batch-means tests over %zu time blocks):\n",
+            o->blocks);
+    memcpy(sorted, r->ranking[0], r->nranked[0] * sizeof *sorted);
+    qsort(sorted, r->nranked[0], sizeof *sorted, fe__cmp_rank);
+    for (size_t i = 0; i < r->nranked[0]; i++)
+        fprintf(f, "  %-20s RSS drop %10.4g   t = %7.2f   p = %.2g%s\n",
+                o->c->terms[sorted[i].group].name, sorted[i].rss_drop, sorted[i].statistic,
+                sorted[i].p_value, sorted[i].redundant ? "   (already in the model's span)" : "");
+    fprintf(f, "\nwhat was left out:\n");
+    if (r->steps == 0)
+        fprintf(f, "  no candidate is significant at family-wise level %.3g\n", o->alpha);
+    for (size_t s = 0; s < r->steps; s++) {
+        const fe_term *t = &o->c->terms[r->added[s]];
+        double se, coef = fe__coef_of(r, r->added[s], &se);
+        char words[512];
+        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
+                   "statistic %.2f, p = %.2g\n     %s\n",
+                s + 1, t->name, t->description, coef, se, coef - r->t_critical * se,
+                coef + r->t_critical * se, r->added_rank[s].statistic,
+                r->added_rank[s].p_value, words);
+        if (r->nalike[s] > 0) {
+            fprintf(f, "     indistinguishable on these data from:");
+            for (size_t j = 0; j < r->nalike[s]; j++)
+                fprintf(f, " %s", o->c->terms[r->alike[s][j]].name);
+            fprintf(f, "\n");
+        }
+    }
+    rel = r->baseline.rms > 0 ? 100.0 * (r->final.rms / r->baseline.rms - 1.0) : 0.0;
+    fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f\n",
+            r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
+            r->baseline.lag1, r->final.lag1);
+    if (o->heldout > 0)
+        fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
+                r->baseline.heldout_rms, r->final.heldout_rms,
+                100.0 * (r->final.heldout_rms / r->baseline.heldout_rms - 1.0));
+    fprintf(f, "\nverdict: %s\n", o->verdict);
+}
+/* Print the story ends here */
+/* [[file:../../literate/cli_discover.org::Write the report][Write the report]] */
+static int fe__have_gnuplot(void)
+{
+    return system("gnuplot --version >/dev/null 2>&1") == 0;
+}
+
+/* Write per-block and per-bin means: what the eye needs to see a concealed
+   effect that the cloud of points hides. */
+static int fe__write_means(const char *path, const fe__stat *s, size_t n, int use_index)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL)
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        if (s[i].n > 0)
+            fprintf(f, "%.10g %.6g %.6g %.0f %.6g %.6g\n",
+                    use_index ? (double)i + 0.5 : 0.5 * (s[i].t0 + s[i].t1),
+                    s[i].sum0 / s[i].n, s[i].sum1 / s[i].n, s[i].n,
+                    sqrt(s[i].sq0 / s[i].n), sqrt(s[i].sq1 / s[i].n));
+    return fclose(f);
+}
+
+static int fe__write_report(const char *dir, const fe__outcome *o, const char *points,
+                            const char *state_var, int state_col, char *err, size_t errlen)
+{
+    char path[4096], script[4096];
+    fe_cli_output out;
+    FILE *f;
+    int plots = fe__have_gnuplot(), rc;
+    snprintf(path, sizeof path, "%s/report.md", dir);
+    if ((rc = fe_cli_output_open(&out, path, err, errlen)) != FE_CLI_OK)
+        return rc;
+    f = out.file;
+    fprintf(f, "# foldest discover report\n\n**Verdict: %s**\n\n```\n", o->verdict);
+    fe__print_story(f, o);
+    fprintf(f, "```\n\n");
+    if (plots) {
+        fprintf(f, "## Residual against time\n\n![residual against time](residual_time.png)\n\n");
+        if (state_var != NULL)
+            fprintf(f, "## Residual against %s\n\n![residual against %s](residual_state.png)\n\n",
+                    state_var, state_var);
+    } else {
+        fprintf(f, "(gnuplot is not installed: no plots; the points are in %s)\n", points);
+    }
+    fprintf(f, "Data: `blocks.dat` and `bins.dat` (block or state value, mean residual "
+               "before, after, rows, RMS before, after) and `residuals.dat` (time, residual "
+               "before, after, position, velocity, temperature; every few rows).\n");
+    if ((rc = fe_cli_output_commit(&out, err, errlen)) != FE_CLI_OK)
+        return rc;
+    if (!plots)
+        return FE_CLI_OK;
+    snprintf(script, sizeof script, "%s/plots.gp", dir);
+    f = fopen(script, "w");
+    if (f == NULL) {
+        snprintf(err, errlen, "%.1000s: cannot write: %s", script, strerror(errno));
+        return FE_CLI_IO;
+    }
+    fprintf(f, "set terminal pngcairo size 1000,500 noenhanced\n"
+               "set datafile separator ' '\nset grid\nset key outside\n"
+               "set output '%s/residual_time.png'\n"
+               "set xlabel 'time block (fitted blocks, then the held-out rows)'\n"
+               "set ylabel 'RMS of recording - model'\n"
+               "set title 'Residual RMS per time block, before and after the discovered terms'\n"
+               "plot '%s/blocks.dat' using 1:5 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
+               "'' using 1:6 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n",
+            dir, dir);
+    (void)points;
+    (void)state_col;
+    if (state_var != NULL)
+        fprintf(f, "set output '%s/residual_state.png'\nset xlabel '%s'\n"
+                   "set title 'Residual mean against %s (40 bins)'\n"
+                   "plot '%s/bins.dat' using 1:2 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
+                   "'' using 1:3 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n",
+                dir, state_var, state_var, dir);
+    fclose(f);
+    {
+        char cmd[8300];
+        snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
+        if (system(cmd) != 0) {
+            snprintf(err, errlen, "%.1000s: gnuplot failed", script);
+            return FE_CLI_IO;
+        }
+    }
+    return FE_CLI_OK;
+}
+/* Write the report ends here */
+/* [[file:../../literate/cli_discover.org::Run discovery on recordings][Run discovery on recordings]] */
+int fe_cli_discover(int argc, char **argv)
+{
+    fe__discover_args a;
+    fe__stream st;
+    fe_catalog cat;
+    fe_catalog_scale scale = {0};
+    fe_discover_acc acc;
+    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
+    fe_discover_options opt = fe_discover_default_options();
+    fe_discover_result *res = NULL;
+    fe__outcome out;
+    fe__stat *blocks = NULL, regions[12];
+    const char *region_var[12];
+    char region_name[12][64];
+    size_t nregions = 0;
+    enum { FE__BINS = 40 };
+    fe__stat bins[3][FE__BINS];
+    double *storage = NULL, *work = NULL, phi[FE_DISCOVER_MAX_COLUMNS];
+    double rmin[FE__ROLES], rmax[FE__ROLES];
+    size_t base[FE_DISCOVER_MAX_GROUPS], nbase = 0, rows = 0, nwork, nst;
+    unsigned roles = 0;
+    int kelvin[FE__ROLES] = {0}, rc, new_pair, pair_index;
+    char err[2048], points[4200] = "";
+    fe_sample s;
+    FILE *pts = NULL;
+
+    memset(&out, 0, sizeof out);
+    rc = fe__discover_parse(argc, argv, &a, err, sizeof err);
+    if (rc == -1) {
+        fe__discover_usage(stdout);
+        free(a.pairs);
+        return FE_CLI_OK;
+    }
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest discover: %s\n", err);
+        if (rc == FE_CLI_USAGE)
+            fprintf(stderr, "'foldest discover --help' for usage\n");
+        free(a.pairs);
+        return rc;
+    }
+    for (size_t i = 0; i < a.npairs; i++) {
+        unsigned r;
+        rc = fe__pair_open(&a.pairs[i], &a, &r, kelvin, err, sizeof err);
+        if (rc != FE_CLI_OK)
+            goto fail;
+        roles = r;
+    }
+    st.a = &a;
+    st.cur = 0;
+    st.skipped = 0;
+
+    /* Pass 1: scale and ranges. */
+    for (int r = 0; r < FE__ROLES; r++) {
+        rmin[r] = INFINITY;
+        rmax[r] = -INFINITY;
+    }
+    while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
+        fe_catalog_scale_add(&scale, &s);
+        for (int r = 0; r < FE__ROLES; r++) {
+            double v = (&s.position)[r];
+            rmin[r] = v < rmin[r] ? v : rmin[r];
+            rmax[r] = v > rmax[r] ? v : rmax[r];
+        }
+        rows++;
+    }
+    if (rc != FE_END)
+        goto fail;
+    out.skipped = st.skipped;
+    scale.temperature_kelvin = kelvin[2];
+    scale.ambient_kelvin = kelvin[3];
+    if (fe_catalog_init(&cat, roles, &scale) != FE_OK)
+        goto internal;
+    out.rows = rows;
+    out.heldout = (size_t)floor(a.holdout * (double)rows);
+    out.fit = rows - out.heldout;
+    if (out.fit < 2 * (size_t)a.blocks + 10) {
+        fprintf(stderr, "foldest discover: only %zu rows compared (%zu outside the simulation): "
+                        "too few for %ld blocks\n", rows, st.skipped, a.blocks);
+        rc = FE_CLI_REFUSED;
+        goto cleanup;
+    }
+    /* The base terms. */
+    if (a.base != NULL) {
+        char *list = malloc(strlen(a.base) + 1), *items[FE_DISCOVER_MAX_GROUPS];
+        int n;
+        if (list == NULL)
+            goto internal;
+        strcpy(list, a.base);
+        n = fe_cli_split_list(list, items, FE_DISCOVER_MAX_GROUPS);
+        for (int i = 0; i < n; i++) {
+            long j = fe_catalog_find(&cat, items[i]);
+            if (j < 0) {
+                fprintf(stderr, "foldest discover: --base: no term '%s' (with these roles)\n",
+                        items[i]);
+                free(list);
+                rc = FE_CLI_USAGE;
+                goto cleanup;
+            }
+            base[nbase++] = (size_t)j;
+        }
+        free(list);
+    }
+
+    /* Pass 2: accumulate. */
+    nst = fe_discover_acc_doubles(cat.count, (size_t)a.blocks);
+    nwork = fe_discover_workspace_doubles(cat.count, (size_t)a.blocks);
+    storage = malloc(nst * sizeof *storage);
+    work = malloc(nwork * sizeof *work);
+    res = malloc(sizeof *res);
+    blocks = calloc((size_t)a.blocks + 1, sizeof *blocks);
+    if (storage == NULL || work == NULL || res == NULL || blocks == NULL)
+        goto internal;
+    if (fe_discover_acc_init(&acc, cat.count, (size_t)a.blocks, out.fit, 0, storage, nst) != FE_OK)
+        goto internal;
+    if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
+        goto fail;
+    while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
+        if (new_pair)
+            fe_discover_break(&acc);
+        if (fe_catalog_eval(&cat, &s, phi) != FE_OK
+            || fe_discover_add(&acc, phi, s.real - s.sim) != FE_OK) {
+            fprintf(stderr, "foldest discover: %s:%zu: a term is not finite at t = %g\n",
+                    a.pairs[st.cur].real.name, a.pairs[st.cur].real.line, s.t);
+            rc = FE_CLI_INPUT;
+            goto cleanup;
+        }
+    }
+    if (rc != FE_END)
+        goto fail;
+    fe_catalog_groups(&cat, groups);
+    opt.alpha = a.alpha;
+    opt.base = base;
+    opt.nbase = nbase;
+    rc = fe_discover_select(&acc, groups, cat.count, &opt, res, work, nwork);
+    if (rc != FE_OK) {
+        fprintf(stderr, "foldest discover: %s%s\n", fe_strerror(rc),
+                rc == FE_ESINGULAR ? ": the base terms are collinear on these data"
+                : rc == FE_ETOOFEW ? ": a time block has no rows" : "");
+        rc = FE_CLI_REFUSED;
+        goto cleanup;
+    }
+    {
+        fe_discover_fit bf;
+        double bse[FE_DISCOVER_MAX_COLUMNS];
+        if (fe_discover_fit_columns(&acc, base, nbase, out.baseline_coef, bse, &bf, work,
+                                    nwork) != FE_OK)
+            goto internal;
+    }
+
+    /* Regions of the state to test. */
+    if (roles & FE_ROLE_VELOCITY) {
+        region_var[nregions] = "velocity";
+        strcpy(region_name[nregions++], "v < 0");
+        region_var[nregions] = "velocity";
+        strcpy(region_name[nregions++], "v > 0");
+    }
+    if (roles & FE_ROLE_POSITION) {
+        region_var[nregions] = "position";
+        strcpy(region_name[nregions++], "x < 0");
+        region_var[nregions] = "position";
+        strcpy(region_name[nregions++], "x > 0");
+    }
+    if (roles & FE_ROLE_TEMPERATURE)
+        for (int b = 0; b < 4; b++) {
+            double lo = rmin[2] + (rmax[2] - rmin[2]) * b / 4.0;
+            double hi = rmin[2] + (rmax[2] - rmin[2]) * (b + 1) / 4.0;
+            region_var[nregions] = "temperature";
+            snprintf(region_name[nregions++], 64, "%.4g to %.4g", lo, hi);
+        }
+    memset(regions, 0, sizeof regions);
+    memset(bins, 0, sizeof bins);
+
+    /* Pass 3: residuals before and after, by block and by region. */
+    if (a.report != NULL) {
+        if (mkdir(a.report, 0777) != 0 && errno != EEXIST) {
+            snprintf(err, sizeof err, "%.1000s: cannot create: %s", a.report, strerror(errno));
+            rc = FE_CLI_IO;
+            goto fail;
+        }
+        snprintf(points, sizeof points, "%s/residuals.dat", a.report);
+        pts = fopen(points, "w");
+        if (pts == NULL) {
+            snprintf(err, sizeof err, "%.1000s: cannot write: %s", points, strerror(errno));
+            rc = FE_CLI_IO;
+            goto fail;
+        }
+    }
+    if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
+        goto fail;
+    {
+        size_t i = 0, stride = rows / FE__PLOT_POINTS + 1;
+        pair_index = 0;
+        while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
+            double before = s.real - s.sim, after = before;
+            size_t k = i < out.fit ? (size_t)((double)i * (double)a.blocks / (double)out.fit)
+                                   : (size_t)a.blocks;
+            pair_index += new_pair;
+            fe_catalog_eval(&cat, &s, phi);
+            for (size_t j = 0; j < nbase; j++)
+                before -= out.baseline_coef[j] * phi[base[j]];
+            for (size_t j = 0; j < res->ncols; j++)
+                after -= res->coef[j] * phi[res->cols[j]];
+            fe__stat_add(&blocks[k], s.t, pair_index, before, after);
+            for (size_t g = 0; g < nregions && i < out.fit; g++) {
+                int in = 0;
+                if (strcmp(region_var[g], "velocity") == 0)
+                    in = region_name[g][2] == '<' ? s.velocity < 0 : s.velocity > 0;
+                else if (strcmp(region_var[g], "position") == 0)
+                    in = region_name[g][2] == '<' ? s.position < 0 : s.position > 0;
+                else {
+                    int b = (int)((s.temperature - rmin[2]) / (rmax[2] - rmin[2] + 1e-300) * 4.0);
+                    in = (b > 3 ? 3 : b) == (int)(g - (nregions - 4));
+                }
+                if (in)
+                    fe__stat_add(&regions[g], s.t, pair_index, before, after);
+            }
+            for (int v = 0; v < 3; v++) {       /* position, velocity, temperature */
+                int r = v == 2 ? 2 : v;
+                double x = (&s.position)[r], w = rmax[r] - rmin[r];
+                int b = w > 0 ? (int)((x - rmin[r]) / w * FE__BINS) : 0;
+                b = b < 0 ? 0 : b >= FE__BINS ? FE__BINS - 1 : b;
+                if (roles & (1u << r))
+                    fe__stat_add(&bins[v][b], x, pair_index, before, after);
+            }
+            if (pts != NULL && i % stride == 0)
+                fprintf(pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
+                        s.position, s.velocity, s.temperature);
+            i++;
+        }
+        if (rc != FE_END)
+            goto fail;
+    }
+
+    /* Locate: time blocks, then regions. */
+    {
+        double ms[FE_DISCOVER_MAX_BLOCKS], med, rho = res->baseline.lag1, all_n = 0, all_sq = 0;
+        double infl;
+        size_t K = (size_t)a.blocks;
+        rho = rho < 0 ? 0 : rho > 0.99 ? 0.99 : rho;
+        infl = (1.0 - rho) / (1.0 + rho);
+        for (size_t k = 0; k < K; k++) {
+            ms[k] = blocks[k].n > 0 ? blocks[k].sq0 / blocks[k].n : 0.0;
+            all_n += blocks[k].n;
+            all_sq += blocks[k].sq0;
+        }
+        {
+            double sorted[FE_DISCOVER_MAX_BLOCKS];
+            memcpy(sorted, ms, K * sizeof *sorted);
+            qsort(sorted, K, sizeof *sorted, fe__cmp_double);
+            med = K % 2 ? sorted[K / 2] : 0.5 * (sorted[K / 2 - 1] + sorted[K / 2]);
+        }
+        for (size_t k = 0; k < K && med > 0; k++) {
+            const fe__stat *b = &blocks[k];
+            double neff = b->n * infl, z, t;
+            if (b->n < 2)
+                continue;
+            z = (ms[k] / med - 1.0) / sqrt(2.0 / neff);
+            t = (b->sum0 / b->n) / sqrt(med / neff);
+            if (z > 4.0 || fabs(t) > 4.0) {
+                fe__located *l = out.nlocated > 0 ? &out.located[out.nlocated - 1] : NULL;
+                if (l != NULL && l->is_time && l->pair == b->pair && l->t1 <= b->t0
+                    && k > 0 && blocks[k - 1].t1 == l->t1) {
+                    /* extend the window */
+                    double n = l->n + b->n;
+                    l->mean_before = (l->mean_before * l->n + b->sum0) / n;
+                    l->mean_after = (l->mean_after * l->n + b->sum1) / n;
+                    l->ms_ratio_before = (l->ms_ratio_before * l->n * med + b->sq0) / (n * med);
+                    l->ms_ratio_after = (l->ms_ratio_after * l->n * med + b->sq1) / (n * med);
+                    l->n = n;
+                    l->t1 = b->t1;
+                    l->z = z > l->z ? z : l->z;
+                    l->t = fabs(t) > fabs(l->t) ? t : l->t;
+                } else if (out.nlocated < 128) {
+                    l = &out.located[out.nlocated++];
+                    memset(l, 0, sizeof *l);
+                    l->is_time = 1;
+                    l->t0 = b->t0;
+                    l->t1 = b->t1;
+                    l->pair = b->pair;
+                    l->n = b->n;
+                    l->z = z;
+                    l->t = t;
+                    l->mean_before = b->sum0 / b->n;
+                    l->mean_after = b->sum1 / b->n;
+                    l->ms_ratio_before = ms[k] / med;
+                    l->ms_ratio_after = b->sq1 / b->n / med;
+                }
+            }
+        }
+        for (size_t g = 0; g < nregions && all_n > 0; g++) {
+            const fe__stat *b = &regions[g];
+            double msall = all_sq / all_n, mean_all = 0, neff, t;
+            for (size_t k = 0; k < K; k++)
+                mean_all += blocks[k].sum0 / all_n;
+            if (b->n < 2 || b->n > all_n - 2)
+                continue;
+            neff = b->n * infl;
+            t = (b->sum0 / b->n - mean_all) / sqrt(msall / neff);
+            if (fabs(t) > 4.0 && out.nlocated < 128) {
+                fe__located *l = &out.located[out.nlocated++];
+                memset(l, 0, sizeof *l);
+                l->variable = region_var[g];
+                snprintf(l->region, sizeof l->region, "%s", region_name[g]);
+                l->n = b->n;
+                l->t = t;
+                l->mean_before = b->sum0 / b->n;
+                l->mean_after = b->sum1 / b->n;
+                l->ms_ratio_before = b->sq0 / b->n / msall;
+                l->ms_ratio_after = b->sq1 / b->n / msall;
+            }
+        }
+    }
+    out.c = &cat;
+    out.r = res;
+    out.blocks = (size_t)a.blocks;
+    out.alpha = a.alpha;
+    out.base = base;
+    out.nbase = nbase;
+    out.verdict = res->steps > 0 ? "mismatch explained"
+                  : out.nlocated > 0 ? "mismatch not explained by the catalog"
+                                     : "no significant mismatch";
+    if (a.json)
+        fe__print_json(stdout, &out);
+    else
+        fe__print_story(stdout, &out);
+    if (pts != NULL) {
+        const char *var = NULL;
+        int col = 0;
+        fclose(pts);
+        pts = NULL;
+        for (size_t i = 0; i < out.nlocated; i++)
+            if (!out.located[i].is_time) {
+                var = out.located[i].variable;
+                break;
+            }
+        if (var == NULL)
+            var = roles & FE_ROLE_VELOCITY ? "velocity"
+                  : roles & FE_ROLE_TEMPERATURE ? "temperature"
+                  : roles & FE_ROLE_POSITION ? "position" : NULL;
+        if (var != NULL)
+            col = strcmp(var, "position") == 0 ? 4 : strcmp(var, "velocity") == 0 ? 5 : 6;
+        {
+            char bp[4200];
+            snprintf(bp, sizeof bp, "%s/blocks.dat", a.report);
+            if (fe__write_means(bp, blocks, (size_t)a.blocks + 1, 1) != 0)
+                rc = FE_CLI_IO;
+            snprintf(bp, sizeof bp, "%s/bins.dat", a.report);
+            if (var != NULL && fe__write_means(bp, bins[col - 4], FE__BINS, 0) != 0)
+                rc = FE_CLI_IO;
+            if (rc == FE_CLI_IO) {
+                snprintf(err, sizeof err, "%.1000s: cannot write the plot data", a.report);
+                goto fail;
+            }
+        }
+        rc = fe__write_report(a.report, &out, points, var, col, err, sizeof err);
+        if (rc != FE_CLI_OK)
+            goto fail;
+        if (!a.json)
+            printf("report: %s/report.md\n", a.report);
+    }
+    rc = FE_CLI_OK;
+    goto cleanup;
+internal:
+    snprintf(err, sizeof err, "out of memory or internal error");
+    rc = FE_CLI_IO;
+fail:
+    fprintf(stderr, "foldest discover: %s\n", err);
+cleanup:
+    if (pts != NULL)
+        fclose(pts);
+    for (size_t i = 0; i < a.npairs; i++) {
+        fe_cli_table_close(&a.pairs[i].real);
+        fe_cli_table_close(&a.pairs[i].sim);
+    }
+    free(a.pairs);
+    free(storage);
+    free(work);
+    free(res);
+    free(blocks);
+    return rc;
+}
+/* Run discovery on recordings ends here */

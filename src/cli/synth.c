@@ -1,0 +1,123 @@
+/* Tangled from literate/cli_discover.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/cli_discover.org::Write a synthetic pair][Write a synthetic pair]] */
+#include "cli.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char fe__synth_help[] =
+    "usage: foldest synth --effect NAME [--seed S] [--rows N] --real REAL.csv --sim SIM.csv\n"
+    "\n"
+    "Write a recording/simulation pair of a synthetic experiment in which the\n"
+    "recording has one effect the simulation lacks, concealed (at most 0.3 noise\n"
+    "standard deviations per sample, coloured noise).  NAME is a catalog term or\n"
+    "'none' (mechanical rig) or 'none_thermal' (thermal rig).  The truth and the\n"
+    "command that analyses the pair are printed on standard error.\n";
+
+int fe_cli_synth(int argc, char **argv)
+{
+    const char *effect = NULL, *real = NULL, *sim = NULL;
+    long seed = 1, rows = 0;
+    char err[1024];
+    fe_synth g;
+    fe_synth_spec spec;
+    fe_sample s;
+    fe_cli_output ro, so;
+    int rc;
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {
+            size_t n;
+            const char *const *e = fe_synth_effects(&n);
+            fputs(fe__synth_help, stdout);
+            printf("\neffects:");
+            for (size_t j = 0; j < n; j++)
+                printf(" %s", e[j]);
+            printf("\n");
+            return FE_CLI_OK;
+        }
+        if (v == NULL) {
+            fprintf(stderr, "foldest synth: %s needs a value\n", o);
+            return FE_CLI_USAGE;
+        }
+        i++;
+        rc = FE_CLI_OK;
+        if (strcmp(o, "--effect") == 0)
+            effect = v;
+        else if (strcmp(o, "--real") == 0)
+            real = v;
+        else if (strcmp(o, "--sim") == 0)
+            sim = v;
+        else if (strcmp(o, "--seed") == 0)
+            rc = fe_cli_parse_long(o, v, &seed, err, sizeof err);
+        else if (strcmp(o, "--rows") == 0)
+            rc = fe_cli_parse_long(o, v, &rows, err, sizeof err);
+        else {
+            snprintf(err, sizeof err, "unknown option '%s'", o);
+            rc = FE_CLI_USAGE;
+        }
+        if (rc != FE_CLI_OK) {
+            fprintf(stderr, "foldest synth: %s\n", err);
+            return rc;
+        }
+    }
+    if (effect == NULL || real == NULL || sim == NULL || seed < 0 || rows < 0) {
+        fputs(fe__synth_help, stderr);
+        return FE_CLI_USAGE;
+    }
+    spec = fe_synth_default_spec(effect, (uint64_t)seed);
+    if (rows > 0)
+        spec.rows = (size_t)rows;
+    rc = fe_synth_init(&g, &spec);
+    if (rc != FE_OK) {
+        fprintf(stderr, "foldest synth: --effect %s: %s\n", effect,
+                rc == FE_EINVAL ? "not an effect a rig can host ('foldest synth --help')"
+                                : fe_strerror(rc));
+        return FE_CLI_USAGE;
+    }
+    if ((rc = fe_cli_output_open(&ro, real, err, sizeof err)) != FE_CLI_OK) {
+        fprintf(stderr, "foldest synth: %s\n", err);
+        return rc;
+    }
+    if ((rc = fe_cli_output_open(&so, sim, err, sizeof err)) != FE_CLI_OK) {
+        fe_cli_output_abort(&ro);
+        fprintf(stderr, "foldest synth: %s\n", err);
+        return rc;
+    }
+    if (g.thermal) {
+        fprintf(ro.file, "time,load\n");
+        fprintf(so.file, "time,load,temperature,ambient\n");
+    } else {
+        fprintf(ro.file, "time,acceleration\n");
+        fprintf(so.file, "time,acceleration,position,velocity,input\n");
+    }
+    while (fe_synth_next(&g, &s) == FE_OK) {
+        fprintf(ro.file, "%.6f,%.10g\n", s.t, s.real);
+        if (g.thermal)
+            fprintf(so.file, "%.6f,%.10g,%.10g,%.10g\n", s.t, s.sim, s.temperature, s.ambient);
+        else
+            fprintf(so.file, "%.6f,%.10g,%.10g,%.10g,%.10g\n", s.t, s.sim, s.position,
+                    s.velocity, s.input);
+    }
+    if ((rc = fe_cli_output_commit(&ro, err, sizeof err)) != FE_CLI_OK) {
+        fe_cli_output_abort(&so);
+        fprintf(stderr, "foldest synth: %s\n", err);
+        return rc;
+    }
+    if ((rc = fe_cli_output_commit(&so, err, sizeof err)) != FE_CLI_OK) {
+        fprintf(stderr, "foldest synth: %s\n", err);
+        return rc;
+    }
+    fprintf(stderr, "synth: %zu rows; hidden effect %s, coefficient %.6g; noise sd %g, "
+                    "lag-one correlation %g\n",
+            spec.rows, effect, g.coefficient, spec.noise_sd, spec.noise_rho);
+    fprintf(stderr, "analyse with:\n  foldest discover --real %s --sim %s --channel %s "
+                    "%s --base %s --holdout 0.3\n",
+            real, sim, g.thermal ? "load" : "acceleration",
+            g.thermal ? "--role temperature=temperature --role ambient=ambient"
+                      : "--role position=position --role velocity=velocity --role input=input",
+            strcmp(effect, "bias") == 0 ? "gain" : strcmp(effect, "gain") == 0 ? "bias"
+                                                                             : "bias,gain");
+    return FE_CLI_OK;
+}
+/* Write a synthetic pair ends here */
