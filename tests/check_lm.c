@@ -486,7 +486,7 @@ static double *read_qmc(const char *dir, const char *name, size_t *n)
 START_TEST(magnetometer_sessions_real)
 {
     const char *dir = fe_test_data_dir("magnetometer_sessions_real");
-    double *m1, *m2, xj[12], xc[9], xs[2][9], rms_joint[2], rms_sep[2], rms_common[2];
+    double *m1, *m2, xj[12], xc[12], xs[2][12], rms_joint[2], rms_sep[2], rms_common[2];
     size_t n1 = 0, n2 = 0;
     struct magcal joint = {2, {0}, {0}, 0}, common, one;
     fe_lm_result r;
@@ -536,18 +536,26 @@ START_TEST(magnetometer_sessions_real)
         ck_assert_double_le(rms_sep[b], rms_joint[b] * (1.0 + 1e-9));
         ck_assert_double_lt(rms_joint[b], 1.5 * rms_sep[b]);
     }
-    /* The per-session offsets are real: the F statistic of the 3 extra
-       parameters, (RSS_common - RSS_joint) / 3 over RSS_joint / (n - 12),
-       beyond its 1e-6 quantile (about 10.2 for 3 and many degrees of
-       freedom). */
+    /* The per-session offsets are real: the two recordings' offsets differ
+       by more than twice as much as those of the halves of either one. */
     {
-        double n = (double)(n1 + n2);
-        double rss_j = (double)n1 * rms_joint[0] * rms_joint[0] + (double)n2 * rms_joint[1] * rms_joint[1];
-        double rss_c = (double)n1 * rms_common[0] * rms_common[0] + (double)n2 * rms_common[1] * rms_common[1];
-        double F = (rss_c - rss_j) / 3.0 / (rss_j / (n - 12.0));
-        fprintf(stderr, "  offsets (counts): filtered (%.1f, %.1f, %.1f), noisy (%.1f, %.1f, %.1f);"
-                        " F = %.1f\n", xj[6], xj[7], xj[8], xj[9], xj[10], xj[11], F);
-        ck_assert_double_gt(F, 10.2);
+        double between = 0.0, within = 0.0;
+        for (int k = 0; k < 3; k++)
+            between += (xj[6 + k] - xj[9 + k]) * (xj[6 + k] - xj[9 + k]);
+        for (int b = 0; b < 2; b++) {
+            size_t n = joint.n[b], h = n / 2;
+            struct magcal halves = {2, {joint.m[b], joint.m[b] + 3 * h}, {h, n - h}, 0};
+            double xh[12], d = 0.0;
+            ck_assert_int_eq(magcal_fit(&halves, xh, &r), FE_OK);
+            for (int k = 0; k < 3; k++)
+                d += (xh[6 + k] - xh[9 + k]) * (xh[6 + k] - xh[9 + k]);
+            within = fmax(within, sqrt(d));
+        }
+        between = sqrt(between);
+        fprintf(stderr, "  offsets (counts): filtered (%.1f, %.1f, %.1f), noisy (%.1f, %.1f, %.1f):"
+                        " %.1f apart; halves of one recording at most %.1f apart\n",
+                xj[6], xj[7], xj[8], xj[9], xj[10], xj[11], between, within);
+        ck_assert_double_gt(between, 2.0 * within);
     }
     free(m1);
     free(m2);
