@@ -86,6 +86,55 @@ START_TEST(linear_model_matches_normal_equations)
 }
 END_TEST
 
+/* Wide rows (more nonzeros than the dense sink folds sparsely): the dense
+   and Schur paths still give the normal-equation solution. */
+enum { WN = 200, WP = 80 };
+struct wide { double J[WN][WP], y[WN]; };
+
+static int wide_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct wide *L = ctx;
+    for (int i = 0; i < WN; i++) {
+        double f = -L->y[i];
+        for (int k = 0; k < WP; k++)
+            f += L->J[i][k] * x[k];
+        fe_lm_emit(s, f, 1.0, L->J[i], FE_SCHUR_NONE, NULL);
+    }
+    return FE_OK;
+}
+
+START_TEST(wide_linear_model_dense_and_schur)
+{
+    static struct wide L;
+    static double gram[(WP + 1) * (WP + 1)], sw[(WP + 1) * (WP + 1)];
+    double want[WP], rss, worst = 0.0, scale = 0.0;
+    fe_rng g = fe_rng_seed(4);
+    fe_lsq a;
+    fe_lm_problem p = {WP, 0, 0, wide_model, &L};
+
+    fe_lsq_init(&a, WP, gram);
+    for (int i = 0; i < WN; i++) {
+        for (int k = 0; k < WP; k++)
+            L.J[i][k] = fe_rng_normal(&g);
+        L.y[i] = L.J[i][3] - 0.5 * L.J[i][70] + 0.1 * fe_rng_normal(&g);
+        fe_lsq_add(&a, L.J[i], L.y[i], 1.0);
+    }
+    ck_assert_int_eq(fe_lsq_solve(&a, NULL, WP, want, &rss, NULL, sw), FE_OK);
+    for (int k = 0; k < WP; k++)
+        scale = fmax(scale, fabs(want[k]));
+    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
+        double x[WP] = {0}, *w = lm_work(&p, method);
+        fe_lm_result r;
+        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
+        for (int k = 0; k < WP; k++)
+            worst = fmax(worst, fabs(x[k] - want[k]));
+        FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
+        free(w);
+    }
+    ck_assert_double_le(worst, 1e-10 * scale);
+}
+END_TEST
+
 /* ------------------------------------------------ 2-D bundle adjustment */
 
 enum { NC = 10, NLM = 40, BAP = 2 * NC + 2 * NLM };
@@ -582,6 +631,7 @@ Suite *fe_lm_suite(void)
     tcase_set_timeout(t, 300);
     tcase_add_test(t, rosenbrock_dense_and_schur);
     tcase_add_test(t, linear_model_matches_normal_equations);
+    tcase_add_test(t, wide_linear_model_dense_and_schur);
     tcase_add_test(t, bundle_adjustment_dense_and_schur_agree);
     tcase_add_test(t, report_table_and_stop);
     tcase_add_test(t, model_failures_are_handled);
