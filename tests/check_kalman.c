@@ -622,8 +622,9 @@ START_TEST(fast_path_equals_reference)
     fe_rng r = fe_rng_seed(77);
     double worst = 0.0, worst_rep = 0.0;
     int rc = FE_OK, same_b = 1;
-    const size_t ns[4] = {1, 2, 4, 6};
-    for (int t = 0; t < 4; t++) {
+    /* n = 10 runs the run-time-size path, the others the fixed-size kernels. */
+    const size_t ns[5] = {1, 2, 4, 6, 10};
+    for (int t = 0; t < 5; t++) {
         size_t n = ns[t];
         kf f, g;
         kf_make(&f, n, 4);
@@ -631,7 +632,7 @@ START_TEST(fast_path_equals_reference)
         ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 10.0), FE_OK);
         ck_assert_int_eq(fe_kalman_set_prior_scaled(&g.k, NULL, 10.0), FE_OK);
         for (int i = 0; i < 60; i++) {
-            double A[4 * 6], z[4], Z[16];
+            double A[4 * 10], z[4], Z[16];
             double nu1[4], nu2[4], w1[4], w2[4], D1[16], D2[16];
             fe_kalman_report r1 = {0, 0, 0, nu1, w1, D1}, r2 = {0, 0, 0, nu2, w2, D2};
             size_t b = 1 + (size_t)(i % 4);
