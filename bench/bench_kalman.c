@@ -1,5 +1,6 @@
 /* Kalman update at n = 4, for packets of b = 1 and b = 3 measurements,
-   in one run:
+   in one run (b = 3 twice: a full Z, and a diagonal Z, i.e. decorrelated
+   measurements):
      - the reference path, fe_kalman_update (CBLAS + one LAPACKE_dposv),
      - the fast path, fe_kalman_update_fast (decorrelate, scalar updates),
      - a hand-written fixed-size update (arrays of 4 and 16 doubles, no
@@ -19,16 +20,18 @@ enum { N = 4, M = 4096 };
 /* One packet stream: b rows of A, b values, a b x b covariance. */
 typedef struct stream {
     size_t b;
+    int diagonal;       /* Z diagonal: decorrelated measurements */
     double A[M][3 * N];
     double z[M][3];
     double Z[M][9];
     fe_kalman_obs obs[M];
 } stream;
 
-static void make_stream(stream *s, size_t b, uint64_t seed)
+static void make_stream(stream *s, size_t b, int diagonal, uint64_t seed)
 {
     fe_rng r = fe_rng_seed(seed);
     s->b = b;
+    s->diagonal = diagonal;
     for (int k = 0; k < M; k++) {
         double L[9] = {0};
         for (size_t i = 0; i < b * N; i++)
@@ -38,7 +41,7 @@ static void make_stream(stream *s, size_t b, uint64_t seed)
         /* Z = L L^T with a random lower triangular L, well conditioned. */
         for (size_t i = 0; i < b; i++) {
             for (size_t j = 0; j < i; j++)
-                L[i * b + j] = 0.3 * (2.0 * fe_rng_uniform(&r) - 1.0);
+                L[i * b + j] = diagonal ? 0.0 : 0.3 * (2.0 * fe_rng_uniform(&r) - 1.0);
             L[i * b + i] = 0.5 + fe_rng_uniform(&r);
         }
         for (size_t i = 0; i < b; i++)
@@ -208,8 +211,8 @@ int main(int argc, char **argv)
 {
     int rounds = argc > 1 ? atoi(argv[1]) : 200;
     long chunk = 20000, chunk_ref = 2000, n_agree = 100000;
-    static stream s1, s3;
-    stream *streams[2] = {&s1, &s3};
+    static stream s1, s3, s3d;
+    stream *streams[3] = {&s1, &s3, &s3d};
     double worst_goal = 0.0;
     int ok = 1;
     size_t len = fe_kalman_doubles(N, 3);
@@ -220,11 +223,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_kalman: cannot set up the filter\n");
         return 1;
     }
-    make_stream(&s1, 1, 1);
-    make_stream(&s3, 3, 3);
+    make_stream(&s1, 1, 0, 1);
+    make_stream(&s3, 3, 0, 3);
+    make_stream(&s3d, 3, 1, 4);
     printf("Kalman update, n = %d (ns per update: best of %d interleaved runs of %ld updates,"
            " %ld for the reference)\n", N, rounds, chunk, chunk_ref);
-    for (int t = 0; t < 2; t++) {
+    for (int t = 0; t < 3; t++) {
         const stream *s = streams[t];
         double t_ref, t_fast, t_hand, xr[N], Pr[N * N], xf[N], Pf[N * N], xh[N], Ph[N * N];
         double agree_fast, agree_hand;
@@ -239,7 +243,8 @@ int main(int argc, char **argv)
         run_hand(s, n_agree, xh, Ph);
         agree_fast = fmax(rel(xf, xr, N), rel(Pf, Pr, N * N));
         agree_hand = fmax(rel(xh, xr, N), rel(Ph, Pr, N * N));
-        printf("  b = %zu (%s Z)\n", s->b, s->b == 1 ? "scalar" : "full");
+        printf("  b = %zu (%s Z)\n", s->b,
+               s->b == 1 ? "scalar" : s->diagonal ? "diagonal" : "full");
         printf("    reference (CBLAS + LAPACKE_dposv)   %8.1f\n", t_ref);
         printf("    fast path (decorrelate + scalar)    %8.1f\n", t_fast);
         printf("    hand-written fixed-size baseline    %8.1f\n", t_hand);

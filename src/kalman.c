@@ -310,26 +310,28 @@ static int fe__kalman_decorrelate(size_t n, const fe_kalman_obs *o,
         p->var_stride = b + 1;
         return FE_OK;
     }
-    /* Z = L L^T, from the lower triangle of Z. */
+    /* Z = L L^T, from the lower triangle of Z.  The diagonal of L is
+       stored inverted: it is only ever divided by. */
     for (size_t j = 0; j < b; j++) {
-        double s = Z[j * b + j];
+        double s = Z[j * b + j], inv;
         for (size_t e = 0; e < j; e++)
             s -= L[j * b + e] * L[j * b + e];
         if (!(s > 0.0))
             return FE_ENOTPD;
-        L[j * b + j] = sqrt(s);
+        inv = 1.0 / sqrt(s);
+        L[j * b + j] = inv;
         for (size_t i = j + 1; i < b; i++) {
             double t = Z[i * b + j];
             for (size_t e = 0; e < j; e++)
                 t -= L[i * b + e] * L[j * b + e];
-            L[i * b + j] = t / L[j * b + j];
+            L[i * b + j] = t * inv;
         }
         if (r != NULL)
-            p->log_det += 2.0 * log(L[j * b + j]);
+            p->log_det -= 2.0 * log(inv);
     }
     /* Whiten: Aw = L^{-1} A, zw = L^{-1} z. */
     for (size_t i = 0; i < b; i++) {
-        double inv = 1.0 / L[i * b + i];
+        double inv = L[i * b + i];
         double t = z[i];
         for (size_t e = 0; e < i; e++)
             t -= L[i * b + e] * zw[e];
@@ -427,21 +429,25 @@ static int fe__kalman_rows_any(size_t n, double *x, double *P, double *g,
     return fe__kalman_rows(n, x, P, x, P, g, p, r);
 }
 
-/* Compile-time n: the new state goes to locals, committed only when finite. */
+/* Compile-time n: update the caller's (x, P) in place, from a saved copy
+   that puts them back if the update is refused or its result not finite. */
 #define FE__KALMAN_SMALL_KERNEL(N)                                           \
     static int fe__kalman_small##N(double *x, double *P,                     \
                                    const struct fe__rows *p,                 \
                                    fe_kalman_report *r)                      \
     {                                                                        \
-        double xl[N], Pl[N * N], g[N];                                       \
-        int rc = fe__kalman_rows(N, x, P, xl, Pl, g, p, r);                  \
-        if (rc != FE_OK)                                                     \
-            return rc;                                                       \
-        if (!fe__finite(xl, N) || !fe__finite(Pl, N * N))                    \
-            return FE_ENONFINITE;                                            \
-        memcpy(x, xl, sizeof xl);                                            \
-        memcpy(P, Pl, sizeof Pl);                                            \
-        return FE_OK;                                                        \
+        double xo[N], Po[N * N], g[N];                                       \
+        int rc;                                                              \
+        memcpy(xo, x, sizeof xo);                                            \
+        memcpy(Po, P, sizeof Po);                                            \
+        rc = fe__kalman_rows(N, x, P, x, P, g, p, r);                        \
+        if (rc == FE_OK && (!fe__finite(x, N) || !fe__finite(P, N * N)))     \
+            rc = FE_ENONFINITE;                                              \
+        if (rc != FE_OK) {                                                   \
+            memcpy(x, xo, sizeof xo);                                        \
+            memcpy(P, Po, sizeof Po);                                        \
+        }                                                                    \
+        return rc;                                                           \
     }
 FE__KALMAN_SMALL_KERNEL(1)
 FE__KALMAN_SMALL_KERNEL(2)

@@ -425,6 +425,8 @@ START_TEST(row_major_dposv_needs_ldb_nrhs)
         info = LAPACKE_dposv(LAPACK_ROW_MAJOR, 'L', (lapack_int)b, (lapack_int)m,
                              D, (lapack_int)b, B, (lapack_int)m);
         ck_assert_int_eq(info, 0);
+        /* LAPACKE prints "Wrong parameter 8 in LAPACKE_dposv_work" here:
+           that is the expected refusal. */
         if (b < m)
             ck_assert_int_eq(LAPACKE_dposv(LAPACK_ROW_MAJOR, 'L', (lapack_int)b,
                                            (lapack_int)m, D2, (lapack_int)b, B2,
@@ -622,8 +624,9 @@ START_TEST(fast_path_equals_reference)
     fe_rng r = fe_rng_seed(77);
     double worst = 0.0, worst_rep = 0.0;
     int rc = FE_OK, same_b = 1;
-    const size_t ns[4] = {1, 2, 4, 6};
-    for (int t = 0; t < 4; t++) {
+    /* n = 10 runs the run-time-size path, the others the fixed-size kernels. */
+    const size_t ns[5] = {1, 2, 4, 6, 10};
+    for (int t = 0; t < 5; t++) {
         size_t n = ns[t];
         kf f, g;
         kf_make(&f, n, 4);
@@ -631,7 +634,7 @@ START_TEST(fast_path_equals_reference)
         ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 10.0), FE_OK);
         ck_assert_int_eq(fe_kalman_set_prior_scaled(&g.k, NULL, 10.0), FE_OK);
         for (int i = 0; i < 60; i++) {
-            double A[4 * 6], z[4], Z[16];
+            double A[4 * 10], z[4], Z[16];
             double nu1[4], nu2[4], w1[4], w2[4], D1[16], D2[16];
             fe_kalman_report r1 = {0, 0, 0, nu1, w1, D1}, r2 = {0, 0, 0, nu2, w2, D2};
             size_t b = 1 + (size_t)(i % 4);
@@ -1110,6 +1113,21 @@ START_TEST(monitor_says_when_consistency_is_lost)
 }
 END_TEST
 
+START_TEST(monitor_sees_a_pessimistic_model)
+{
+    /* The sensor becomes four times more precise at step 600 and the
+       filter does not know: the NIS shrinks, the lower CUSUM alarms. */
+    fe_kalman_monitor mon;
+    ck_assert_int_eq(fe_kalman_monitor_init(&mon, NULL), FE_OK);
+    run_monitored(45, 1000, 600, 0.25, 1.0, &mon);
+    ck_assert_int_eq(mon.alarm_side, -1);
+    ck_assert_msg(mon.alarm_step >= 600 && mon.alarm_step <= 680,
+                  "alarm at %llu", (unsigned long long)mon.alarm_step);
+    ck_assert_msg(mon.onset_step >= 570 && mon.onset_step <= 610,
+                  "onset at %llu", (unsigned long long)mon.onset_step);
+}
+END_TEST
+
 START_TEST(wrong_dynamics_show_in_autocorrelation)
 {
     /* The filter believes gravity is half what it is: the innovations
@@ -1200,6 +1218,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, track_accumulator_folds_a_tracker);
     tcase_add_test(t, consistent_model_passes_the_monitor);
     tcase_add_test(t, monitor_says_when_consistency_is_lost);
+    tcase_add_test(t, monitor_sees_a_pessimistic_model);
     tcase_add_test(t, wrong_dynamics_show_in_autocorrelation);
     tcase_add_test(t, monitor_scans_and_refuses);
     tcase_add_test(t, chi_square_quantiles);
