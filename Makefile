@@ -50,7 +50,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo bench install uninstall clean \
+        check-install check-tangle tangle doc demo run-examples bench install uninstall clean \
         check-tsan check-mpi bench-mpi
 
 all: lib cli examples
@@ -226,6 +226,10 @@ doc: $(B)/.deps
 # ---------------------------------------------------------------- demo
 demo: all
 	@sh examples/demo.sh $(B)
+
+# Every example program, one after the other.
+run-examples: all
+	@for e in $(EXAMPLES); do echo "== $$e"; $$e || exit 1; echo; done
 
 # ---------------------------------------------------------------- install
 install: lib cli

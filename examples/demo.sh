@@ -1,9 +1,42 @@
 #!/bin/sh
-# make demo: run every example and show what it prints.
+# make demo: the main job.  foldest finds what a simulation left out:
+#   1. a synthetic experiment whose recording hides quadratic drag (at most
+#      0.3 noise standard deviations per sample, coloured noise), generated
+#      here, and a negative control with nothing hidden;
+#   2. the phone free-fall recordings (../shared/data/freefall-drag, or
+#      $FOLDEST_DATA), against a vacuum free-fall simulation of each drop;
+# each with a report (Markdown and plots) under $OUT.
+set -e
 B=${1:-build}
-for e in "$B"/examples/*; do
-  [ -x "$e" ] || continue
-  echo "== $(basename "$e")"
-  "$e" || exit 1
-  echo
-done
+FOLDEST=$B/bin/foldest
+OUT=${FOLDEST_OUT:-$B/out}/demo
+mkdir -p "$OUT"
+say() { printf '\n\033[1m== %s\033[0m\n' "$*"; }
+
+say "1. A synthetic experiment with a concealed effect (the truth is known)"
+"$FOLDEST" synth --effect quadratic_drag --seed 7 --real "$OUT/drag_real.csv" --sim "$OUT/drag_sim.csv"
+"$FOLDEST" discover --real "$OUT/drag_real.csv" --sim "$OUT/drag_sim.csv" --channel acceleration \
+  --role position=position --role velocity=velocity --role input=input \
+  --base bias,gain --holdout 0.3 --report "$OUT/synthetic"
+
+say "1b. The negative control: the same rig with nothing hidden"
+"$FOLDEST" synth --effect none --seed 7 --real "$OUT/null_real.csv" --sim "$OUT/null_sim.csv" 2>/dev/null
+"$FOLDEST" discover --real "$OUT/null_real.csv" --sim "$OUT/null_sim.csv" --channel acceleration \
+  --role position=position --role velocity=velocity --role input=input \
+  --base bias,gain --holdout 0.3 | tail -n 4
+
+say "2. Real recordings: a phone in free fall against a vacuum simulation"
+DATA=${FOLDEST_DATA:-../shared/data}
+if [ -f "$DATA/freefall-drag/csv/fall_1.csv" ]; then
+  FOLDEST_OUT=$OUT "$B/examples/freefall_sim" "$DATA/freefall-drag/csv" "$OUT/freefall_sim" > "$OUT/freefall_sim.txt"
+  head -n 12 "$OUT/freefall_sim.txt"
+  args=$(tail -n 1 "$OUT/freefall_sim.txt" | sed 's/^foldest discover//')
+  # shellcheck disable=SC2086
+  "$FOLDEST" discover $args --report "$OUT/freefall"
+else
+  echo "no recordings at $DATA (set FOLDEST_DATA): skipped"
+fi
+
+say "Reports"
+for r in "$OUT"/*/report.md; do echo "  $r"; done
+echo "(other examples: make run-examples)"

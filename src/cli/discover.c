@@ -150,7 +150,7 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
 typedef struct fe__stat {
     double n, sum0, sq0, sum1, sq1;
     double t0, t1;              /* first and last time */
-    int pair;                   /* recording of the first row */
+    int pair, pair1;            /* recordings of the first and last rows */
 } fe__stat;
 
 static void fe__stat_add(fe__stat *s, double t, int pair, double before, double after)
@@ -160,6 +160,7 @@ static void fe__stat_add(fe__stat *s, double t, int pair, double before, double 
         s->pair = pair;
     }
     s->t1 = t;
+    s->pair1 = pair;
     s->n += 1;
     s->sum0 += before;
     s->sq0 += before * before;
@@ -176,7 +177,7 @@ static int fe__cmp_double(const void *a, const void *b)
 typedef struct fe__located {
     int is_time;
     double t0, t1;
-    int pair;
+    int pair, pair1;
     const char *variable;
     char region[64];
     double n, z, t, mean_before, mean_after, ms_ratio_before, ms_ratio_after;
@@ -431,6 +432,14 @@ typedef struct fe__outcome {
     fe__located located[128];
     size_t nlocated;
     const char *verdict;
+    /* The final model refitted on each recording alone (classical errors). */
+    const fe__stat *regions;
+    const char *const *region_var;
+    const char (*region_name)[64];
+    size_t nregions;
+    size_t npairs;
+    double *per_coef, *per_se;                  /* npairs x ncols */
+    double *per_rows, *per_held;                /* rows, held-out rows of each */
 } fe__outcome;
 
 static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
@@ -487,7 +496,8 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         const fe__located *l = &o->located[i];
         fprintf(f, "%s{\"kind\": \"%s\", ", i ? ", " : "", l->is_time ? "time" : "state");
         if (l->is_time) {
-            fprintf(f, "\"recording\": %d, \"start\": ", l->pair + 1);
+            fprintf(f, "\"recording\": %d, \"end_recording\": %d, \"start\": ", l->pair + 1,
+                    l->pair1 + 1);
             fe__json_number(f, l->t0);
             fprintf(f, ", \"end\": ");
             fe__json_number(f, l->t1);
@@ -538,6 +548,17 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         }
         fprintf(f, "]}");
     }
+    fprintf(f, "], \"per_recording\": [");
+    for (size_t q = 0; q < o->npairs && r->steps > 0 && o->per_coef != NULL; q++) {
+        fprintf(f, "%s{\"recording\": %zu, \"rows\": %.0f, \"heldout\": %s, \"coefficients\": {",
+                q ? ", " : "", q + 1, o->per_rows[q],
+                o->per_held[q] >= o->per_rows[q] && o->per_rows[q] > 0 ? "true" : "false");
+        for (size_t j = 0; j < r->ncols; j++) {
+            fprintf(f, "%s\"%s\": ", j ? ", " : "", o->c->terms[r->cols[j]].name);
+            fe__json_number(f, o->per_coef[q * r->ncols + j]);
+        }
+        fprintf(f, "}}");
+    }
     fprintf(f, "], \"ranking\": [");
     for (size_t i = 0; i < r->nranked[0]; i++) {
         const fe_discover_rank *k = &r->ranking[0][i];
@@ -576,14 +597,16 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
     for (size_t i = 0; i < o->nlocated; i++) {
         const fe__located *l = &o->located[i];
-        if (l->is_time)
-            fprintf(f, "  time %.4g to %.4g (recording %d): mean residual %+.3g, mean square "
-                       "%.2fx typical (z = %.1f, t = %.1f); after: %+.3g, %.2fx\n",
-                    l->t0, l->t1, l->pair + 1, l->mean_before, l->ms_ratio_before, l->z, l->t,
-                    l->mean_after, l->ms_ratio_after);
+        if (l->is_time && l->pair == l->pair1)
+            fprintf(f, "  recording %d, time %.4g to %.4g:", l->pair + 1, l->t0, l->t1);
+        else if (l->is_time)
+            fprintf(f, "  recording %d time %.4g to recording %d time %.4g:", l->pair + 1,
+                    l->t0, l->pair1 + 1, l->t1);
         else
-            fprintf(f, "  %s %s: %.0f rows, mean residual %+.3g (t = %.1f); after: %+.3g\n",
-                    l->variable, l->region, l->n, l->mean_before, l->t, l->mean_after);
+            fprintf(f, "  %s %s (%.0f rows):", l->variable, l->region, l->n);
+        fprintf(f, " mean residual %+.3g, mean square %.2fx typical (z = %.1f, t = %.1f);"
+                   " after: %+.3g, %.2fx\n", l->mean_before, l->ms_ratio_before, l->z, l->t,
+                l->mean_after, l->ms_ratio_after);
     }
     fprintf(f, "\ncandidates, first step (batch-means tests over %zu time blocks):\n",
             o->blocks);
@@ -611,6 +634,36 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             for (size_t j = 0; j < r->nalike[s]; j++)
                 fprintf(f, " %s", o->c->terms[r->alike[s][j]].name);
             fprintf(f, "\n");
+        }
+    }
+    if (r->steps > 0 && o->npairs > 1 && o->per_coef != NULL) {
+        fprintf(f, "\nthe same model fitted on each recording alone (classical standard errors):\n");
+        for (size_t q = 0; q < o->npairs; q++) {
+            fprintf(f, "  recording %2zu (%4.0f rows%s):", q + 1, o->per_rows[q],
+                    o->per_held[q] <= 0 ? "" : o->per_held[q] < o->per_rows[q]
+                                                   ? ", partly held out" : ", held out");
+            for (size_t s = 0; s < r->steps; s++)
+                for (size_t j = 0; j < r->ncols; j++)
+                    if (r->cols[j] == r->added[s])
+                        fprintf(f, "  %s %.4g +/- %.2g", o->c->terms[r->added[s]].name,
+                                o->per_coef[q * r->ncols + j], o->per_se[q * r->ncols + j]);
+            fprintf(f, "\n");
+        }
+    }
+    if (r->steps > 0 && o->nregions > 0) {
+        double total = 0.0;
+        for (size_t g = 0; g < o->nregions; g++)
+            if (strcmp(o->region_var[g], "velocity") != 0)
+                total += o->regions[g].sq0 - o->regions[g].sq1;
+        fprintf(f, "\nwhere the discovered terms help (share of the drop in the residual's sum "
+                   "of squares, fitted rows):\n");
+        for (size_t g = 0; g < o->nregions; g++) {
+            const fe__stat *b = &o->regions[g];
+            if (strcmp(o->region_var[g], "velocity") == 0 || b->n == 0 || !(total > 0))
+                continue;
+            fprintf(f, "  %-12s %-24s %6.0f rows  %5.1f%%   RMS %.4g -> %.4g\n", o->region_var[g],
+                    o->region_name[g], b->n, 100.0 * (b->sq0 - b->sq1) / total,
+                    sqrt(b->sq0 / b->n), sqrt(b->sq1 / b->n));
         }
     }
     rel = r->baseline.rms > 0 ? 100.0 * (r->final.rms / r->baseline.rms - 1.0) : 0.0;
@@ -722,9 +775,9 @@ int fe_cli_discover(int argc, char **argv)
     fe_discover_options opt = fe_discover_default_options();
     fe_discover_result *res = NULL;
     fe__outcome out;
-    fe__stat *blocks = NULL, regions[12];
-    const char *region_var[12];
-    char region_name[12][64];
+    fe__stat *blocks = NULL, regions[16];
+    const char *region_var[16];
+    char region_name[16][64];
     size_t nregions = 0;
     enum { FE__BINS = 40 };
     fe__stat bins[3][FE__BINS];
@@ -736,6 +789,8 @@ int fe_cli_discover(int argc, char **argv)
     char err[2048], points[4200] = "";
     fe_sample s;
     FILE *pts = NULL;
+    fe_lsq *per = NULL;
+    double *per_g = NULL;
 
     memset(&out, 0, sizeof out);
     rc = fe__discover_parse(argc, argv, &a, err, sizeof err);
@@ -862,10 +917,18 @@ int fe_cli_discover(int argc, char **argv)
 
     /* Regions of the state to test. */
     if (roles & FE_ROLE_VELOCITY) {
+        double vmax = scale.vmax;
         region_var[nregions] = "velocity";
         strcpy(region_name[nregions++], "v < 0");
         region_var[nregions] = "velocity";
         strcpy(region_name[nregions++], "v > 0");
+        region_var[nregions] = "velocity";
+        strcpy(region_name[nregions++], "v = 0");
+        for (int b = 0; b < 4; b++) {
+            region_var[nregions] = "speed";
+            snprintf(region_name[nregions++], 64, "|v| %.3g to %.3g", vmax * b / 4.0,
+                     vmax * (b + 1) / 4.0);
+        }
     }
     if (roles & FE_ROLE_POSITION) {
         region_var[nregions] = "position";
@@ -900,6 +963,18 @@ int fe_cli_discover(int argc, char **argv)
     }
     if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
         goto fail;
+    out.npairs = a.npairs;
+    per = calloc(a.npairs, sizeof *per);
+    per_g = calloc(a.npairs * fe_lsq_storage(res->ncols), sizeof *per_g);
+    out.per_coef = calloc(a.npairs * (res->ncols + 1), sizeof *out.per_coef);
+    out.per_se = calloc(a.npairs * (res->ncols + 1), sizeof *out.per_se);
+    out.per_rows = calloc(a.npairs, sizeof *out.per_rows);
+    out.per_held = calloc(a.npairs, sizeof *out.per_held);
+    if (per == NULL || per_g == NULL || out.per_coef == NULL || out.per_se == NULL
+        || out.per_rows == NULL || out.per_held == NULL)
+        goto internal;
+    for (size_t q = 0; q < a.npairs && res->ncols > 0; q++)
+        fe_lsq_init(&per[q], res->ncols, per_g + q * fe_lsq_storage(res->ncols));
     {
         size_t i = 0, stride = rows / FE__PLOT_POINTS + 1;
         pair_index = 0;
@@ -908,16 +983,30 @@ int fe_cli_discover(int argc, char **argv)
             size_t k = i < out.fit ? (size_t)((double)i * (double)a.blocks / (double)out.fit)
                                    : (size_t)a.blocks;
             pair_index += new_pair;
+            if (i >= out.fit)
+                out.per_held[pair_index] += 1.0;
             fe_catalog_eval(&cat, &s, phi);
             for (size_t j = 0; j < nbase; j++)
                 before -= out.baseline_coef[j] * phi[base[j]];
             for (size_t j = 0; j < res->ncols; j++)
                 after -= res->coef[j] * phi[res->cols[j]];
             fe__stat_add(&blocks[k], s.t, pair_index, before, after);
+            if (res->ncols > 0) {
+                double row[FE_DISCOVER_MAX_COLUMNS];
+                for (size_t j = 0; j < res->ncols; j++)
+                    row[j] = phi[res->cols[j]];
+                fe_lsq_add(&per[pair_index], row, s.real - s.sim, 1.0);
+            }
             for (size_t g = 0; g < nregions && i < out.fit; g++) {
                 int in = 0;
                 if (strcmp(region_var[g], "velocity") == 0)
-                    in = region_name[g][2] == '<' ? s.velocity < 0 : s.velocity > 0;
+                    in = region_name[g][2] == '<' ? s.velocity < 0
+                         : region_name[g][2] == '>' ? s.velocity > 0 : s.velocity == 0;
+                else if (strcmp(region_var[g], "speed") == 0) {
+                    int b = (int)(fabs(s.velocity) / (scale.vmax + 1e-300) * 4.0);
+                    size_t first = (size_t)(strcmp(region_var[0], "velocity") == 0 ? 3 : 0);
+                    in = s.velocity != 0 && (b > 3 ? 3 : b) == (int)(g - first);
+                }
                 else if (strcmp(region_var[g], "position") == 0)
                     in = region_name[g][2] == '<' ? s.position < 0 : s.position > 0;
                 else {
@@ -942,6 +1031,23 @@ int fe_cli_discover(int argc, char **argv)
         }
         if (rc != FE_END)
             goto fail;
+    }
+
+    /* Refit the final model on each recording alone. */
+    for (size_t q = 0; q < a.npairs && res->ncols > 0; q++) {
+        double *cov = malloc(res->ncols * res->ncols * sizeof *cov);
+        double *w = malloc(fe_lsq_solve_work(res->ncols) * sizeof *w), rss;
+        out.per_rows[q] = per[q].n;
+        if (cov != NULL && w != NULL
+            && fe_lsq_solve(&per[q], NULL, res->ncols, out.per_coef + q * res->ncols, &rss,
+                            cov, w) == FE_OK)
+            for (size_t j = 0; j < res->ncols; j++)
+                out.per_se[q * res->ncols + j] = sqrt(cov[j * res->ncols + j]);
+        else
+            for (size_t j = 0; j < res->ncols; j++)
+                out.per_coef[q * res->ncols + j] = NAN;
+        free(cov);
+        free(w);
     }
 
     /* Locate: time blocks, then regions. */
@@ -971,7 +1077,7 @@ int fe_cli_discover(int argc, char **argv)
             t = (b->sum0 / b->n) / sqrt(med / neff);
             if (z > 4.0 || fabs(t) > 4.0) {
                 fe__located *l = out.nlocated > 0 ? &out.located[out.nlocated - 1] : NULL;
-                if (l != NULL && l->is_time && l->pair == b->pair && l->t1 <= b->t0
+                if (l != NULL && l->is_time && l->pair1 == b->pair && l->t1 <= b->t0
                     && k > 0 && blocks[k - 1].t1 == l->t1) {
                     /* extend the window */
                     double n = l->n + b->n;
@@ -981,6 +1087,7 @@ int fe_cli_discover(int argc, char **argv)
                     l->ms_ratio_after = (l->ms_ratio_after * l->n * med + b->sq1) / (n * med);
                     l->n = n;
                     l->t1 = b->t1;
+                    l->pair1 = b->pair1;
                     l->z = z > l->z ? z : l->z;
                     l->t = fabs(t) > fabs(l->t) ? t : l->t;
                 } else if (out.nlocated < 128) {
@@ -990,6 +1097,7 @@ int fe_cli_discover(int argc, char **argv)
                     l->t0 = b->t0;
                     l->t1 = b->t1;
                     l->pair = b->pair;
+                    l->pair1 = b->pair1;
                     l->n = b->n;
                     l->z = z;
                     l->t = t;
@@ -1002,20 +1110,22 @@ int fe_cli_discover(int argc, char **argv)
         }
         for (size_t g = 0; g < nregions && all_n > 0; g++) {
             const fe__stat *b = &regions[g];
-            double msall = all_sq / all_n, mean_all = 0, neff, t;
+            double msall = all_sq / all_n, mean_all = 0, neff, t, z;
             for (size_t k = 0; k < K; k++)
                 mean_all += blocks[k].sum0 / all_n;
             if (b->n < 2 || b->n > all_n - 2)
                 continue;
             neff = b->n * infl;
             t = (b->sum0 / b->n - mean_all) / sqrt(msall / neff);
-            if (fabs(t) > 4.0 && out.nlocated < 128) {
+            z = (b->sq0 / b->n / msall - 1.0) / sqrt(2.0 / neff);
+            if ((fabs(t) > 4.0 || z > 4.0) && out.nlocated < 128) {
                 fe__located *l = &out.located[out.nlocated++];
                 memset(l, 0, sizeof *l);
                 l->variable = region_var[g];
                 snprintf(l->region, sizeof l->region, "%s", region_name[g]);
                 l->n = b->n;
                 l->t = t;
+                l->z = z;
                 l->mean_before = b->sum0 / b->n;
                 l->mean_after = b->sum1 / b->n;
                 l->ms_ratio_before = b->sq0 / b->n / msall;
@@ -1025,6 +1135,10 @@ int fe_cli_discover(int argc, char **argv)
     }
     out.c = &cat;
     out.r = res;
+    out.regions = regions;
+    out.region_var = region_var;
+    out.region_name = (const char (*)[64])region_name;
+    out.nregions = nregions;
     out.blocks = (size_t)a.blocks;
     out.alpha = a.alpha;
     out.base = base;
@@ -1090,6 +1204,12 @@ cleanup:
     free(work);
     free(res);
     free(blocks);
+    free(per);
+    free(per_g);
+    free(out.per_coef);
+    free(out.per_se);
+    free(out.per_rows);
+    free(out.per_held);
     return rc;
 }
 /* Run discovery on recordings ends here */
