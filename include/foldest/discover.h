@@ -10,7 +10,7 @@
 
 enum {
     FE_DISCOVER_MAX_COLUMNS = 64,   /* term columns m */
-    FE_DISCOVER_MAX_GROUPS = 48,    /* candidate terms (groups of columns) */
+    FE_DISCOVER_MAX_GROUPS = 64,    /* candidate terms (groups of columns) */
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12      /* forward-selection steps */
