@@ -8,6 +8,7 @@
 
 #include "foldest/error.h"
 #include "foldest/kalman.h"
+#include "foldest/special.h"
 /* Kalman Filter Includes ends here */
 /* [[file:../literate/kalman.org::Lay out the workspace][Lay out the workspace]] */
 /* Pointers into an fe_kalman's workspace. */
@@ -970,124 +971,7 @@ double fe_kalman_monitor_autocorr(const fe_kalman_monitor *m, size_t lag,
          / (m->acf[0] / (double)m->acf_terms[0]);
 }
 /* Monitor the innovations ends here */
-/* [[file:../literate/kalman.org::Compute chi-square quantiles][Compute chi-square quantiles]] */
-static double fe__normal_quantile(double p)
-{
-    static const double a[6] = {-3.969683028665376e+01, 2.209460984245205e+02,
-                                -2.759285104469687e+02, 1.383577518672690e+02,
-                                -3.066479806614716e+01, 2.506628277459239e+00};
-    static const double b[5] = {-5.447609879822406e+01, 1.615858368580409e+02,
-                                -1.556989798598866e+02, 6.680131188771972e+01,
-                                -1.328068155288572e+01};
-    static const double c[6] = {-7.784894002430293e-03, -3.223964580411365e-01,
-                                -2.400758277161838e+00, -2.549732539343734e+00,
-                                4.374664141464968e+00, 2.938163982698783e+00};
-    static const double d[4] = {7.784695709041462e-03, 3.224671290700398e-01,
-                                2.445134137142996e+00, 3.754408661907416e+00};
-    const double plow = 0.02425;
-    double q, r;
-    if (p < plow) {
-        q = sqrt(-2.0 * log(p));
-        return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5])
-             / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-    }
-    if (p > 1.0 - plow) {
-        q = sqrt(-2.0 * log(1.0 - p));
-        return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5])
-             / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-    }
-    q = p - 0.5;
-    r = q * q;
-    return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q
-         / (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
-}
-
-/* log Gamma(x), x > 0 (Lanczos, g = 7). */
-static double fe__log_gamma(double x)
-{
-    static const double c[9] = {0.99999999999980993, 676.5203681218851,
-                                -1259.1392167224028, 771.32342877765313,
-                                -176.61502916214059, 12.507343278686905,
-                                -0.13857109526572012, 9.9843695780195716e-6,
-                                1.5056327351493116e-7};
-    double s, t;
-    if (x < 0.5)
-        return fe__log_gamma(x + 1.0) - log(x);
-    x -= 1.0;
-    s = c[0];
-    for (int i = 1; i < 9; i++)
-        s += c[i] / (x + (double)i);
-    t = x + 7.5;
-    return 0.9189385332046728 + (x + 0.5) * log(t) - t + log(s);
-}
-
-/* The regularised lower incomplete gamma function P(a, x). */
-static double fe__gamma_p(double a, double x)
-{
-    double front;
-    if (x <= 0.0)
-        return 0.0;
-    front = exp(-x + a * log(x) - fe__log_gamma(a));
-    if (x < a + 1.0) {
-        double ap = a, del = 1.0 / a, sum = del;
-        for (int i = 0; i < 1000 && fabs(del) > 1e-17 * fabs(sum); i++) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-        }
-        return sum * front;
-    } else {
-        const double tiny = 1e-300;
-        double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
-        for (int i = 1; i < 1000; i++) {
-            double an = -(double)i * ((double)i - a), del;
-            b += 2.0;
-            d = an * d + b;
-            if (fabs(d) < tiny)
-                d = tiny;
-            c = b + an / c;
-            if (fabs(c) < tiny)
-                c = tiny;
-            d = 1.0 / d;
-            del = d * c;
-            h *= del;
-            if (fabs(del - 1.0) < 1e-16)
-                break;
-        }
-        return 1.0 - front * h;
-    }
-}
-
-double fe_kalman_chi2_quantile(double q, double dof)
-{
-    double a, h, t, x, lo = 0.0, hi = INFINITY, lognorm;
-    if (!(q > 0.0 && q < 1.0) || !(dof > 0.0) || !isfinite(dof))
-        return NAN;
-    a = 0.5 * dof;
-    h = 2.0 / (9.0 * dof);
-    t = 1.0 - h + fe__normal_quantile(q) * sqrt(h);
-    x = t > 0.0 ? dof * t * t * t : 0.0;
-    if (!(x > 1e-300))
-        x = 1e-300 + dof * 1e-6;
-    lognorm = a * log(2.0) + fe__log_gamma(a);
-    for (int it = 0; it < 200; it++) {
-        double F = fe__gamma_p(a, 0.5 * x) - q;
-        double f = exp((a - 1.0) * log(x) - 0.5 * x - lognorm);
-        double xn;
-        if (F < 0.0)
-            lo = x;
-        else
-            hi = x;
-        xn = f > 0.0 ? x - F / f : NAN;
-        if (!(xn > lo && xn < hi))
-            xn = isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * x;
-        if (fabs(xn - x) <= 1e-15 * x)
-            return xn;
-        x = xn;
-    }
-    return x;
-}
-
+/* [[file:../literate/kalman.org::Compute the band of mean NIS][Compute the band of mean NIS]] */
 int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
                                double *lo, double *hi)
 {
@@ -1098,11 +982,11 @@ int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
         return FE_ETOOFEW;
     nu = (double)m->dof;
     steps = (double)m->steps;
-    *lo = fe_kalman_chi2_quantile(0.5 * (1.0 - prob), nu) / steps;
-    *hi = fe_kalman_chi2_quantile(0.5 * (1.0 + prob), nu) / steps;
+    *lo = fe_chi2_quantile(0.5 * (1.0 - prob), nu) / steps;
+    *hi = fe_chi2_quantile(0.5 * (1.0 + prob), nu) / steps;
     return FE_OK;
 }
-/* Compute chi-square quantiles ends here */
+/* Compute the band of mean NIS ends here */
 /* [[file:../literate/kalman.org::Kalman filters as accumulators][Kalman filters as accumulators]] */
 static int fe__kalman_acc_init(void *acc, void *ctx)
 {

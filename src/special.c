@@ -48,22 +48,38 @@ double fe_beta_inc(double a, double b, double x)
         return NAN;
     if (x == 0.0 || x == 1.0)
         return x;
-    lbt = lgamma(a + b) - lgamma(a) - lgamma(b) + a * log(x) + b * log1p(-x);
+    lbt = fe_log_gamma(a + b) - fe_log_gamma(a) - fe_log_gamma(b) + a * log(x) + b * log1p(-x);
     if (x < (a + 1.0) / (a + b + 2.0))
         return exp(lbt) * fe__beta_fraction(a, b, x) / a;
     return 1.0 - exp(lbt) * fe__beta_fraction(b, a, 1.0 - x) / b;
 }
 /* Evaluate the incomplete beta continued fraction ends here */
 /* [[file:../literate/special.org::Evaluate the incomplete gamma function][Evaluate the incomplete gamma function]] */
-double fe_gamma_q(double a, double x)
+double fe_log_gamma(double x)
 {
-    double lpre;
-    if (!(a > 0.0) || !(x >= 0.0))
-        return NAN;
-    if (x == 0.0)
-        return 1.0;
-    lpre = -x + a * log(x) - lgamma(a);
-    if (x < a + 1.0) {                  /* series for P, then Q = 1 - P */
+    static const double c[9] = {0.99999999999980993, 676.5203681218851,
+                                -1259.1392167224028, 771.32342877765313,
+                                -176.61502916214059, 12.507343278686905,
+                                -0.13857109526572012, 9.9843695780195716e-6,
+                                1.5056327351493116e-7};
+    double s, t;
+    if (x < 0.5)
+        return fe_log_gamma(x + 1.0) - log(x);
+    x -= 1.0;
+    s = c[0];
+    for (int i = 1; i < 9; i++)
+        s += c[i] / (x + (double)i);
+    t = x + 7.5;
+    return 0.9189385332046728 + (x + 0.5) * log(t) - t + log(s);
+}
+
+
+/* P(a, x) and Q(a, x), each of the pair computed directly where it is the
+   smaller, the other as its complement. */
+static void fe__gamma_pq(double a, double x, double *p, double *q)
+{
+    double lpre = -x + a * log(x) - fe_log_gamma(a);
+    if (x < a + 1.0) {                  /* series for P */
         double ap = a, sum = 1.0 / a, del = sum;
         for (int n = 0; n < FE__SPECIAL_ITERATIONS; n++) {
             ap += 1.0;
@@ -72,7 +88,8 @@ double fe_gamma_q(double a, double x)
             if (fabs(del) < fabs(sum) * FE__SPECIAL_EPS)
                 break;
         }
-        return 1.0 - sum * exp(lpre);
+        *p = sum * exp(lpre);
+        *q = 1.0 - *p;
     } else {                            /* continued fraction for Q */
         double b = x + 1.0 - a, c = 1.0 / FE__SPECIAL_TINY, d = 1.0 / b, h = d;
         for (int i = 1; i <= FE__SPECIAL_ITERATIONS; i++) {
@@ -88,8 +105,31 @@ double fe_gamma_q(double a, double x)
             if (fabs(delta - 1.0) < FE__SPECIAL_EPS)
                 break;
         }
-        return exp(lpre) * h;
+        *q = exp(lpre) * h;
+        *p = 1.0 - *q;
     }
+}
+
+double fe_gamma_p(double a, double x)
+{
+    double p, q;
+    if (!(a > 0.0) || !(x >= 0.0))
+        return NAN;
+    if (x == 0.0)
+        return 0.0;
+    fe__gamma_pq(a, x, &p, &q);
+    return p;
+}
+
+double fe_gamma_q(double a, double x)
+{
+    double p, q;
+    if (!(a > 0.0) || !(x >= 0.0))
+        return NAN;
+    if (x == 0.0)
+        return 1.0;
+    fe__gamma_pq(a, x, &p, &q);
+    return q;
 }
 /* Evaluate the incomplete gamma function ends here */
 /* [[file:../literate/special.org::Tails of t, F and chi-square][Tails of t, F and chi-square]] */
@@ -141,3 +181,65 @@ double fe_chi2_upper(double x, double k)
     return fe_gamma_q(0.5 * k, 0.5 * x);
 }
 /* Tails of t, F and chi-square ends here */
+/* [[file:../literate/special.org::Compute normal and chi-square quantiles][Compute normal and chi-square quantiles]] */
+double fe_normal_quantile(double p)
+{
+    static const double a[6] = {-3.969683028665376e+01, 2.209460984245205e+02,
+                                -2.759285104469687e+02, 1.383577518672690e+02,
+                                -3.066479806614716e+01, 2.506628277459239e+00};
+    static const double b[5] = {-5.447609879822406e+01, 1.615858368580409e+02,
+                                -1.556989798598866e+02, 6.680131188771972e+01,
+                                -1.328068155288572e+01};
+    static const double c[6] = {-7.784894002430293e-03, -3.223964580411365e-01,
+                                -2.400758277161838e+00, -2.549732539343734e+00,
+                                4.374664141464968e+00, 2.938163982698783e+00};
+    static const double d[4] = {7.784695709041462e-03, 3.224671290700398e-01,
+                                2.445134137142996e+00, 3.754408661907416e+00};
+    const double plow = 0.02425;
+    double q, r;
+    if (p < plow) {
+        q = sqrt(-2.0 * log(p));
+        return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5])
+             / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+    }
+    if (p > 1.0 - plow) {
+        q = sqrt(-2.0 * log(1.0 - p));
+        return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5])
+             / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+    }
+    q = p - 0.5;
+    r = q * q;
+    return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q
+         / (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+}
+
+double fe_chi2_quantile(double q, double dof)
+{
+    double a, h, t, x, lo = 0.0, hi = INFINITY, lognorm;
+    if (!(q > 0.0 && q < 1.0) || !(dof > 0.0) || !isfinite(dof))
+        return NAN;
+    a = 0.5 * dof;
+    h = 2.0 / (9.0 * dof);
+    t = 1.0 - h + fe_normal_quantile(q) * sqrt(h);
+    x = t > 0.0 ? dof * t * t * t : 0.0;
+    if (!(x > 1e-300))
+        x = 1e-300 + dof * 1e-6;
+    lognorm = a * log(2.0) + fe_log_gamma(a);
+    for (int it = 0; it < 200; it++) {
+        double F = fe_gamma_p(a, 0.5 * x) - q;
+        double f = exp((a - 1.0) * log(x) - 0.5 * x - lognorm);
+        double xn;
+        if (F < 0.0)
+            lo = x;
+        else
+            hi = x;
+        xn = f > 0.0 ? x - F / f : NAN;
+        if (!(xn > lo && xn < hi))
+            xn = isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * x;
+        if (fabs(xn - x) <= 1e-15 * x)
+            return xn;
+        x = xn;
+    }
+    return x;
+}
+/* Compute normal and chi-square quantiles ends here */

@@ -248,12 +248,6 @@ int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
    not enough data or lag is out of range. */
 double fe_kalman_monitor_autocorr(const fe_kalman_monitor *m, size_t lag,
                                   uint64_t *terms);
-
-/* fe_kalman_chi2_quantile: the q-quantile of chi-square with `dof` > 0
-   degrees of freedom, to about 1e-13 relative (Newton on the incomplete
-   gamma function from a Wilson-Hilferty start).  NAN for q outside (0, 1)
-   or a bad dof.  Thread-safe (no lgamma/signgam). */
-double fe_kalman_chi2_quantile(double q, double dof);
 /* Innovation Monitor Declarations ends here */
 /* [[file:../../literate/kalman.org::Kalman Accumulator Declarations][Kalman Accumulator Declarations]] */
 /* Configuration of the covariance-form accumulators (their context): the

@@ -7,8 +7,14 @@
    a, b > 0 and 0 <= x <= 1; NaN for other arguments. */
 double fe_beta_inc(double a, double b, double x);
 
-/* fe_gamma_q: the regularised upper incomplete gamma function Q(a, x)
-   for a > 0, x >= 0; NaN for other arguments. */
+/* fe_log_gamma: log Gamma(x) for x > 0 (Lanczos; thread-safe, unlike
+   lgamma). */
+double fe_log_gamma(double x);
+
+/* fe_gamma_p, fe_gamma_q: the regularised lower and upper incomplete gamma
+   functions P(a, x) and Q(a, x) = 1 - P(a, x) for a > 0, x >= 0; NaN for
+   other arguments. */
+double fe_gamma_p(double a, double x);
 double fe_gamma_q(double a, double x);
 
 /* fe_student_t_two_sided: P(|T| > |t|) for Student's t with nu > 0
@@ -24,6 +30,16 @@ double fe_f_upper(double f, double d1, double d2);
 
 /* fe_chi2_upper: P(X > x) for chi-square with k degrees of freedom. */
 double fe_chi2_upper(double x, double k);
+
+/* fe_normal_quantile: the p-quantile of the standard normal, 0 < p < 1
+   (Acklam's rational approximation, relative error below 1.2e-9). */
+double fe_normal_quantile(double p);
+
+/* fe_chi2_quantile: the q-quantile of chi-square with dof > 0 degrees of
+   freedom, 0 < q < 1, to about 1e-13 relative: a Wilson-Hilferty start
+   refined by Newton's method on P(dof/2, x/2) inside a kept bracket.
+   NaN for other arguments. */
+double fe_chi2_quantile(double q, double dof);
 
 #endif /* FOLDEST_SPECIAL_H */
 /* Tail Probability Declarations ends here */
