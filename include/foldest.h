@@ -11,6 +11,8 @@
 #include "foldest/meanvar.h"
 #include "foldest/random.h"
 #include "foldest/csv.h"
+#include "foldest/quadric.h"
+#include "foldest/sphere.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

@@ -71,27 +71,33 @@ int fe_quadric_region(const double v[3])
 }
 /* Find the region of a direction ends here */
 /* [[file:../literate/quadric.org::Mark the region of a sample][Mark the region of a sample]] */
-static int fe__quadric_full(const fe_quadric *q)
+/* The centre for coverage and the box size, from the current box. */
+static float fe__quadric_frame(const fe_quadric *q, double c[3])
 {
-    return q->cover[0] == ~(uint64_t)0
-        && q->cover[1] == ((uint64_t)1 << (FE_QUADRIC_REGIONS - 64)) - 1;
-}
-
-/* The centre and axis scales for coverage, from the current box. */
-static void fe__quadric_frame(const fe_quadric *q, double c[3], double s[3])
-{
+    double size = 0.0;
     for (int j = 0; j < 3; j++) {
-        double w = q->hi[j] - q->lo[j];
+        double h = 0.5 * (q->hi[j] - q->lo[j]);
         c[j] = (q->flags & FE_QUADRIC_FIXED_REF) ? q->ref[j]
                                                  : 0.5 * (q->lo[j] + q->hi[j]);
-        s[j] = w > 0.0 ? 2.0 / w : 0.0;
+        size = h > size ? h : size;
     }
+    return (float)size;
 }
 
-static void fe__quadric_mark(uint64_t cover[2], int region)
+static int fe__quadric_full(const fe_quadric *q)
 {
-    if (region >= 0)
-        cover[region >> 6] |= (uint64_t)1 << (region & 63);
+    double c[3];
+    float size = fe__quadric_frame(q, c);
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        if (q->seen[r] < size)
+            return 0;
+    return 1;
+}
+
+static void fe__quadric_mark(fe_quadric *q, int region, float size)
+{
+    if (region >= 0 && q->seen[region] < size)
+        q->seen[region] = size;
 }
 /* Mark the region of a sample ends here */
 /* [[file:../literate/quadric.org::Fold one sample into the moments][Fold one sample into the moments]] */
@@ -123,13 +129,11 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
             q->hi[j] = x[j];
     }
     q->flags |= FE_QUADRIC_HAS_REF;
-    if (!fe__quadric_full(q)) {
-        double c[3], s[3];
-        fe__quadric_frame(q, c, s);
-        fe__quadric_mark(q->cover,
-                         fe__quadric_region((x[0] - c[0]) * s[0],
-                                            (x[1] - c[1]) * s[1],
-                                            (x[2] - c[2]) * s[2]));
+    {
+        double c[3];
+        float size = fe__quadric_frame(q, c);
+        fe__quadric_mark(q, fe__quadric_region(x[0] - c[0], x[1] - c[1],
+                                               x[2] - c[2]), size);
     }
     return FE_OK;
 }
@@ -263,12 +267,12 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
                 q->hi[j] = hi[j];
             }
             if (!fe__quadric_full(q)) {
-                double c[3], s[3];
-                fe__quadric_frame(q, c, s);
+                double c[3];
+                float size = fe__quadric_frame(q, c);
                 for (size_t i = 0; i < m; i++)
-                    fe__quadric_mark(q->cover, fe__quadric_region(
-                        (b[3 * i] - c[0]) * s[0], (b[3 * i + 1] - c[1]) * s[1],
-                        (b[3 * i + 2] - c[2]) * s[2]));
+                    fe__quadric_mark(q, fe__quadric_region(
+                        b[3 * i] - c[0], b[3 * i + 1] - c[1], b[3 * i + 2] - c[2]),
+                        size);
             }
             k += m;
             continue;
@@ -391,8 +395,8 @@ int fe_quadric_merge(fe_quadric *a, const fe_quadric *b)
     }
     for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
         a->m[k] = sum[k];
-    a->cover[0] |= b->cover[0];
-    a->cover[1] |= b->cover[1];
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        a->seen[r] = b->seen[r] > a->seen[r] ? b->seen[r] : a->seen[r];
     return FE_OK;
 }
 /* Merge two accumulations ends here */
@@ -421,12 +425,14 @@ uint64_t fe_quadric_count(const fe_quadric *q)
 
 int fe_quadric_regions(const fe_quadric *q)
 {
+    double c[3];
+    float half;
     int n = 0;
-    if (q == NULL)
+    if (q == NULL || q->m[0] == 0.0)
         return 0;
-    for (int w = 0; w < 2; w++)
-        for (uint64_t bits = q->cover[w]; bits != 0; bits &= bits - 1)
-            n++;
+    half = 0.5f * fe__quadric_frame(q, c);
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        n += q->seen[r] > 0.0f && q->seen[r] >= half;
     return n;
 }
 

@@ -22,13 +22,15 @@ enum {
 
 /* The sufficient statistics of every quadric fit of three-axis samples:
    moments of degree <= 4 of u = x - ref, per-axis extremes of x, and the
-   regions visited.  A flat value: copy it, store it, send it.  All zero
-   bytes is the empty accumulation whose reference is its first sample. */
+   regions visited (with the box size at the visit).  A flat value: copy
+   it, store it, send it.  All zero bytes is the empty accumulation whose
+   reference is its first sample. */
 typedef struct fe_quadric {
     double m[FE_QUADRIC_MOMENTS];  /* m[0] = N; m[k] = sum of u^alpha_k */
     double ref[3];                 /* the reference point c */
     double lo[3], hi[3];           /* per-axis min and max of x (N > 0) */
-    uint64_t cover[2];             /* bit r of the 128: region r visited */
+    float seen[FE_QUADRIC_REGIONS];  /* box size when region r was last
+                                      visited; 0: never */
     uint32_t flags;                /* FE_QUADRIC_HAS_REF, _FIXED_REF */
     uint32_t reserved;             /* zero */
 } fe_quadric;
@@ -64,8 +66,9 @@ int fe_quadric_merge(fe_quadric *a, const fe_quadric *b);
    about 400 multiplications.  FE_ENONFINITE on overflow (q unchanged). */
 int fe_quadric_recentre(fe_quadric *q, const double ref[3]);
 
-/* fe_quadric_count: N.  fe_quadric_coverage: fraction of the 100 regions
-   visited, in [0, 1].  fe_quadric_regions: their number. */
+/* fe_quadric_count: N.  fe_quadric_regions: the number of regions
+   visited while the box was at least half its final size (its largest
+   half-width).  fe_quadric_coverage: their fraction of 100, in [0, 1]. */
 uint64_t fe_quadric_count(const fe_quadric *q);
 double fe_quadric_coverage(const fe_quadric *q);
 int fe_quadric_regions(const fe_quadric *q);
