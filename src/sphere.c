@@ -518,6 +518,7 @@ static int fe__sphere_finish(const fe__sphere_problem *pr, const fe_quadric *q,
             scale[k] = beta[k] < 0.0 ? -sigma : sigma;
         }
     }
+    cost = fmax(cost, 0.0);     /* theta' Phi theta can round below 0 */
     fit->rss = cost;
     fit->rms_percent = 50.0 * sqrt(cost / q->m[0]);
     /* The shape: eigenvalues of A. */
