@@ -6,9 +6,11 @@
 #include "cli.h"
 
 int fe_cli_stats(int argc, char **argv);
+int fe_cli_calibrate(int argc, char **argv);
 
 static const fe_cli_command fe_cli_commands[] = {
     {"stats", "mean, standard deviation, min and max of columns", fe_cli_stats},
+    {"calibrate", "sphere or ellipsoid calibration of a 3-axis sensor", fe_cli_calibrate},
 };
 
 #endif /* FOLDEST_CLI_COMMANDS_H */
