@@ -3,7 +3,7 @@
 #include "foldest/error.h"
 #include "foldest/quadric.h"
 
-enum { FE__QUADRIC_BLOCK = 128, FE__QUADRIC_LANES = 4 };
+enum { FE__QUADRIC_BLOCK = 512, FE__QUADRIC_LANES = 4 };
 
 /* The exponents (a, b, c) of moment k, in the order of m[]. */
 static const unsigned char fe__quadric_exp[FE_QUADRIC_MOMENTS][3] = {
@@ -149,13 +149,51 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
 enum { FE__L = FE__QUADRIC_LANES };
 
 FE__QUADRIC_KERNEL
-static void fe__quadric_block(const double *X, const double *Y,
-                              const double *Z, int n, double out[35])
+static void fe__quadric_block(const double *b, int n, const double ref[3],
+                              double out[35], double rlo[3], double rhi[3])
 {
+    double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
     double a[9][FE__L] = {{0}}, c[10][FE__L] = {{0}}, q[8][FE__L] = {{0}},
-           r[7][FE__L] = {{0}};
-    int i = 0, l;
+           r[7][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
+    int i, l, k;
 
+    for (i = 0; i < n; i++) {
+        X[i] = b[3 * i] - ref[0];
+        Y[i] = b[3 * i + 1] - ref[1];
+        Z[i] = b[3 * i + 2] - ref[2];
+    }
+    /* Extremes of the relative coordinates, in lanes. */
+    for (l = 0; l < FE__L; l++) {
+        lo[0][l] = hi[0][l] = X[0];
+        lo[1][l] = hi[1][l] = Y[0];
+        lo[2][l] = hi[2][l] = Z[0];
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            lo[0][l] = X[i + l] < lo[0][l] ? X[i + l] : lo[0][l];
+            hi[0][l] = X[i + l] > hi[0][l] ? X[i + l] : hi[0][l];
+            lo[1][l] = Y[i + l] < lo[1][l] ? Y[i + l] : lo[1][l];
+            hi[1][l] = Y[i + l] > hi[1][l] ? Y[i + l] : hi[1][l];
+            lo[2][l] = Z[i + l] < lo[2][l] ? Z[i + l] : lo[2][l];
+            hi[2][l] = Z[i + l] > hi[2][l] ? Z[i + l] : hi[2][l];
+        }
+    for (; i < n; i++) {
+        lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
+        hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
+        lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
+        hi[1][0] = Y[i] > hi[1][0] ? Y[i] : hi[1][0];
+        lo[2][0] = Z[i] < lo[2][0] ? Z[i] : lo[2][0];
+        hi[2][0] = Z[i] > hi[2][0] ? Z[i] : hi[2][0];
+    }
+    for (int j = 0; j < 3; j++) {
+        rlo[j] = lo[j][0];
+        rhi[j] = hi[j][0];
+        for (l = 1; l < FE__L; l++) {
+            rlo[j] = lo[j][l] < rlo[j] ? lo[j][l] : rlo[j];
+            rhi[j] = hi[j][l] > rhi[j] ? hi[j][l] : rhi[j];
+        }
+    }
+    /* The moments, in four groups of lanes. */
     for (i = 0; i + FE__L <= n; i += FE__L)
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
@@ -191,24 +229,24 @@ static void fe__quadric_block(const double *X, const double *Y,
             r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
             r[6][l] += zz * zz;
         }
-    for (int k = 0; k < 35; k++)
+    for (k = 0; k < 35; k++)
         out[k] = 0.0;
     out[0] = (double)n;
     for (l = 0; l < FE__L; l++) {
-        for (int k = 0; k < 9; k++)
+        for (k = 0; k < 9; k++)
             out[1 + k] += a[k][l];
-        for (int k = 0; k < 10; k++)
+        for (k = 0; k < 10; k++)
             out[10 + k] += c[k][l];
-        for (int k = 0; k < 8; k++)
+        for (k = 0; k < 8; k++)
             out[20 + k] += q[k][l];
-        for (int k = 0; k < 7; k++)
+        for (k = 0; k < 7; k++)
             out[28 + k] += r[k][l];
     }
     /* The tail that does not fill the lanes. */
     for (; i < n; i++) {
         double p[35];
         fe__quadric_monomials(X[i], Y[i], Z[i], p);
-        for (int k = 1; k < 35; k++)
+        for (k = 1; k < 35; k++)
             out[k] += p[k];
     }
 }
@@ -217,7 +255,6 @@ static void fe__quadric_block(const double *X, const double *Y,
 int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
                         size_t *done)
 {
-    double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
     size_t k = 0;
     int rc = FE_OK;
 
@@ -228,36 +265,35 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
     while (k < n) {
         size_t m = n - k < FE__QUADRIC_BLOCK ? n - k : FE__QUADRIC_BLOCK;
         const double *b = x + 3 * k;
-        double lo[3], hi[3], bad = 0.0, sums[35], next[35];
-        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0;
+        double lo[3], hi[3], rlo[3], rhi[3], sums[35], next[35];
+        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1;
 
-        if (fast) {
-            for (int j = 0; j < 3; j++) {
-                lo[j] = q->lo[j];
-                hi[j] = q->hi[j];
-            }
-            for (size_t i = 0; i < m; i++) {
-                X[i] = b[3 * i] - q->ref[0];
-                Y[i] = b[3 * i + 1] - q->ref[1];
-                Z[i] = b[3 * i + 2] - q->ref[2];
-                bad += (X[i] + Y[i] + Z[i]) * 0.0;  /* NaN if any is not finite */
-                for (int j = 0; j < 3; j++) {
-                    double v = b[3 * i + j];
-                    lo[j] = v < lo[j] ? v : lo[j];
-                    hi[j] = v > hi[j] ? v : hi[j];
-                }
-            }
-            fast = bad == 0.0;
-            if (fast && !fe__quadric_full(q))
-                for (int j = 0; j < 3; j++)
-                    fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
-        }
-        if (fast) {
-            fe__quadric_block(X, Y, Z, (int)m, sums);
+        if (fast) {             /* a non-finite sample makes a sum non-finite */
+            fe__quadric_block(b, (int)m, q->ref, sums, rlo, rhi);
             for (int j = 0; j < FE_QUADRIC_MOMENTS; j++) {
                 next[j] = q->m[j] + sums[j];
                 fast = fast && fe__finite(next[j]);
             }
+        }
+        if (fast) {
+            /* Inside the box for sure when strictly inside after rounding
+               (x - ref rounds monotonically); else find the extremes. */
+            for (int j = 0; j < 3; j++) {
+                lo[j] = q->lo[j];
+                hi[j] = q->hi[j];
+                inside = inside && rlo[j] > lo[j] - q->ref[j]
+                         && rhi[j] < hi[j] - q->ref[j];
+            }
+            if (!inside)
+                for (size_t i = 0; i < m; i++)
+                    for (int j = 0; j < 3; j++) {
+                        double v = b[3 * i + j];
+                        lo[j] = v < lo[j] ? v : lo[j];
+                        hi[j] = v > hi[j] ? v : hi[j];
+                    }
+            if (!fe__quadric_full(q))
+                for (int j = 0; j < 3; j++)
+                    fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
         }
         if (fast) {
             for (int j = 0; j < FE_QUADRIC_MOMENTS; j++)

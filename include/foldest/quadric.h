@@ -50,7 +50,7 @@ int fe_quadric_init(fe_quadric *q, const double *centre);
 int fe_quadric_add(fe_quadric *q, const double x[3]);
 
 /* fe_quadric_add_many: fold the n samples x[3k..3k+2], faster than n
-   calls of fe_quadric_add (blocks of 128, vector code where the compiler
+   calls of fe_quadric_add (blocks of 512, vector code where the compiler
    offers it), with the same result up to rounding of the moments (the
    extremes and the coverage are identical).  Stops at the first sample
    refused; *done (if not NULL) receives how many were folded. */
