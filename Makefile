@@ -48,7 +48,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo bench install uninstall clean
+        check-install check-tangle tangle doc demo bench size install uninstall clean
 
 all: lib cli examples
 
@@ -97,6 +97,22 @@ $(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
 
 bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+
+# ---------------------------------------------------------------- embedded
+# The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4
+# and report its code size and the size of its state.
+ARM := arm-none-eabi
+size:
+	@command -v $(ARM)-gcc >/dev/null || { [ "$$(id -u)" = 0 ] && \
+	  apt-get install -y -q --no-install-recommends gcc-arm-none-eabi; } || \
+	  { echo "size: needs $(ARM)-gcc: sudo apt-get install -y gcc-arm-none-eabi"; exit 1; }
+	@mkdir -p $(B)/arm && printf '#include "foldest/quadric.h"\nfe_quadric fe_state;\n' > $(B)/arm/state.c
+	$(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -std=c11 -ffreestanding $(WARN) -Iinclude -c src/quadric.c -o $(B)/arm/quadric.o
+	@$(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -std=c11 -ffreestanding -Iinclude -c $(B)/arm/state.c -o $(B)/arm/state.o
+	@$(ARM)-size $(B)/arm/quadric.o
+	@set -- $$($(ARM)-nm -S $(B)/arm/quadric.o | grep ' fe_quadric_add$$'); printf 'fe_quadric_add (the step): %d bytes of code\n' 0x$$2
+	@set -- $$($(ARM)-nm -S $(B)/arm/state.o | grep ' fe_state$$'); printf 'fe_quadric (the state): %d bytes\n' 0x$$2
+	@echo "undefined symbols (compiler runtime only):" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
 
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
