@@ -9,7 +9,6 @@
    Build against an installed foldest:
      cc calibrate_mag.c $(pkg-config --cflags --libs foldest) -o calibrate_mag */
 #define _POSIX_C_SOURCE 200809L
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,6 +42,16 @@ static size_t read_recording(const char *path, double *x, size_t max)
     return n;
 }
 
+/* A square root by Newton's method: the example links with foldest alone
+   (`pkg-config --libs foldest` has no -lm), so it calls nothing from libm. */
+static double root(double a)
+{
+    double r = a > 1.0 ? a : 1.0;
+    for (int k = 0; k < 60 && a > 0.0; k++)
+        r = 0.5 * (r + a / r);
+    return a > 0.0 ? r : 0.0;
+}
+
 /* A synthetic magnetometer: hard iron (6000, 250, 3500) counts, soft iron
    stretching the 1100-count field into an ellipsoid, noise of 3 counts. */
 static size_t synthesise(double *x, size_t n)
@@ -56,7 +65,7 @@ static size_t synthesise(double *x, size_t n)
             v[j] = fe_rng_normal(&g);
             s += v[j] * v[j];
         }
-        s = sqrt(s);
+        s = root(s);
         for (int r = 0; r < 3; r++)
             x[3 * i + r] = b[r] + 3.0 * fe_rng_normal(&g)
                          + 1100.0 * (S[3 * r] * v[0] + S[3 * r + 1] * v[1] + S[3 * r + 2] * v[2]) / s;
