@@ -196,6 +196,53 @@ START_TEST(trace_and_stop)
 }
 END_TEST
 
+struct damping { int rejected, increased, calls; double last; };
+
+static int watch_damping(const fe_sphere_iteration *it, void *ctx)
+{
+    struct damping *d = ctx;
+    d->rejected += !it->accepted;
+    d->increased += it->accepted && it->lambda > 0.0 && d->calls > 0
+                    && it->cost > d->last * (1 + 1e-10);
+    d->last = it->cost;
+    d->calls++;
+    return 0;
+}
+
+START_TEST(damping_when_a_step_fails)
+{
+    /* Half a sphere (x > centre), fitted with the hemisphere check off:
+       from the box's centre, pure Gauss-Newton overshoots and
+       Levenberg-Marquardt damping has to step in.  The cost never rises. */
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_options o = fe_sphere_default_options();
+    fe_sphere_fit f;
+    struct damping d = {0, 0, 0, 0.0};
+    fe_rng g = fe_rng_seed(3);
+    for (size_t i = 0; i < N; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        v[0] = fabs(v[0]);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(&g);
+    }
+    fe_quadric_add_many(&q, x, N, NULL);
+    o.min_extent = 0.0;
+    o.trace = watch_damping;
+    o.trace_ctx = &d;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+    ck_assert_int_gt(d.rejected, 0);
+    ck_assert_int_eq(d.increased, 0);
+    ck_assert_double_eq_tol(f.radius, 400, 20);
+}
+END_TEST
+
 START_TEST(refuse_too_few_and_bad_arguments)
 {
     double x[3 * 6];
@@ -596,6 +643,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, trace_and_stop);
+    tcase_add_test(t, damping_when_a_step_fails);
     tcase_add_test(t, refuse_too_few_and_bad_arguments);
     tcase_add_test(t, refuse_planar_data);
     tcase_add_test(t, refuse_one_hemisphere);
