@@ -157,27 +157,31 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
            r[7][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
     int i, l, k;
 
-    for (i = 0; i < n; i++) {
-        X[i] = b[3 * i] - ref[0];
-        Y[i] = b[3 * i + 1] - ref[1];
-        Z[i] = b[3 * i + 2] - ref[2];
-    }
-    /* Extremes of the relative coordinates, in lanes. */
+    /* Copy relative to the reference; extremes of the relative
+       coordinates, in lanes. */
     for (l = 0; l < FE__L; l++) {
-        lo[0][l] = hi[0][l] = X[0];
-        lo[1][l] = hi[1][l] = Y[0];
-        lo[2][l] = hi[2][l] = Z[0];
+        lo[0][l] = hi[0][l] = b[0] - ref[0];
+        lo[1][l] = hi[1][l] = b[1] - ref[1];
+        lo[2][l] = hi[2][l] = b[2] - ref[2];
     }
     for (i = 0; i + FE__L <= n; i += FE__L)
         for (l = 0; l < FE__L; l++) {
-            lo[0][l] = X[i + l] < lo[0][l] ? X[i + l] : lo[0][l];
-            hi[0][l] = X[i + l] > hi[0][l] ? X[i + l] : hi[0][l];
-            lo[1][l] = Y[i + l] < lo[1][l] ? Y[i + l] : lo[1][l];
-            hi[1][l] = Y[i + l] > hi[1][l] ? Y[i + l] : hi[1][l];
-            lo[2][l] = Z[i + l] < lo[2][l] ? Z[i + l] : lo[2][l];
-            hi[2][l] = Z[i + l] > hi[2][l] ? Z[i + l] : hi[2][l];
+            double x = b[3 * (i + l)] - ref[0], y = b[3 * (i + l) + 1] - ref[1],
+                   z = b[3 * (i + l) + 2] - ref[2];
+            X[i + l] = x;
+            Y[i + l] = y;
+            Z[i + l] = z;
+            lo[0][l] = x < lo[0][l] ? x : lo[0][l];
+            hi[0][l] = x > hi[0][l] ? x : hi[0][l];
+            lo[1][l] = y < lo[1][l] ? y : lo[1][l];
+            hi[1][l] = y > hi[1][l] ? y : hi[1][l];
+            lo[2][l] = z < lo[2][l] ? z : lo[2][l];
+            hi[2][l] = z > hi[2][l] ? z : hi[2][l];
         }
     for (; i < n; i++) {
+        X[i] = b[3 * i] - ref[0];
+        Y[i] = b[3 * i + 1] - ref[1];
+        Z[i] = b[3 * i + 2] - ref[2];
         lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
         hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
         lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
