@@ -220,6 +220,19 @@ START_TEST(bad_samples_leave_it_unchanged)
         ck_assert_mem_eq(&q, &before, sizeof q);
         ck_assert_int_eq(fe_quadric_add(NULL, huge), FE_EINVAL);
     }
+    /* A merge or a move whose binomial shift overflows is refused too. */
+    {
+        const double far[3] = {1e90, 0, 0};
+        fe_quadric a = FE_QUADRIC_EMPTY, b, before;
+        fe_quadric_add_many(&a, x, 10, NULL);
+        fe_quadric_init(&b, far);
+        ck_assert_int_eq(fe_quadric_add(&b, far), FE_OK);
+        before = a;
+        ck_assert_int_eq(fe_quadric_merge(&a, &b), FE_ENONFINITE);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+        ck_assert_int_eq(fe_quadric_recentre(&a, far), FE_ENONFINITE);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+    }
 }
 END_TEST
 

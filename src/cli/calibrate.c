@@ -41,7 +41,8 @@ static const char fe__calibrate_help[] =
     "too few, lie near a plane, cover one side of the sphere only, or give a\n"
     "quadric that is not an ellipsoid.  A malformed field gives\n"
     "FILE:LINE:COLUMN: message and exit status 3, with no output.  Exit status:\n"
-    "0 success, 1 refused, 2 usage, 3 malformed input, 4 input/output error.\n";
+    "0 success, 1 refused, 2 usage, 3 malformed input, 4 input/output error.\n"
+    "Progress is shown on standard error for large files when it is a terminal.\n";
 /* Calibrate Includes and Help ends here */
 /* [[file:../../literate/calibrate.org::Calibrate Options][Calibrate Options]] */
 typedef struct fe__calibrate_args {
