@@ -99,20 +99,27 @@ bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
 # ---------------------------------------------------------------- embedded
-# The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4
-# and report its code size and the size of its state.
-ARM := arm-none-eabi
+# The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4,
+# alone and linked into a program that only steps (with libgcc's soft
+# double), and report the code size and the size of its state.
+ARM   := arm-none-eabi
+ARMCC  = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -ffreestanding $(WARN) -Iinclude
 size:
 	@command -v $(ARM)-gcc >/dev/null || { [ "$$(id -u)" = 0 ] && \
 	  apt-get install -y -q --no-install-recommends gcc-arm-none-eabi; } || \
 	  { echo "size: needs $(ARM)-gcc: sudo apt-get install -y gcc-arm-none-eabi"; exit 1; }
-	@mkdir -p $(B)/arm && printf '#include "foldest/quadric.h"\nfe_quadric fe_state;\n' > $(B)/arm/state.c
-	$(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -std=c11 -ffreestanding $(WARN) -Iinclude -c src/quadric.c -o $(B)/arm/quadric.o
-	@$(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -std=c11 -ffreestanding -Iinclude -c $(B)/arm/state.c -o $(B)/arm/state.o
-	@$(ARM)-size $(B)/arm/quadric.o
-	@set -- $$($(ARM)-nm -S $(B)/arm/quadric.o | grep ' fe_quadric_add$$'); printf 'fe_quadric_add (the step): %d bytes of code\n' 0x$$2
-	@set -- $$($(ARM)-nm -S $(B)/arm/state.o | grep ' fe_state$$'); printf 'fe_quadric (the state): %d bytes\n' 0x$$2
-	@echo "undefined symbols (compiler runtime only):" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
+	@mkdir -p $(B)/arm && printf '%s\n' '#include <stddef.h>' '#include "foldest/quadric.h"' \
+	  'fe_quadric fe_state;' 'int fe_probe(const double *x);' \
+	  'int fe_probe(const double *x) { return fe_quadric_add(&fe_state, x); }' \
+	  'void *memcpy(void *d, const void *s, size_t n) { char *a = d; const char *b = s; while (n--) *a++ = *b++; return d; }' \
+	  'void *memset(void *d, int c, size_t n) { char *a = d; while (n--) *a++ = (char)c; return d; }' > $(B)/arm/probe.c
+	$(ARMCC) -c src/quadric.c -o $(B)/arm/quadric.o
+	@$(ARMCC) -ffunction-sections -fdata-sections -nostdlib -Wl,--gc-sections -Wl,-e,fe_probe \
+	  src/quadric.c $(B)/arm/probe.c -lgcc -o $(B)/arm/step.elf
+	@$(ARM)-size $(B)/arm/quadric.o $(B)/arm/step.elf
+	@set -- $$($(ARM)-size $(B)/arm/step.elf | tail -1); \
+	  printf 'the step with its soft-double routines: %d bytes of flash; the state: %d bytes of RAM\n' $$1 $$3
+	@echo "quadric.o needs only the compiler's runtime:" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
 
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
