@@ -153,8 +153,8 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
                               double out[35], double rlo[3], double rhi[3])
 {
     double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
-    double a[9][FE__L] = {{0}}, c[10][FE__L] = {{0}}, q[8][FE__L] = {{0}},
-           r[7][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
+    double a[9][FE__L] = {{0}}, c[9][FE__L] = {{0}}, q[8][FE__L] = {{0}},
+           r[8][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
     int i, l, k;
 
     /* Copy relative to the reference; extremes of the relative
@@ -209,11 +209,10 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
             double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
-                   yz = y * z, zz = z * z;
+                   yz = y * z;
             c[0][l] += xx * x; c[1][l] += xx * y; c[2][l] += xx * z;
             c[3][l] += xy * y; c[4][l] += xy * z; c[5][l] += xz * z;
             c[6][l] += yy * y; c[7][l] += yy * z; c[8][l] += yz * z;
-            c[9][l] += zz * z;
         }
     for (i = 0; i + FE__L <= n; i += FE__L)
         for (l = 0; l < FE__L; l++) {
@@ -231,7 +230,7 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
                    zz = z * z;
             r[0][l] += xy * zz; r[1][l] += xz * zz; r[2][l] += yy * yy;
             r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
-            r[6][l] += zz * zz;
+            r[6][l] += zz * zz; r[7][l] += zz * z;
         }
     for (k = 0; k < 35; k++)
         out[k] = 0.0;
@@ -239,8 +238,9 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
     for (l = 0; l < FE__L; l++) {
         for (k = 0; k < 9; k++)
             out[1 + k] += a[k][l];
-        for (k = 0; k < 10; k++)
+        for (k = 0; k < 9; k++)
             out[10 + k] += c[k][l];
+        out[19] += r[7][l];             /* the ninth of r is the tenth cubic */
         for (k = 0; k < 8; k++)
             out[20 + k] += q[k][l];
         for (k = 0; k < 7; k++)
