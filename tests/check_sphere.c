@@ -135,6 +135,20 @@ START_TEST(precision_with_a_large_offset)
                       param_diff(&streaming, &stored));
         FE_ASSERT_REL(streaming.rms_percent, stored.rms_percent, 1e-6);
     }
+    /* Raw power sums (moments about the origin) lose the shape: the fit
+       is refused or its centre is off by more than the radius. */
+    {
+        const double origin[3] = {0, 0, 0};
+        fe_quadric raw;
+        fe_sphere_fit f;
+        int rc;
+        ellipsoid_points(x, N, c, r, 1e-3, 13);
+        fe_quadric_init(&raw, origin);
+        fe_quadric_add_many(&raw, x, N, NULL);
+        rc = fe_sphere_fit_moments(&raw, FE_FIT_AXIAL, NULL, &f);
+        ck_assert_msg(rc != FE_OK || fabs(f.offset[0] - c[0]) > 1.0,
+                      "raw sums fitted: rc %d, offset %.17g", rc, f.offset[0]);
+    }
 }
 END_TEST
 
