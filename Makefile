@@ -50,7 +50,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo run-examples bench install uninstall clean \
+        check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
         check-tsan check-mpi bench-mpi
 
 all: lib cli examples
@@ -124,6 +124,29 @@ check-mpi: $(MPI_PROGS)
 
 bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
 	@for b in $^; do echo "== $$b"; OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 $(MPIRUN) $$b || exit 1; done
+
+# ---------------------------------------------------------------- embedded
+# The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4,
+# alone and linked into a program that only steps (with libgcc's soft
+# double), and report the code size and the size of its state.
+ARM   := arm-none-eabi
+ARMCC  = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -ffreestanding $(WARN) -Iinclude
+size:
+	@command -v $(ARM)-gcc >/dev/null || { [ "$$(id -u)" = 0 ] && \
+	  apt-get install -y -q --no-install-recommends gcc-arm-none-eabi; } || \
+	  { echo "size: needs $(ARM)-gcc: sudo apt-get install -y gcc-arm-none-eabi"; exit 1; }
+	@mkdir -p $(B)/arm && printf '%s\n' '#include <stddef.h>' '#include "foldest/quadric.h"' \
+	  'fe_quadric fe_state;' 'int fe_probe(const double *x);' \
+	  'int fe_probe(const double *x) { return fe_quadric_add(&fe_state, x); }' \
+	  'void *memcpy(void *d, const void *s, size_t n) { char *a = d; const char *b = s; while (n--) *a++ = *b++; return d; }' \
+	  'void *memset(void *d, int c, size_t n) { char *a = d; while (n--) *a++ = (char)c; return d; }' > $(B)/arm/probe.c
+	$(ARMCC) -c src/quadric.c -o $(B)/arm/quadric.o
+	@$(ARMCC) -ffunction-sections -fdata-sections -nostdlib -Wl,--gc-sections -Wl,-e,fe_probe \
+	  src/quadric.c $(B)/arm/probe.c -lgcc -o $(B)/arm/step.elf
+	@$(ARM)-size $(B)/arm/quadric.o $(B)/arm/step.elf
+	@set -- $$($(ARM)-size $(B)/arm/step.elf | tail -1); \
+	  printf 'the step with its soft-double routines: %d bytes of flash; the state: %d bytes of RAM\n' $$1 $$3
+	@echo "quadric.o needs only the compiler's runtime:" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
 
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines

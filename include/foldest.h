@@ -20,6 +20,8 @@
 #include "foldest/lm.h"
 #include "foldest/kalman.h"
 #include "foldest/parallel.h"
+#include "foldest/quadric.h"
+#include "foldest/sphere.h"
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

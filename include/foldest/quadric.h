@@ -1,0 +1,93 @@
+/* Tangled from literate/quadric.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/quadric.org::Quadric Moment Declarations][Quadric Moment Declarations]] */
+#ifndef FOLDEST_QUADRIC_H
+#define FOLDEST_QUADRIC_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "foldest/fold.h"
+
+enum {
+    FE_QUADRIC_MOMENTS = 35,    /* monomials of degree <= 4 in 3 variables */
+    FE_QUADRIC_REGIONS = 100    /* equal-area regions of the sphere */
+};
+
+/* Flags of an accumulation. */
+enum {
+    FE_QUADRIC_HAS_REF = 1,     /* ref[] is set (first sample, or supplied) */
+    FE_QUADRIC_FIXED_REF = 2    /* ref[] was supplied: it is also the centre
+                                   for coverage */
+};
+
+/* The sufficient statistics of every quadric fit of three-axis samples:
+   moments of degree <= 4 of u = x - ref, per-axis extremes of x, and the
+   regions visited (with the box size at the visit).  A flat value: copy
+   it, store it, send it.  All zero bytes is the empty accumulation whose
+   reference is its first sample. */
+typedef struct fe_quadric {
+    double m[FE_QUADRIC_MOMENTS];  /* m[0] = N; m[k] = sum of u^alpha_k */
+    double ref[3];                 /* the reference point c */
+    double lo[3], hi[3];           /* per-axis min and max of x (N > 0) */
+    float seen[FE_QUADRIC_REGIONS];  /* box size when region r was last
+                                      visited; 0: never */
+    uint32_t flags;                /* FE_QUADRIC_HAS_REF, _FIXED_REF */
+    uint32_t reserved;             /* zero */
+} fe_quadric;
+
+#define FE_QUADRIC_EMPTY {{0}, {0}, {0}, {0}, {0}, 0, 0}
+
+/* fe_quadric_init: the empty accumulation.  `centre` NULL: the reference
+   is the first sample and coverage is measured from the centre of the
+   bounding box; otherwise `centre` (3 doubles, copied) is the reference
+   and the centre for coverage.  FE_EINVAL for NULL q, FE_ENONFINITE for a
+   non-finite centre. */
+int fe_quadric_init(fe_quadric *q, const double *centre);
+
+/* fe_quadric_add: fold one sample x[0..2].  FE_ENONFINITE when x is not
+   finite or a moment would overflow; then q is unchanged.  No allocation,
+   no libc: freestanding. */
+int fe_quadric_add(fe_quadric *q, const double x[3]);
+
+/* fe_quadric_add_many: fold the n samples x[3k..3k+2], faster than n
+   calls of fe_quadric_add (blocks of 512, vector code where the compiler
+   offers it), with the same result up to rounding of the moments (the
+   extremes and the coverage are identical).  Stops at the first sample
+   refused; *done (if not NULL) receives how many were folded. */
+int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
+                        size_t *done);
+
+/* fe_quadric_merge: a <- a (+) b.  b's moments are moved to a's
+   reference (binomial expansion) and added; extremes and coverage combine.
+   FE_ENONFINITE on overflow; then a is unchanged. */
+int fe_quadric_merge(fe_quadric *a, const fe_quadric *b);
+
+/* fe_quadric_recentre: move q's moments to the reference `ref`.  Cost:
+   about 400 multiplications.  FE_ENONFINITE on overflow (q unchanged). */
+int fe_quadric_recentre(fe_quadric *q, const double ref[3]);
+
+/* fe_quadric_count: N.  fe_quadric_regions: the number of regions
+   visited while the box was at least half its final size (its largest
+   half-width).  fe_quadric_coverage: their fraction of 100, in [0, 1]. */
+uint64_t fe_quadric_count(const fe_quadric *q);
+double fe_quadric_coverage(const fe_quadric *q);
+int fe_quadric_regions(const fe_quadric *q);
+
+/* fe_quadric_region: the region (0..99) of the direction v (any length),
+   or -1 for v = 0 or non-finite.  Band = floor(5 (z/|v| + 1)), sector =
+   floor(longitude / 36 degrees): region = 10 band + sector. */
+int fe_quadric_region(const double v[3]);
+
+/* fe_quadric_index: position in m[] of the moment sum u1^a u2^b u3^c, or
+   -1 when a + b + c > 4.  fe_quadric_exponents: the inverse (k < 35). */
+int fe_quadric_index(int a, int b, int c);
+void fe_quadric_exponents(int k, int e[3]);
+
+/* fe_quadric_accumulator: the accumulator for fe_fold and friends, over
+   observations of 3 doubles and accumulations of type fe_quadric.
+   `centre` (NULL, or 3 doubles that must outlive the descriptor) is given
+   to fe_quadric_init by fe_init. */
+fe_accumulator fe_quadric_accumulator(const double *centre);
+
+#endif /* FOLDEST_QUADRIC_H */
+/* Quadric Moment Declarations ends here */

@@ -1,0 +1,134 @@
+/* Tangled from literate/sphere.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/sphere.org::Sphere Fit Declarations][Sphere Fit Declarations]] */
+#ifndef FOLDEST_SPHERE_H
+#define FOLDEST_SPHERE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "foldest/quadric.h"
+
+/* The models. */
+typedef enum fe_sphere_model {
+    FE_FIT_SPHERE = 0,          /* centre and radius: 4 parameters */
+    FE_FIT_AXIAL = 1,           /* centre and three axis scales: 6 */
+    FE_FIT_ELLIPSOID = 2        /* centre and symmetric matrix: 9 */
+} fe_sphere_model;
+
+enum { FE_SPHERE_MAX_PARAMS = 9 };
+
+/* Why a fit was refused (fit->refusal); 0 when it was not. */
+enum fe_sphere_refusal {
+    FE_SPHERE_ACCEPTED = 0,
+    FE_SPHERE_TOO_FEW,          /* no more samples than parameters */
+    FE_SPHERE_PLANAR,           /* samples near a plane or a line */
+    FE_SPHERE_HEMISPHERE,       /* samples on one side of the centre */
+    FE_SPHERE_COVERAGE,         /* coverage below min_coverage */
+    FE_SPHERE_NOT_PD,           /* fitted quadric is not an ellipsoid */
+    FE_SPHERE_DEGENERATE,       /* a fitted scale is zero */
+    FE_SPHERE_SINGULAR,         /* Gauss-Newton matrix not positive definite */
+    FE_SPHERE_NO_CONVERGENCE,   /* iteration limit reached */
+    FE_SPHERE_UNBOUNDED         /* the best fit flattens into a plane */
+};
+
+/* One iteration, for the trace callback. */
+typedef struct fe_sphere_iteration {
+    int iteration;              /* from 1 */
+    double cost;                /* S at the current parameters */
+    double trial_cost;          /* S at current + step */
+    double lambda;              /* damping used for the step */
+    double step;                /* max |step| (frame of the solve) */
+    int accepted;               /* the step lowered the cost */
+    int nparams;
+    const double *params;       /* after the iteration, frame of the solve */
+} fe_sphere_iteration;
+
+/* A nonzero return stops the fit, which then returns FE_ESTOPPED. */
+typedef int fe_sphere_trace_fn(const fe_sphere_iteration *it, void *ctx);
+
+typedef struct fe_sphere_options {
+    int max_iterations;         /* default 100 */
+    double xtol;                /* default 1e-11, relative step */
+    double min_planarity;       /* default 1e-3; 0 disables */
+    double min_extent;          /* default 0.5; 0 disables */
+    double min_coverage;        /* default 0 (report only) */
+    fe_sphere_trace_fn *trace;  /* NULL: no trace */
+    void *trace_ctx;
+} fe_sphere_options;
+
+/* fe_sphere_default_options: the defaults above, by value. */
+fe_sphere_options fe_sphere_default_options(void);
+
+/* A fit.  Units are the sensor's.  matrix is row-major. */
+typedef struct fe_sphere_fit {
+    int model;                  /* fe_sphere_model */
+    int refusal;                /* enum fe_sphere_refusal */
+    uint64_t n;                 /* samples */
+    int nparams;
+    double offset[3];           /* b, the centre */
+    double matrix[9];           /* M: y = M (x - b) lies on the unit sphere */
+    double radius;              /* the field: geometric mean of semi-axes */
+    double axes[3];             /* semi-axes, ascending */
+    double params[FE_SPHERE_MAX_PARAMS]; /* b, then s (sphere), s1 s2 s3
+                                   (axial) or A11 A12 A13 A22 A23 A33 of
+                                   A_x = M^T M (ellipsoid) */
+    double se[FE_SPHERE_MAX_PARAMS];     /* standard errors of params */
+    double cov[FE_SPHERE_MAX_PARAMS * FE_SPHERE_MAX_PARAMS]; /* row-major,
+                                   nparams x nparams */
+    double rss;                 /* S = sum of r_i^2, r_i = 1 - |y_i|^2 */
+    double rms_percent;         /* 50 sqrt(S / n) */
+    double coverage;            /* fraction of the 100 regions visited */
+    double extent_lo[3], extent_hi[3]; /* per axis, in half-widths */
+    double planarity;           /* smallest/largest covariance eigenvalue */
+    int iterations;
+    double frame_centre[3];     /* c and sigma of the solve's frame */
+    double frame_scale;
+} fe_sphere_fit;
+
+/* fe_sphere_fit_moments: (iii), the fit users call.  Fits `model` to the
+   moments `q`.  No allocation (a few kilobytes of stack).  Returns FE_OK;
+   FE_ETOOFEW, FE_EUNDETERMINED, FE_ENOTPD or FE_ENOCONV with fit->refusal
+   saying why (fit holds what was measured); FE_ESTOPPED when the trace
+   asked; FE_EINVAL for NULL or an unknown model; FE_EINTERNAL if LAPACK
+   rejects an argument.  opt NULL: defaults.  Cost: one moment shift and
+   a few dozen 10x10 products per iteration, independent of N. */
+int fe_sphere_fit_moments(const fe_quadric *q, fe_sphere_model model,
+                          const fe_sphere_options *opt, fe_sphere_fit *fit);
+
+/* fe_sphere_fit_stored: (ii), the same fit by accumulating J^T J and
+   J^T r over the n stored samples xyz[3i..3i+2] at every iteration.
+   Same errors as fe_sphere_fit_moments. */
+int fe_sphere_fit_stored(const double *xyz, size_t n, fe_sphere_model model,
+                         const fe_sphere_options *opt, fe_sphere_fit *fit);
+
+/* fe_sphere_naive_workspace: doubles of workspace fe_sphere_fit_naive
+   needs for n samples: n (p + 1). */
+size_t fe_sphere_naive_workspace(size_t n, fe_sphere_model model);
+
+/* fe_sphere_fit_naive: (i), the same fit materialising J and r in the
+   caller's `work` (work_len doubles; FE_ESIZE if too small). */
+int fe_sphere_fit_naive(const double *xyz, size_t n, fe_sphere_model model,
+                        const fe_sphere_options *opt, double *work,
+                        size_t work_len, fe_sphere_fit *fit);
+
+/* fe_sphere_cost: S = sum of (1 - |M (x_i - b)|^2)^2 of the calibration
+   `fit` over the samples summarised by q (other data than it was fitted
+   on, say), from the moments.  FE_EINVAL for NULL. */
+int fe_sphere_cost(const fe_quadric *q, const fe_sphere_fit *fit,
+                   double *rss);
+
+/* fe_sphere_apply: y = M (x - b), the calibrated sample on the unit
+   sphere.  x and y may be the same array. */
+void fe_sphere_apply(const fe_sphere_fit *fit, const double x[3],
+                     double y[3]);
+
+/* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
+   fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */
+const char *fe_sphere_model_name(int model);
+int fe_sphere_model_parse(const char *name, fe_sphere_model *model);
+
+/* fe_sphere_refusal_string: a sentence for fit->refusal. */
+const char *fe_sphere_refusal_string(int refusal);
+
+#endif /* FOLDEST_SPHERE_H */
+/* Sphere Fit Declarations ends here */

@@ -1,0 +1,410 @@
+/* Tangled from literate/calibrate.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../../literate/calibrate.org::Calibrate Includes and Help][Calibrate Includes and Help]] */
+#include "cli.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char fe__calibrate_help[] =
+    "usage: foldest calibrate [--model sphere|axial|ellipsoid] [--columns a,b,c]\n"
+    "                         [--skip N] [--json] [--trace] [--apply OUT.csv]\n"
+    "                         FILE.csv|-\n"
+    "\n"
+    "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
+    "the matrix M such that y = M (x - b) lies on the unit sphere, from samples\n"
+    "taken in many orientations (a constant field, or gravity at rest).\n"
+    "\n"
+    "  --model M       sphere (offset, radius), axial (offset, three axis\n"
+    "                  scales; the default) or ellipsoid (offset and a symmetric\n"
+    "                  matrix: soft iron, cross-axis terms)\n"
+    "  --columns a,b,c the three columns, by header name, unique prefix or number\n"
+    "                  from 1; default: the table's columns when it has three\n"
+    "  --skip N        skip N lines before the header (default: found\n"
+    "                  automatically after metadata lines)\n"
+    "  --json          print one JSON object: model, n, offset, offset_se,\n"
+    "                  matrix (3x3, to the unit sphere), radius, axes, params,\n"
+    "                  params_se, rms_percent, rms_radial_percent, coverage,\n"
+    "                  coverage_fold, planarity, extent_lo, extent_hi,\n"
+    "                  iterations, refusal\n"
+    "  --trace         print the Gauss-Newton iterations on standard error\n"
+    "  --apply OUT.csv write the calibrated samples R M (x - b) (R: the fitted\n"
+    "                  field) to OUT.csv; needs a file, not standard input\n"
+    "\n"
+    "The samples are folded once into 35 moments; the fit never reads them again.\n"
+    "From a file a second pass counts the coverage exactly from the fitted centre\n"
+    "(100 equal-area regions), measures the radial RMS error, and writes --apply.\n"
+    "rms_percent is 50 sqrt(S/n), S the sum of (1 - |y|^2)^2: the RMS radial\n"
+    "error to first order.\n"
+    "\n"
+    "The fit is refused (exit status 1, with the reason) when the samples are\n"
+    "too few, lie near a plane, cover one side of the sphere only, or give a\n"
+    "quadric that is not an ellipsoid.  A malformed field gives\n"
+    "FILE:LINE:COLUMN: message and exit status 3, with no output.  Exit status:\n"
+    "0 success, 1 refused, 2 usage, 3 malformed input, 4 input/output error.\n"
+    "Progress is shown on standard error for large files when it is a terminal.\n";
+/* Calibrate Includes and Help ends here */
+/* [[file:../../literate/calibrate.org::Calibrate Options][Calibrate Options]] */
+typedef struct fe__calibrate_args {
+    const char *path, *apply;
+    char *columns;
+    long skip;
+    int json, trace;
+    fe_sphere_model model;
+} fe__calibrate_args;
+
+/* Parse argv; FE_CLI_OK, or an exit status after printing why (-1 for
+   --help, printed). */
+static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
+{
+    char err[512];
+    memset(a, 0, sizeof *a);
+    a->skip = -1;
+    a->model = FE_FIT_AXIAL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(fe__calibrate_help, stdout);
+            return -1;
+        } else if (strcmp(argv[i], "--json") == 0) {
+            a->json = 1;
+        } else if (strcmp(argv[i], "--trace") == 0) {
+            a->trace = 1;
+        } else if (strcmp(argv[i], "--model") == 0 && i + 1 < argc) {
+            if (fe_sphere_model_parse(argv[++i], &a->model) != FE_OK) {
+                fprintf(stderr, "foldest calibrate: --model: '%s' is not sphere, axial or ellipsoid\n",
+                        argv[i]);
+                return FE_CLI_USAGE;
+            }
+        } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
+            a->columns = argv[++i];
+        } else if (strcmp(argv[i], "--apply") == 0 && i + 1 < argc) {
+            a->apply = argv[++i];
+        } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
+            if (fe_cli_parse_long("--skip", argv[++i], &a->skip, err, sizeof err) != FE_CLI_OK
+                || a->skip < 0) {
+                fprintf(stderr, "foldest calibrate: %s\n", a->skip < 0 ? "--skip: negative" : err);
+                return FE_CLI_USAGE;
+            }
+        } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
+            fprintf(stderr, "foldest calibrate: unknown option or missing value '%s'\n%s",
+                    argv[i], fe__calibrate_help);
+            return FE_CLI_USAGE;
+        } else if (a->path == NULL) {
+            a->path = argv[i];
+        } else {
+            fprintf(stderr, "foldest calibrate: one input file, please\n");
+            return FE_CLI_USAGE;
+        }
+    }
+    if (a->path == NULL) {
+        fputs(fe__calibrate_help, stderr);
+        return FE_CLI_USAGE;
+    }
+    if (a->apply != NULL && strcmp(a->path, "-") == 0) {
+        fprintf(stderr, "foldest calibrate: --apply reads the input twice (fit, then "
+                        "calibrate): give a file, not standard input\n");
+        return FE_CLI_USAGE;
+    }
+    return FE_CLI_OK;
+}
+/* Calibrate Options ends here */
+/* [[file:../../literate/calibrate.org::Choose the columns and fold the samples][Choose the columns and fold the samples]] */
+static int fe__calibrate_columns(fe_cli_table *t, char *spec, size_t cols[3])
+{
+    char err[2048], *names[4];
+    int n;
+    if (spec == NULL) {
+        if (t->ncols == 3) {
+            for (size_t j = 0; j < 3; j++)
+                cols[j] = j;
+            return FE_CLI_OK;
+        }
+        fprintf(stderr, "foldest calibrate: %s has %zu columns: name three with "
+                        "--columns a,b,c; the columns are:", t->name, t->ncols);
+        for (size_t j = 0; j < t->ncols; j++)
+            fprintf(stderr, "%s '%s'", j ? "," : "", t->names[j]);
+        fputc('\n', stderr);
+        return FE_CLI_USAGE;
+    }
+    n = fe_cli_split_list(spec, names, 4);
+    if (n != 3) {
+        fprintf(stderr, "foldest calibrate: --columns needs three columns, a,b,c\n");
+        return FE_CLI_USAGE;
+    }
+    for (int j = 0; j < 3; j++)
+        if (fe_cli_table_column(t, names[j], &cols[j], err, sizeof err) != FE_CLI_OK) {
+            fprintf(stderr, "foldest calibrate: %s\n", err);
+            return FE_CLI_USAGE;
+        }
+    return FE_CLI_OK;
+}
+
+static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[3], fe_quadric *q)
+{
+    char err[1024];
+    double x[3];
+    int rc;
+    fe_quadric_init(q, NULL);
+    while ((rc = fe_cli_table_next(t, cols, 3, x, err, sizeof err)) == FE_OK) {
+        rc = fe_quadric_add(q, x);
+        if (rc != FE_OK) {
+            fe_cli_progress_done(t);
+            fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line,
+                    fe_strerror(rc));
+            return FE_CLI_INPUT;
+        }
+        fe_cli_progress(t);
+    }
+    fe_cli_progress_done(t);
+    if (rc != FE_END) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        return rc;
+    }
+    if (t->rows == 0) {
+        fprintf(stderr, "foldest calibrate: %s: no data rows\n", t->name);
+        return FE_CLI_INPUT;
+    }
+    return FE_CLI_OK;
+}
+/* Choose the columns and fold the samples ends here */
+/* [[file:../../literate/calibrate.org::Measure exactly and apply in a second pass][Measure exactly and apply in a second pass]] */
+typedef struct fe__calibrate_pass2 {
+    int done;                   /* the pass ran */
+    int regions;
+    double rms_radial_percent;
+} fe__calibrate_pass2;
+
+static int fe__calibrate_second_pass(const fe__calibrate_args *a,
+                                     const size_t cols[3],
+                                     const fe_sphere_fit *fit,
+                                     fe__calibrate_pass2 *out)
+{
+    char err[1024];
+    unsigned char hit[FE_QUADRIC_REGIONS] = {0};
+    double x[3], y[3], ss = 0.0;
+    const char *apply = a->apply;
+    fe_cli_output o;
+    fe_cli_table table, *t = &table;
+    int rc;
+
+    memset(out, 0, sizeof *out);
+    if (strcmp(a->path, "-") == 0)
+        return FE_CLI_OK;       /* standard input: no second pass */
+    rc = fe_cli_table_open(t, a->path, a->skip, err, sizeof err);
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        return rc;
+    }
+    if (apply != NULL) {
+        rc = fe_cli_output_open(&o, apply, err, sizeof err);
+        if (rc != FE_CLI_OK) {
+            fprintf(stderr, "foldest calibrate: %s\n", err);
+            fe_cli_table_close(t);
+            return rc;
+        }
+        fprintf(o.file, "%s_cal,%s_cal,%s_cal\n", t->names[cols[0]],
+                t->names[cols[1]], t->names[cols[2]]);
+    }
+    while ((rc = fe_cli_table_next(t, cols, 3, x, err, sizeof err)) == FE_OK) {
+        int r;
+        double len;
+        fe_sphere_apply(fit, x, y);
+        r = fe_quadric_region(y);
+        if (r >= 0)
+            hit[r] = 1;
+        len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+        ss += (len - 1.0) * (len - 1.0);
+        if (apply != NULL)
+            fprintf(o.file, "%.10g,%.10g,%.10g\n", fit->radius * y[0],
+                    fit->radius * y[1], fit->radius * y[2]);
+        fe_cli_progress(t);
+    }
+    fe_cli_progress_done(t);
+    if (rc != FE_END) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        if (apply != NULL)
+            fe_cli_output_abort(&o);
+        fe_cli_table_close(t);
+        return rc;
+    }
+    if (apply != NULL && fe_cli_output_commit(&o, err, sizeof err) != FE_CLI_OK) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        fe_cli_table_close(t);
+        return FE_CLI_IO;
+    }
+    out->done = 1;
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        out->regions += hit[r];
+    out->rms_radial_percent = t->rows > 0 ? 100.0 * sqrt(ss / (double)t->rows) : 0.0;
+    fe_cli_table_close(t);
+    return FE_CLI_OK;
+}
+/* Measure exactly and apply in a second pass ends here */
+/* [[file:../../literate/calibrate.org::Print a calibration][Print a calibration]] */
+static void fe__calibrate_json_array(const double *v, int n)
+{
+    printf("[");
+    for (int k = 0; k < n; k++)
+        printf("%s%.10g", k ? ", " : "", v[k]);
+    printf("]");
+}
+
+static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
+                               int rc, const fe__calibrate_pass2 *p2)
+{
+    int fitted = rc == FE_OK || f->refusal == FE_SPHERE_HEMISPHERE
+                 || f->refusal == FE_SPHERE_COVERAGE;
+    printf("{\"file\": ");
+    fe_cli_json_string(stdout, t->name);
+    printf(", \"model\": \"%s\", \"n\": %llu", fe_sphere_model_name(f->model),
+           (unsigned long long)f->n);
+    if (fitted && f->iterations > 0 && f->radius > 0.0) {
+        printf(", \"offset\": ");
+        fe__calibrate_json_array(f->offset, 3);
+        printf(", \"offset_se\": ");
+        fe__calibrate_json_array(f->se, 3);
+        printf(", \"matrix\": [");
+        for (int i = 0; i < 3; i++) {
+            printf("%s", i ? ", " : "");
+            fe__calibrate_json_array(f->matrix + 3 * i, 3);
+        }
+        printf("], \"radius\": %.10g, \"axes\": ", f->radius);
+        fe__calibrate_json_array(f->axes, 3);
+        printf(", \"params\": ");
+        fe__calibrate_json_array(f->params, f->nparams);
+        printf(", \"params_se\": ");
+        fe__calibrate_json_array(f->se, f->nparams);
+        printf(", \"rms_percent\": %.6g", f->rms_percent);
+    } else {
+        printf(", \"offset\": null, \"matrix\": null, \"rms_percent\": null");
+    }
+    if (p2->done)
+        printf(", \"rms_radial_percent\": %.6g, \"coverage\": %.2f",
+               p2->rms_radial_percent, p2->regions / 100.0);
+    else
+        printf(", \"rms_radial_percent\": null, \"coverage\": %.2f", f->coverage);
+    printf(", \"coverage_fold\": %.2f, \"planarity\": %.4g", f->coverage, f->planarity);
+    if (f->extent_lo[0] != 0.0 || f->extent_hi[0] != 0.0) {
+        printf(", \"extent_lo\": ");
+        fe__calibrate_json_array(f->extent_lo, 3);
+        printf(", \"extent_hi\": ");
+        fe__calibrate_json_array(f->extent_hi, 3);
+    }
+    printf(", \"iterations\": %d, \"refusal\": ", f->iterations);
+    if (rc == FE_OK)
+        printf("null");
+    else
+        fe_cli_json_string(stdout, f->refusal != FE_SPHERE_ACCEPTED
+                                       ? fe_sphere_refusal_string(f->refusal)
+                                       : fe_strerror(rc));
+    printf("}\n");
+}
+
+static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
+                               const fe__calibrate_pass2 *p2)
+{
+    static const char *const axis[3] = {"x", "y", "z"};
+    printf("%s: %s fit of %llu samples, %d iterations\n", t->name,
+           fe_sphere_model_name(f->model), (unsigned long long)f->n, f->iterations);
+    printf("  offset b         ");
+    for (int j = 0; j < 3; j++)
+        printf("  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
+    printf("\n  matrix M (y = M (x - b) on the unit sphere)\n");
+    for (int i = 0; i < 3; i++)
+        printf("      %14.7g %14.7g %14.7g\n", f->matrix[3 * i], f->matrix[3 * i + 1],
+               f->matrix[3 * i + 2]);
+    printf("  field            %.6g (semi-axes %.6g %.6g %.6g)\n", f->radius, f->axes[0],
+           f->axes[1], f->axes[2]);
+    if (f->model != FE_FIT_ELLIPSOID) {
+        printf("  scales          ");
+        for (int k = 3; k < f->nparams; k++)
+            printf("  %.6g +- %.2g", f->params[k], f->se[k]);
+        printf("\n");
+    }
+    printf("  rms residual     %.3f %% of the field", f->rms_percent);
+    if (p2->done)
+        printf(" (radial, exact: %.3f %%)", p2->rms_radial_percent);
+    printf("\n  coverage         %d %% of 100 equal-area regions%s\n",
+           p2->done ? p2->regions : (int)lround(100 * f->coverage),
+           p2->done ? "" : " (estimated in the fold)");
+    printf("  extents          x [%.2f, %.2f]  y [%.2f, %.2f]  z [%.2f, %.2f]\n",
+           f->extent_lo[0], f->extent_hi[0], f->extent_lo[1], f->extent_hi[1],
+           f->extent_lo[2], f->extent_hi[2]);
+}
+
+static void fe__calibrate_refusal(const fe_cli_table *t, const fe_sphere_fit *f, int rc)
+{
+    fprintf(stderr, "foldest calibrate: %s: %s fit refused: %s\n", t->name,
+            fe_sphere_model_name(f->model),
+            f->refusal != FE_SPHERE_ACCEPTED ? fe_sphere_refusal_string(f->refusal)
+                                             : fe_strerror(rc));
+    fprintf(stderr, "  %llu samples, coverage about %.0f %%, planarity %.3g",
+            (unsigned long long)f->n, 100 * f->coverage, f->planarity);
+    if (f->refusal == FE_SPHERE_HEMISPHERE)
+        fprintf(stderr, "; the samples reach x [%.2f, %.2f]  y [%.2f, %.2f]  z [%.2f, %.2f]"
+                        " of the half-widths about the centre",
+                f->extent_lo[0], f->extent_hi[0], f->extent_lo[1], f->extent_hi[1],
+                f->extent_lo[2], f->extent_hi[2]);
+    fputc('\n', stderr);
+}
+
+static int fe__calibrate_trace(const fe_sphere_iteration *it, void *ctx)
+{
+    (void)ctx;
+    fprintf(stderr, "iteration %2d: cost %.10g, trial %.10g, lambda %.3g, step %.3g%s\n",
+            it->iteration, it->cost, it->trial_cost, it->lambda, it->step,
+            it->accepted ? "" : " (rejected)");
+    return 0;
+}
+/* Print a calibration ends here */
+/* [[file:../../literate/calibrate.org::Calibrate a recording][Calibrate a recording]] */
+int fe_cli_calibrate(int argc, char **argv)
+{
+    fe__calibrate_args a;
+    fe__calibrate_pass2 p2;
+    fe_sphere_options opt = fe_sphere_default_options();
+    fe_cli_table t;
+    fe_quadric q;
+    fe_sphere_fit fit;
+    size_t cols[3];
+    char err[1024];
+    int rc = fe__calibrate_parse(argc, argv, &a), fitrc;
+
+    if (rc != FE_CLI_OK)
+        return rc < 0 ? FE_CLI_OK : rc;
+    rc = fe_cli_table_open(&t, a.path, a.skip, err, sizeof err);
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        return rc;
+    }
+    rc = fe__calibrate_columns(&t, a.columns, cols);
+    if (rc == FE_CLI_OK)
+        rc = fe__calibrate_fold(&t, cols, &q);
+    if (rc != FE_CLI_OK) {
+        fe_cli_table_close(&t);
+        return rc;
+    }
+    if (a.trace)
+        opt.trace = fe__calibrate_trace;
+    fitrc = fe_sphere_fit_moments(&q, a.model, &opt, &fit);
+    memset(&p2, 0, sizeof p2);
+    if (fitrc == FE_OK) {
+        rc = fe__calibrate_second_pass(&a, cols, &fit, &p2);
+        if (rc != FE_CLI_OK) {
+            fe_cli_table_close(&t);
+            return rc;
+        }
+    }
+    if (a.json)
+        fe__calibrate_json(&t, &fit, fitrc, &p2);
+    if (fitrc != FE_OK) {
+        fe__calibrate_refusal(&t, &fit, fitrc);
+        fe_cli_table_close(&t);
+        return FE_CLI_REFUSED;
+    }
+    if (!a.json)
+        fe__calibrate_text(&t, &fit, &p2);
+    fe_cli_table_close(&t);
+    return FE_CLI_OK;
+}
+/* Calibrate a recording ends here */

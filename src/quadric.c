@@ -1,0 +1,525 @@
+/* Tangled from literate/quadric.org: do not edit; edit the .org and run make tangle. */
+/* [[file:../literate/quadric.org::Quadric Includes][Quadric Includes]] */
+#include "foldest/error.h"
+#include "foldest/quadric.h"
+
+enum { FE__QUADRIC_BLOCK = 512, FE__QUADRIC_LANES = 4 };
+
+/* The exponents (a, b, c) of moment k, in the order of m[]. */
+static const unsigned char fe__quadric_exp[FE_QUADRIC_MOMENTS][3] = {
+    {0,0,0},
+    {1,0,0},{0,1,0},{0,0,1},
+    {2,0,0},{1,1,0},{1,0,1},{0,2,0},{0,1,1},{0,0,2},
+    {3,0,0},{2,1,0},{2,0,1},{1,2,0},{1,1,1},{1,0,2},{0,3,0},{0,2,1},{0,1,2},{0,0,3},
+    {4,0,0},{3,1,0},{3,0,1},{2,2,0},{2,1,1},{2,0,2},{1,3,0},{1,2,1},{1,1,2},{1,0,3},
+    {0,4,0},{0,3,1},{0,2,2},{0,1,3},{0,0,4}
+};
+
+static int fe__finite(double x)
+{
+    return x - x == 0.0;
+}
+/* Quadric Includes ends here */
+/* [[file:../literate/quadric.org::Compute the monomials of one sample][Compute the monomials of one sample]] */
+static void fe__quadric_monomials(double x, double y, double z, double p[35])
+{
+    double xx = x * x, xy = x * y, xz = x * z, yy = y * y, yz = y * z,
+           zz = z * z;
+    p[0] = 1.0;
+    p[1] = x; p[2] = y; p[3] = z;
+    p[4] = xx; p[5] = xy; p[6] = xz; p[7] = yy; p[8] = yz; p[9] = zz;
+    p[10] = xx * x; p[11] = xx * y; p[12] = xx * z; p[13] = xy * y;
+    p[14] = xy * z; p[15] = xz * z; p[16] = yy * y; p[17] = yy * z;
+    p[18] = yz * z; p[19] = zz * z;
+    p[20] = xx * xx; p[21] = xx * xy; p[22] = xx * xz; p[23] = xx * yy;
+    p[24] = xx * yz; p[25] = xx * zz; p[26] = xy * yy; p[27] = xy * yz;
+    p[28] = xy * zz; p[29] = xz * zz; p[30] = yy * yy; p[31] = yy * yz;
+    p[32] = yy * zz; p[33] = yz * zz; p[34] = zz * zz;
+}
+/* Compute the monomials of one sample ends here */
+/* [[file:../literate/quadric.org::Find the region of a direction][Find the region of a direction]] */
+static const double fe__quadric_band[9] = {
+    -0.64, -0.36, -0.16, -0.04, 0.0, 0.04, 0.16, 0.36, 0.64 /* t|t| */
+};
+static const double fe__quadric_sector[5][2] = {   /* cos, sin of 36 k deg */
+    {1.0, 0.0},
+    {0.80901699437494742, 0.58778525229247314},
+    {0.30901699437494742, 0.95105651629515357},
+    {-0.30901699437494742, 0.95105651629515357},
+    {-0.80901699437494742, 0.58778525229247314}
+};
+
+static int fe__quadric_region(double x, double y, double z)
+{
+    double r2 = x * x + y * y + z * z, zz = z * (z < 0.0 ? -z : z);
+    int band = 0, c = 0, north;
+    for (int j = 0; j < 9; j++)
+        band += zz >= fe__quadric_band[j] * r2;
+    for (int k = 0; k < 5; k++)
+        c += fe__quadric_sector[k][0] * y - fe__quadric_sector[k][1] * x >= 0.0;
+    north = y >= 0.0;
+    if (!(r2 > 0.0) || !fe__finite(r2))
+        return -1;
+    return 10 * band + (north ? c - 1 : 9 - c);
+}
+
+int fe_quadric_region(const double v[3])
+{
+    if (v == NULL)
+        return -1;
+    return fe__quadric_region(v[0], v[1], v[2]);
+}
+/* Find the region of a direction ends here */
+/* [[file:../literate/quadric.org::Mark the region of a sample][Mark the region of a sample]] */
+/* The centre for coverage and the box size, from the current box. */
+static float fe__quadric_frame(const fe_quadric *q, double c[3])
+{
+    double size = 0.0;
+    for (int j = 0; j < 3; j++) {
+        double h = 0.5 * (q->hi[j] - q->lo[j]);
+        c[j] = (q->flags & FE_QUADRIC_FIXED_REF) ? q->ref[j]
+                                                 : 0.5 * (q->lo[j] + q->hi[j]);
+        size = h > size ? h : size;
+    }
+    return (float)size;
+}
+
+static int fe__quadric_full(const fe_quadric *q)
+{
+    double c[3];
+    float size = fe__quadric_frame(q, c);
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        if (q->seen[r] < size)
+            return 0;
+    return 1;
+}
+
+static void fe__quadric_mark(fe_quadric *q, int region, float size)
+{
+    if (region >= 0 && q->seen[region] < size)
+        q->seen[region] = size;
+}
+/* Mark the region of a sample ends here */
+/* [[file:../literate/quadric.org::Fold one sample into the moments][Fold one sample into the moments]] */
+int fe_quadric_add(fe_quadric *q, const double x[3])
+{
+    double ref[3], p[FE_QUADRIC_MOMENTS], m[FE_QUADRIC_MOMENTS];
+    int first;
+
+    if (q == NULL || x == NULL)
+        return FE_EINVAL;
+    if (!fe__finite(x[0]) || !fe__finite(x[1]) || !fe__finite(x[2]))
+        return FE_ENONFINITE;
+    for (int j = 0; j < 3; j++)
+        ref[j] = (q->flags & FE_QUADRIC_HAS_REF) ? q->ref[j] : x[j];
+    fe__quadric_monomials(x[0] - ref[0], x[1] - ref[1], x[2] - ref[2], p);
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
+        m[k] = q->m[k] + p[k];
+        if (!fe__finite(m[k]))
+            return FE_ENONFINITE;
+    }
+    first = q->m[0] == 0.0;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        q->m[k] = m[k];
+    for (int j = 0; j < 3; j++) {
+        q->ref[j] = ref[j];
+        if (first || x[j] < q->lo[j])
+            q->lo[j] = x[j];
+        if (first || x[j] > q->hi[j])
+            q->hi[j] = x[j];
+    }
+    q->flags |= FE_QUADRIC_HAS_REF;
+    {
+        double c[3];
+        float size = fe__quadric_frame(q, c);
+        fe__quadric_mark(q, fe__quadric_region(x[0] - c[0], x[1] - c[1],
+                                               x[2] - c[2]), size);
+    }
+    return FE_OK;
+}
+/* Fold one sample into the moments ends here */
+/* [[file:../literate/quadric.org::Sum the moments of a block][Sum the moments of a block]] */
+#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__) \
+    && !defined(FE_NO_CLONES)
+#define FE__QUADRIC_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define FE__QUADRIC_KERNEL
+#endif
+
+enum { FE__L = FE__QUADRIC_LANES };
+
+FE__QUADRIC_KERNEL
+static void fe__quadric_block(const double *b, int n, const double ref[3],
+                              double out[35], double rlo[3], double rhi[3])
+{
+    double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
+    double a[9][FE__L] = {{0}}, c[9][FE__L] = {{0}}, q[8][FE__L] = {{0}},
+           r[8][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
+    int i, l, k;
+
+    /* Copy relative to the reference; extremes of the relative
+       coordinates, in lanes. */
+    for (l = 0; l < FE__L; l++) {
+        lo[0][l] = hi[0][l] = b[0] - ref[0];
+        lo[1][l] = hi[1][l] = b[1] - ref[1];
+        lo[2][l] = hi[2][l] = b[2] - ref[2];
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = b[3 * (i + l)] - ref[0], y = b[3 * (i + l) + 1] - ref[1],
+                   z = b[3 * (i + l) + 2] - ref[2];
+            X[i + l] = x;
+            Y[i + l] = y;
+            Z[i + l] = z;
+            lo[0][l] = x < lo[0][l] ? x : lo[0][l];
+            hi[0][l] = x > hi[0][l] ? x : hi[0][l];
+            lo[1][l] = y < lo[1][l] ? y : lo[1][l];
+            hi[1][l] = y > hi[1][l] ? y : hi[1][l];
+            lo[2][l] = z < lo[2][l] ? z : lo[2][l];
+            hi[2][l] = z > hi[2][l] ? z : hi[2][l];
+        }
+    for (; i < n; i++) {
+        X[i] = b[3 * i] - ref[0];
+        Y[i] = b[3 * i + 1] - ref[1];
+        Z[i] = b[3 * i + 2] - ref[2];
+        lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
+        hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
+        lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
+        hi[1][0] = Y[i] > hi[1][0] ? Y[i] : hi[1][0];
+        lo[2][0] = Z[i] < lo[2][0] ? Z[i] : lo[2][0];
+        hi[2][0] = Z[i] > hi[2][0] ? Z[i] : hi[2][0];
+    }
+    for (int j = 0; j < 3; j++) {
+        rlo[j] = lo[j][0];
+        rhi[j] = hi[j][0];
+        for (l = 1; l < FE__L; l++) {
+            rlo[j] = lo[j][l] < rlo[j] ? lo[j][l] : rlo[j];
+            rhi[j] = hi[j][l] > rhi[j] ? hi[j][l] : rhi[j];
+        }
+    }
+    /* The moments, in four groups of lanes. */
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            a[0][l] += x; a[1][l] += y; a[2][l] += z;
+            a[3][l] += x * x; a[4][l] += x * y; a[5][l] += x * z;
+            a[6][l] += y * y; a[7][l] += y * z; a[8][l] += z * z;
+        }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
+                   yz = y * z;
+            c[0][l] += xx * x; c[1][l] += xx * y; c[2][l] += xx * z;
+            c[3][l] += xy * y; c[4][l] += xy * z; c[5][l] += xz * z;
+            c[6][l] += yy * y; c[7][l] += yy * z; c[8][l] += yz * z;
+        }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
+                   yz = y * z, zz = z * z;
+            q[0][l] += xx * xx; q[1][l] += xx * xy; q[2][l] += xx * xz;
+            q[3][l] += xx * yy; q[4][l] += xx * yz; q[5][l] += xx * zz;
+            q[6][l] += xy * yy; q[7][l] += xy * yz;
+        }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xy = x * y, xz = x * z, yy = y * y, yz = y * z,
+                   zz = z * z;
+            r[0][l] += xy * zz; r[1][l] += xz * zz; r[2][l] += yy * yy;
+            r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
+            r[6][l] += zz * zz; r[7][l] += zz * z;
+        }
+    for (k = 0; k < 35; k++)
+        out[k] = 0.0;
+    out[0] = (double)n;
+    for (l = 0; l < FE__L; l++) {
+        for (k = 0; k < 9; k++)
+            out[1 + k] += a[k][l];
+        for (k = 0; k < 9; k++)
+            out[10 + k] += c[k][l];
+        out[19] += r[7][l];             /* the ninth of r is the tenth cubic */
+        for (k = 0; k < 8; k++)
+            out[20 + k] += q[k][l];
+        for (k = 0; k < 7; k++)
+            out[28 + k] += r[k][l];
+    }
+    /* The tail that does not fill the lanes. */
+    for (; i < n; i++) {
+        double p[35];
+        fe__quadric_monomials(X[i], Y[i], Z[i], p);
+        for (k = 1; k < 35; k++)
+            out[k] += p[k];
+    }
+}
+/* Sum the moments of a block ends here */
+/* [[file:../literate/quadric.org::Fold an array block by block][Fold an array block by block]] */
+int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
+                        size_t *done)
+{
+    size_t k = 0;
+    int rc = FE_OK;
+
+    if (done != NULL)
+        *done = 0;
+    if (q == NULL || (x == NULL && n > 0))
+        return FE_EINVAL;
+    while (k < n) {
+        size_t m = n - k < FE__QUADRIC_BLOCK ? n - k : FE__QUADRIC_BLOCK;
+        const double *b = x + 3 * k;
+        double lo[3], hi[3], rlo[3], rhi[3], sums[35], next[35];
+        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1;
+
+        if (fast) {             /* a non-finite sample makes a sum non-finite */
+            fe__quadric_block(b, (int)m, q->ref, sums, rlo, rhi);
+            for (int j = 0; j < FE_QUADRIC_MOMENTS; j++) {
+                next[j] = q->m[j] + sums[j];
+                fast = fast && fe__finite(next[j]);
+            }
+        }
+        if (fast) {
+            /* Inside the box for sure when strictly inside after rounding
+               (x - ref rounds monotonically); else find the extremes. */
+            for (int j = 0; j < 3; j++) {
+                lo[j] = q->lo[j];
+                hi[j] = q->hi[j];
+                inside = inside && rlo[j] > lo[j] - q->ref[j]
+                         && rhi[j] < hi[j] - q->ref[j];
+            }
+            if (!inside)
+                for (size_t i = 0; i < m; i++)
+                    for (int j = 0; j < 3; j++) {
+                        double v = b[3 * i + j];
+                        lo[j] = v < lo[j] ? v : lo[j];
+                        hi[j] = v > hi[j] ? v : hi[j];
+                    }
+            if (!fe__quadric_full(q))
+                for (int j = 0; j < 3; j++)
+                    fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
+        }
+        if (fast) {
+            for (int j = 0; j < FE_QUADRIC_MOMENTS; j++)
+                q->m[j] = next[j];
+            for (int j = 0; j < 3; j++) {
+                q->lo[j] = lo[j];
+                q->hi[j] = hi[j];
+            }
+            if (!fe__quadric_full(q)) {
+                double c[3];
+                float size = fe__quadric_frame(q, c);
+                for (size_t i = 0; i < m; i++)
+                    fe__quadric_mark(q, fe__quadric_region(
+                        b[3 * i] - c[0], b[3 * i + 1] - c[1], b[3 * i + 2] - c[2]),
+                        size);
+            }
+            k += m;
+            continue;
+        }
+        for (size_t end = k + m; k < end; k++) {
+            rc = fe_quadric_add(q, x + 3 * k);
+            if (rc != FE_OK)
+                break;
+        }
+        if (rc != FE_OK)
+            break;
+    }
+    if (done != NULL)
+        *done = k;
+    return rc;
+}
+/* Fold an array block by block ends here */
+/* [[file:../literate/quadric.org::Move moments to another reference][Move moments to another reference]] */
+int fe_quadric_index(int a, int b, int c)
+{
+    if (a < 0 || b < 0 || c < 0 || a + b + c > 4)
+        return -1;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        if (fe__quadric_exp[k][0] == a && fe__quadric_exp[k][1] == b
+            && fe__quadric_exp[k][2] == c)
+            return k;
+    return -1;
+}
+
+void fe_quadric_exponents(int k, int e[3])
+{
+    for (int j = 0; j < 3; j++)
+        e[j] = (k >= 0 && k < FE_QUADRIC_MOMENTS) ? fe__quadric_exp[k][j] : 0;
+}
+
+/* out = the moments m moved by delta (u' = u + delta). */
+static int fe__quadric_shift(const double m[35], const double delta[3],
+                             double out[35])
+{
+    static const double binom[5][5] = {
+        {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0},
+        {1, 4, 6, 4, 1}
+    };
+    double pw[3][5];
+    int index[5][5][5];
+
+    for (int j = 0; j < 3; j++) {
+        pw[j][0] = 1.0;
+        for (int e = 1; e < 5; e++)
+            pw[j][e] = pw[j][e - 1] * delta[j];
+    }
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        index[fe__quadric_exp[k][0]][fe__quadric_exp[k][1]][fe__quadric_exp[k][2]] = k;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
+        int a = fe__quadric_exp[k][0], b = fe__quadric_exp[k][1],
+            c = fe__quadric_exp[k][2];
+        double s = 0.0;
+        for (int p = 0; p <= a; p++)
+            for (int r = 0; r <= b; r++)
+                for (int t = 0; t <= c; t++)
+                    s += binom[a][p] * binom[b][r] * binom[c][t]
+                       * pw[0][a - p] * pw[1][b - r] * pw[2][c - t]
+                       * m[index[p][r][t]];
+        if (!fe__finite(s))
+            return FE_ENONFINITE;
+        out[k] = s;
+    }
+    return FE_OK;
+}
+
+int fe_quadric_recentre(fe_quadric *q, const double ref[3])
+{
+    double delta[3], out[FE_QUADRIC_MOMENTS];
+    int rc;
+    if (q == NULL || ref == NULL)
+        return FE_EINVAL;
+    if (!fe__finite(ref[0]) || !fe__finite(ref[1]) || !fe__finite(ref[2]))
+        return FE_ENONFINITE;
+    for (int j = 0; j < 3; j++)
+        delta[j] = q->ref[j] - ref[j];
+    rc = fe__quadric_shift(q->m, delta, out);
+    if (rc != FE_OK)
+        return rc;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        q->m[k] = out[k];
+    for (int j = 0; j < 3; j++)
+        q->ref[j] = ref[j];
+    q->flags |= FE_QUADRIC_HAS_REF;
+    return FE_OK;
+}
+/* Move moments to another reference ends here */
+/* [[file:../literate/quadric.org::Merge two accumulations][Merge two accumulations]] */
+int fe_quadric_merge(fe_quadric *a, const fe_quadric *b)
+{
+    double delta[3], moved[FE_QUADRIC_MOMENTS], sum[FE_QUADRIC_MOMENTS];
+    int rc;
+
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (b->m[0] == 0.0)
+        return FE_OK;
+    if (a->m[0] == 0.0 && !(a->flags & FE_QUADRIC_FIXED_REF)) {
+        *a = *b;
+        return FE_OK;
+    }
+    for (int j = 0; j < 3; j++)
+        delta[j] = b->ref[j] - a->ref[j];
+    rc = fe__quadric_shift(b->m, delta, moved);
+    if (rc != FE_OK)
+        return rc;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
+        sum[k] = a->m[k] + moved[k];
+        if (!fe__finite(sum[k]))
+            return FE_ENONFINITE;
+    }
+    for (int j = 0; j < 3; j++) {
+        int first = a->m[0] == 0.0;
+        a->lo[j] = first || b->lo[j] < a->lo[j] ? b->lo[j] : a->lo[j];
+        a->hi[j] = first || b->hi[j] > a->hi[j] ? b->hi[j] : a->hi[j];
+    }
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        a->m[k] = sum[k];
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        a->seen[r] = b->seen[r] > a->seen[r] ? b->seen[r] : a->seen[r];
+    return FE_OK;
+}
+/* Merge two accumulations ends here */
+/* [[file:../literate/quadric.org::Read out the count and the coverage][Read out the count and the coverage]] */
+int fe_quadric_init(fe_quadric *q, const double *centre)
+{
+    fe_quadric e = FE_QUADRIC_EMPTY;
+    if (q == NULL)
+        return FE_EINVAL;
+    if (centre != NULL) {
+        for (int j = 0; j < 3; j++) {
+            if (!fe__finite(centre[j]))
+                return FE_ENONFINITE;
+            e.ref[j] = centre[j];
+        }
+        e.flags = FE_QUADRIC_HAS_REF | FE_QUADRIC_FIXED_REF;
+    }
+    *q = e;
+    return FE_OK;
+}
+
+uint64_t fe_quadric_count(const fe_quadric *q)
+{
+    return q != NULL ? (uint64_t)q->m[0] : 0;
+}
+
+int fe_quadric_regions(const fe_quadric *q)
+{
+    double c[3];
+    float half;
+    int n = 0;
+    if (q == NULL || q->m[0] == 0.0)
+        return 0;
+    half = 0.5f * fe__quadric_frame(q, c);
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
+        n += q->seen[r] > 0.0f && q->seen[r] >= half;
+    return n;
+}
+
+double fe_quadric_coverage(const fe_quadric *q)
+{
+    return (double)fe_quadric_regions(q) / FE_QUADRIC_REGIONS;
+}
+/* Read out the count and the coverage ends here */
+/* [[file:../literate/quadric.org::Moments as an accumulator][Moments as an accumulator]] */
+static int fe__quadric_init_fn(void *acc, void *ctx)
+{
+    return fe_quadric_init(acc, ctx);
+}
+
+static int fe__quadric_step(void *acc, const void *obs, void *ctx)
+{
+    (void)ctx;
+    return fe_quadric_add(acc, obs);
+}
+
+static int fe__quadric_step_many(void *acc, const void *obs, size_t n,
+                                 size_t *done, void *ctx)
+{
+    (void)ctx;
+    return fe_quadric_add_many(acc, obs, n, done);
+}
+
+static int fe__quadric_merge_fn(void *acc, const void *other, void *ctx)
+{
+    (void)ctx;
+    return fe_quadric_merge(acc, other);
+}
+
+fe_accumulator fe_quadric_accumulator(const double *centre)
+{
+    fe_accumulator f = {
+        .name = "quadric",
+        .acc_size = sizeof(fe_quadric),
+        .obs_size = 3 * sizeof(double),
+        .init = fe__quadric_init_fn,
+        .step = fe__quadric_step,
+        .step_many = fe__quadric_step_many,
+        .merge = fe__quadric_merge_fn,
+        .copy = 0,
+        /* read, never written, by the functions above */
+        .ctx = (void *)(uintptr_t)centre,
+    };
+    return f;
+}
+/* Moments as an accumulator ends here */

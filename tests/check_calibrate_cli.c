@@ -1,0 +1,267 @@
+/* foldest calibrate: fits, JSON, refusals, located errors with no partial
+   output, --apply (atomic; refused for standard input), --help.  Runs the
+   built binary (FE_TEST_CLI) on recordings written here. */
+#define _POSIX_C_SOURCE 200809L
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+#ifndef FE_TEST_CLI
+#define FE_TEST_CLI "build/bin/foldest"
+#endif
+
+/* A recording: metadata lines, a header, then n samples on an ellipsoid
+   (centre 100, -50, 30; semi-axes 400, 380, 420), or only the upper half
+   (hemisphere), or a circle in a plane (planar). */
+enum shape { WHOLE, HEMISPHERE, PLANAR };
+
+static void write_recording(const char *path, size_t n, enum shape shape,
+                            const char *bad_line)
+{
+    FILE *f = fopen(path, "w");
+    fe_rng g = fe_rng_seed(21);
+    ck_assert_ptr_nonnull(f);
+    fprintf(f, "Fs,50.00\nInitialization time,60\nt,mx,my,mz\n");
+    for (size_t i = 0; i < n; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        if (shape == HEMISPHERE)
+            v[2] = fabs(v[2]);
+        if (shape == PLANAR)
+            v[2] = 0.0, s = sqrt(v[0] * v[0] + v[1] * v[1]);
+        fprintf(f, "%.3f,%.4f,%.4f,%.4f\n", 0.02 * (double)i,
+                100 + 400 * v[0] / s + 2 * fe_rng_normal(&g),
+                -50 + 380 * v[1] / s + 2 * fe_rng_normal(&g),
+                30 + 420 * v[2] / s + 2 * fe_rng_normal(&g));
+        if (bad_line != NULL && i == n / 2)
+            fputs(bad_line, f);
+    }
+    fclose(f);
+}
+
+/* Run `sh -c cmd` with every %s replaced by path; capture stdout (and
+   stderr too unless split) into out; return the exit status. */
+static int run(const char *fmt, const char *path, char *out, size_t outlen)
+{
+    char cmd[2048];
+    FILE *p;
+    size_t got;
+    int status;
+    snprintf(cmd, sizeof cmd, fmt, FE_TEST_CLI, path, path, path);
+    p = popen(cmd, "r");
+    ck_assert_ptr_nonnull(p);
+    got = fread(out, 1, outlen - 1, p);
+    out[got] = '\0';
+    status = pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static double json_number(const char *json, const char *key, int index)
+{
+    char pattern[64];
+    const char *at;
+    double v = NAN;
+    snprintf(pattern, sizeof pattern, "\"%s\": ", key);
+    at = strstr(json, pattern);
+    ck_assert_msg(at != NULL, "no %s in %s", key, json);
+    at += strlen(pattern);
+    for (int k = 0; k < index; k++) {
+        at = strchr(at, ',');
+        ck_assert_ptr_nonnull(at);
+        at++;
+    }
+    while (*at == '[' || *at == ' ')
+        at++;
+    ck_assert_int_eq(sscanf(at, "%lf", &v), 1);
+    return v;
+}
+
+START_TEST(fit_json_and_text)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[16384];
+    int fd = mkstemp(path), status;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 3000, WHOLE, NULL);
+    status = run("%s calibrate --columns mx,my,mz --json %s 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "\"model\": \"axial\""));
+    ck_assert_ptr_nonnull(strstr(out, "\"n\": 3000,"));
+    ck_assert_ptr_nonnull(strstr(out, "\"refusal\": null"));
+    ck_assert_double_eq_tol(json_number(out, "offset", 0), 100.0, 0.5);
+    ck_assert_double_eq_tol(json_number(out, "offset", 1), -50.0, 0.5);
+    ck_assert_double_eq_tol(json_number(out, "offset", 2), 30.0, 0.5);
+    ck_assert_double_eq_tol(json_number(out, "matrix", 0), 1.0 / 400, 1e-5);
+    ck_assert_double_eq(json_number(out, "matrix", 1), 0.0);  /* axial: diagonal */
+    ck_assert_double_lt(json_number(out, "rms_percent", 0), 0.6);
+    ck_assert_double_lt(json_number(out, "rms_radial_percent", 0), 0.6);
+    ck_assert_double_eq(json_number(out, "coverage", 0), 1.0);
+    ck_assert_double_gt(json_number(out, "offset_se", 0), 0.0);
+    /* The full ellipsoid, and the plain text. */
+    status = run("%s calibrate --columns 2,3,4 --model ellipsoid %s 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "ellipsoid fit of 3000 samples"));
+    ck_assert_ptr_nonnull(strstr(out, "coverage         100 %"));
+    /* Standard input: one pass, the fold's coverage estimate. */
+    status = run("cat %2$s | %1$s calibrate --columns mx,my,mz --json - 2>&1", path, out,
+                 sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "\"file\": \"<stdin>\""));
+    ck_assert_ptr_nonnull(strstr(out, "\"rms_radial_percent\": null"));
+    status = run("cat %2$s | %1$s calibrate --columns mx,my,mz --trace - 2>&1 >/dev/null", path,
+                 out, sizeof out);
+    ck_assert_int_eq(status, 0);
+    ck_assert_ptr_nonnull(strstr(out, "iteration  1: cost"));
+    unlink(path);
+}
+END_TEST
+
+START_TEST(apply_writes_calibrated_samples)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[4096], applied[64], line[256];
+    int fd = mkstemp(path), status;
+    size_t rows = 0;
+    double worst = 0.0, radius;
+    FILE *f;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 2000, WHOLE, NULL);
+    snprintf(applied, sizeof applied, "%s.out", path);
+    status = run("%1$s calibrate --columns mx,my,mz --json --apply %2$s.out %2$s 2>&1", path,
+                 out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    radius = json_number(out, "radius", 0);
+    f = fopen(applied, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    ck_assert_str_eq(line, "mx_cal,my_cal,mz_cal\n");
+    while (fgets(line, sizeof line, f) != NULL) {
+        double y[3];
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf", &y[0], &y[1], &y[2]), 3);
+        worst = fmax(worst, fabs(sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) / radius - 1));
+        rows++;
+    }
+    fclose(f);
+    ck_assert_uint_eq(rows, 2000);
+    ck_assert_double_lt(worst, 0.03);    /* noise 2 on a radius of 400 */
+    unlink(applied);
+    /* A malformed line: the located message, nothing written. */
+    write_recording(path, 2000, WHOLE, "17.0,1,oops,3\n");
+    status = run("%1$s calibrate --columns mx,my,mz --apply %2$s.out %2$s 2>&1", path, out,
+                 sizeof out);
+    ck_assert_int_eq(status, 3);
+    ck_assert_ptr_nonnull(strstr(out, ":1005:8: 'oops' in column 'my' is not a number"));
+    ck_assert_int_ne(access(applied, F_OK), 0);
+    /* Standard input cannot be read twice: refused before reading. */
+    status = run("cat %2$s | %1$s calibrate --apply %2$s.out - 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 2);
+    ck_assert_ptr_nonnull(strstr(out, "give a file, not standard input"));
+    ck_assert_int_ne(access(applied, F_OK), 0);
+    unlink(path);
+}
+END_TEST
+
+struct refusal_case {
+    const char *what;
+    enum shape shape;
+    size_t n;
+    const char *args, *bad;
+    int status;
+    const char *expect;
+    int quiet_stdout;           /* nothing may reach standard output */
+};
+
+static const struct refusal_case refusals[] = {
+    {"planar", PLANAR, 1000, "--columns mx,my,mz", NULL, 1, "lie near a plane", 1},
+    {"hemisphere", HEMISPHERE, 2000, "--columns mx,my,mz", NULL, 1,
+     "cover one side of the sphere only", 1},
+    {"hemisphere json", HEMISPHERE, 2000, "--columns mx,my,mz --json", NULL, 1,
+     "\"refusal\": \"the samples cover one side", 0},
+    {"too few", WHOLE, 5, "--columns mx,my,mz --model ellipsoid", NULL, 1, "too few samples", 1},
+    {"malformed", WHOLE, 100, "--columns mx,my,mz", "1,2,3\n", 1 + 2,
+     ":55:1: expected 4 fields, found 3", 1},
+    {"four columns", WHOLE, 100, "", NULL, 2, "name three with --columns a,b,c", 1},
+    {"two columns", WHOLE, 100, "--columns mx,my", NULL, 2, "needs three columns", 1},
+    {"unknown column", WHOLE, 100, "--columns mx,my,qq", NULL, 2, "no column 'qq'", 1},
+    {"unknown model", WHOLE, 100, "--model cube", NULL, 2, "'cube' is not sphere", 1},
+    {"unknown option", WHOLE, 100, "--frobnicate", NULL, 2, "unknown option", 1},
+};
+
+START_TEST(refusals_and_errors)
+{
+    const struct refusal_case *c = &refusals[_i];
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[8192], cmd[512];
+    int fd = mkstemp(path), status;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, c->n, c->shape, c->bad);
+    snprintf(cmd, sizeof cmd, "%%1$s calibrate %s %%2$s 2>&1", c->args);
+    status = run(cmd, path, out, sizeof out);
+    ck_assert_msg(status == c->status, "%s: status %d, want %d: %s", c->what, status,
+                  c->status, out);
+    ck_assert_msg(strstr(out, c->expect) != NULL, "%s: no \"%s\" in:\n%s", c->what,
+                  c->expect, out);
+    if (c->quiet_stdout) {
+        snprintf(cmd, sizeof cmd, "%%1$s calibrate %s %%2$s 2>/dev/null", c->args);
+        run(cmd, path, out, sizeof out);
+        ck_assert_msg(out[0] == '\0', "%s: standard output not empty: %s", c->what, out);
+    }
+    unlink(path);
+}
+END_TEST
+
+START_TEST(help_documents_everything)
+{
+    char out[8192];
+    const char *words[] = {"--model", "sphere", "axial", "ellipsoid", "--columns", "--skip",
+                           "--json", "--apply OUT.csv", "--trace", "FILE:LINE:COLUMN",
+                           "rms_percent", "coverage", "matrix", "standard input"};
+    ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
+    for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
+        ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
+    ck_assert_int_eq(run("%s --help", "", out, sizeof out), 0);
+    ck_assert_ptr_nonnull(strstr(out, "calibrate"));
+}
+END_TEST
+
+START_TEST(real_recording_from_the_command_line)
+{
+    /* The QMC5883L file as it is: three metadata lines, then mx,my,mz. */
+    const char *dir = fe_test_data_dir("calibrate on the qmc5883l recording");
+    char path[4096], out[8192];
+    int status;
+    if (dir == NULL)
+        return;
+    snprintf(path, sizeof path, "%s/qmc5883l_tomisuarez/filtered_raw_data.csv", dir);
+    status = run("%s calibrate --model ellipsoid --json %s 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "\"n\": 22745,"));
+    ck_assert_double_eq_tol(json_number(out, "rms_percent", 0), 2.80, 0.01);
+    ck_assert_double_eq_tol(json_number(out, "coverage", 0), 0.99, 0.015);
+    status = run("%s calibrate --model sphere %s 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 1);
+    ck_assert_ptr_nonnull(strstr(out, "grows without bound"));
+}
+END_TEST
+
+Suite *fe_calibrate_cli_suite(void)
+{
+    Suite *s = suite_create("calibrate_cli");
+    TCase *t = tcase_create("calibrate");
+    tcase_set_timeout(t, 120);
+    tcase_add_test(t, fit_json_and_text);
+    tcase_add_test(t, apply_writes_calibrated_samples);
+    tcase_add_loop_test(t, refusals_and_errors, 0,
+                        (int)(sizeof refusals / sizeof refusals[0]));
+    tcase_add_test(t, help_documents_everything);
+    tcase_add_test(t, real_recording_from_the_command_line);
+    suite_add_tcase(s, t);
+    return s;
+}

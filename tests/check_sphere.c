@@ -1,0 +1,674 @@
+/* Sphere and ellipsoid fits: the three algorithms agree, the streaming fit
+   keeps its precision with a large offset, refusals with their reasons, the
+   trace, and the real recordings of ../shared/data. */
+#define _POSIX_C_SOURCE 200809L
+#include <fcntl.h>
+#include <stdint.h>
+#include <unistd.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+static void ellipsoid_points(double *x, size_t n, const double c[3],
+                             const double r[3], double noise, uint64_t seed)
+{
+    fe_rng g = fe_rng_seed(seed);
+    for (size_t i = 0; i < n; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = c[j] + r[j] * v[j] / s + noise * fe_rng_normal(&g);
+    }
+}
+
+/* Largest parameter difference relative to the field: offsets and scales
+   divided by the radius R, entries of A_x (of size 1/R^2) times R^2. */
+static double param_diff(const fe_sphere_fit *a, const fe_sphere_fit *b)
+{
+    double worst = 0.0;
+    for (int k = 0; k < a->nparams; k++) {
+        double scale = a->model == FE_FIT_ELLIPSOID && k >= 3 ? 1.0 / (b->radius * b->radius)
+                                                              : b->radius;
+        worst = fmax(worst, fabs(a->params[k] - b->params[k]) / scale);
+    }
+    return worst;
+}
+
+static fe_sphere_fit fit_moments(const double *x, size_t n, fe_sphere_model model,
+                                 int *rc)
+{
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    memset(&f, 0, sizeof f);
+    *rc = fe_quadric_add_many(&q, x, n, NULL);
+    if (*rc == FE_OK)
+        *rc = fe_sphere_fit_moments(&q, model, NULL, &f);
+    return f;
+}
+
+static const double C0[3] = {100, -50, 30}, R0[3] = {400, 380, 420};
+
+START_TEST(three_algorithms_agree)
+{
+    fe_sphere_model model = (fe_sphere_model)_i;
+    enum { NMAX = 20000 };
+    static double x[3 * NMAX], w[10 * NMAX];
+    size_t n = fe_test_quick() ? 2000 : NMAX;
+    size_t wl = fe_sphere_naive_workspace(n, model);
+    fe_sphere_fit streaming, stored, naive;
+    int rc;
+    ellipsoid_points(x, n, C0, R0, 2.0, 11);
+    streaming = fit_moments(x, n, model, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_stored(x, n, model, NULL, &stored), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_naive(x, n, model, NULL, w, wl, &naive), FE_OK);
+    ck_assert_double_le(param_diff(&streaming, &stored), 1e-9);
+    ck_assert_double_le(param_diff(&naive, &stored), 1e-9);
+    FE_ASSERT_REL(streaming.rss, stored.rss, 1e-9);
+    FE_ASSERT_REL(naive.rss, stored.rss, 1e-9);
+    ck_assert_int_eq(streaming.iterations, stored.iterations);
+    /* The model recovers what it can: an axial or full ellipsoid the
+       centre and the semi-axes within a few standard errors. */
+    if (model != FE_FIT_SPHERE) {
+        for (int j = 0; j < 3; j++) {
+            ck_assert_double_le(fabs(streaming.offset[j] - C0[j]), 5 * streaming.se[j]);
+            ck_assert_double_lt(fabs(streaming.axes[j] - R0[j == 0 ? 1 : j == 1 ? 0 : 2]), 1.0);
+        }
+        ck_assert_double_lt(streaming.rms_percent, 0.6);
+    } else {
+        /* A sphere through a 5% ellipsoid leaves a 2.6% residual. */
+        ck_assert_double_gt(streaming.rms_percent, 2.0);
+    }
+    /* The cost read back from the moments is the fit's. */
+    {
+        fe_quadric q = FE_QUADRIC_EMPTY;
+        double rss;
+        fe_quadric_add_many(&q, x, n, NULL);
+        ck_assert_int_eq(fe_sphere_cost(&q, &streaming, &rss), FE_OK);
+        FE_ASSERT_REL(rss, streaming.rss, 1e-8);
+    }
+}
+END_TEST
+
+START_TEST(calibration_maps_to_the_unit_sphere)
+{
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_sphere_fit f;
+    double worst = 0.0;
+    int rc;
+    ellipsoid_points(x, N, C0, R0, 0.0, 12);
+    f = fit_moments(x, N, FE_FIT_ELLIPSOID, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        double y[3];
+        fe_sphere_apply(&f, x + 3 * i, y);
+        worst = fmax(worst, fabs(sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0));
+    }
+    ck_assert_double_le(worst, 1e-9);
+    ck_assert_double_le(f.rms_percent, 1e-7);
+    FE_ASSERT_REL(f.radius, cbrt(400.0 * 380.0 * 420.0), 1e-9);
+    /* M is symmetric. */
+    FE_ASSERT_REL(f.matrix[1], f.matrix[3], 1e-9);
+}
+END_TEST
+
+START_TEST(precision_with_a_large_offset)
+{
+    /* Offset 1e4, radius 1: the raw fourth powers are 1e16 and the shape
+       lives 16 digits down; moments about the first sample keep it. */
+    enum { N = 20000 };
+    static double x[3 * N];
+    const double c[3] = {1e4, -1e4, 1e4}, r[3] = {1.0, 0.9, 1.1};
+    for (int model = 0; model < 3; model++) {
+        fe_sphere_fit streaming, stored;
+        int rc;
+        ellipsoid_points(x, N, c, r, 1e-3, 13);
+        streaming = fit_moments(x, N, (fe_sphere_model)model, &rc);
+        ck_assert_int_eq(rc, FE_OK);
+        ck_assert_int_eq(fe_sphere_fit_stored(x, N, (fe_sphere_model)model, NULL, &stored), FE_OK);
+        ck_assert_msg(param_diff(&streaming, &stored) <= 1e-9, "model %d: %.3g", model,
+                      param_diff(&streaming, &stored));
+        FE_ASSERT_REL(streaming.rms_percent, stored.rms_percent, 1e-6);
+    }
+    /* Raw power sums (moments about the origin) lose the shape: the fit
+       is refused or its centre is off by more than the radius. */
+    {
+        const double origin[3] = {0, 0, 0};
+        fe_quadric raw;
+        fe_sphere_fit f;
+        int rc;
+        ellipsoid_points(x, N, c, r, 1e-3, 13);
+        fe_quadric_init(&raw, origin);
+        fe_quadric_add_many(&raw, x, N, NULL);
+        rc = fe_sphere_fit_moments(&raw, FE_FIT_AXIAL, NULL, &f);
+        ck_assert_msg(rc != FE_OK || fabs(f.offset[0] - c[0]) > 1.0,
+                      "raw sums fitted: rc %d, offset %.17g", rc, f.offset[0]);
+    }
+}
+END_TEST
+
+START_TEST(merged_shards_fit_like_the_whole)
+{
+    enum { N = 9000 };
+    static double x[3 * N];
+    fe_accumulator acc = fe_quadric_accumulator(NULL);
+    fe_quadric a, b, whole;
+    fe_sphere_fit fa, fw;
+    ellipsoid_points(x, N, C0, R0, 2.0, 14);
+    fe_init(&acc, &a);
+    fe_init(&acc, &b);
+    fe_init(&acc, &whole);
+    fe_fold(&acc, &whole, x, N, NULL);
+    fe_fold(&acc, &a, x, 4000, NULL);
+    fe_fold(&acc, &b, x + 3 * 4000, N - 4000, NULL);
+    ck_assert_int_eq(fe_merge(&acc, &a, &b), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_moments(&a, FE_FIT_AXIAL, NULL, &fa), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_moments(&whole, FE_FIT_AXIAL, NULL, &fw), FE_OK);
+    ck_assert_double_le(param_diff(&fa, &fw), 1e-11);
+}
+END_TEST
+
+static int count_iterations(const fe_sphere_iteration *it, void *ctx)
+{
+    int *calls = ctx;
+    ++*calls;
+    return it->iteration >= 100 ? 1 : 0;
+}
+
+static int stop_at_two(const fe_sphere_iteration *it, void *ctx)
+{
+    (void)ctx;
+    return it->iteration == 2;
+}
+
+START_TEST(trace_and_stop)
+{
+    enum { N = 3000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_options o = fe_sphere_default_options();
+    fe_sphere_fit f;
+    int calls = 0;
+    ellipsoid_points(x, N, C0, R0, 2.0, 15);
+    fe_quadric_add_many(&q, x, N, NULL);
+    o.trace = count_iterations;
+    o.trace_ctx = &calls;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &f), FE_OK);
+    ck_assert_int_eq(calls, f.iterations);
+    ck_assert_int_ge(calls, 2);
+    o.trace = stop_at_two;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &f), FE_ESTOPPED);
+    o = fe_sphere_default_options();
+    o.max_iterations = 1;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &f), FE_ENOCONV);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_NO_CONVERGENCE);
+}
+END_TEST
+
+struct damping { int rejected, increased, calls; double last; };
+
+static int watch_damping(const fe_sphere_iteration *it, void *ctx)
+{
+    struct damping *d = ctx;
+    d->rejected += !it->accepted;
+    d->increased += it->accepted && it->lambda > 0.0 && d->calls > 0
+                    && it->cost > d->last * (1 + 1e-10);
+    d->last = it->cost;
+    d->calls++;
+    return 0;
+}
+
+START_TEST(damping_when_a_step_fails)
+{
+    /* Half a sphere (x > centre), fitted with the hemisphere check off:
+       from the box's centre, pure Gauss-Newton overshoots and
+       Levenberg-Marquardt damping has to step in.  The cost never rises. */
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_options o = fe_sphere_default_options();
+    fe_sphere_fit f;
+    struct damping d = {0, 0, 0, 0.0};
+    fe_rng g = fe_rng_seed(3);
+    for (size_t i = 0; i < N; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        v[0] = fabs(v[0]);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(&g);
+    }
+    fe_quadric_add_many(&q, x, N, NULL);
+    o.min_extent = 0.0;
+    o.trace = watch_damping;
+    o.trace_ctx = &d;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+    ck_assert_int_gt(d.rejected, 0);
+    ck_assert_int_eq(d.increased, 0);
+    ck_assert_double_eq_tol(f.radius, 400, 20);
+}
+END_TEST
+
+START_TEST(refuse_too_few_and_bad_arguments)
+{
+    double x[3 * 6];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    double w[10];
+    ellipsoid_points(x, 6, C0, R0, 2.0, 16);
+    fe_quadric_add_many(&q, x, 6, NULL);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_ETOOFEW);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_ETOOFEW);
+    ck_assert_int_eq(fe_sphere_fit_moments(NULL, FE_FIT_AXIAL, NULL, &f), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)7, NULL, &f), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_fit_naive(x, 6, FE_FIT_SPHERE, NULL, w, 10, &f), FE_ESIZE);
+    ck_assert_str_eq(fe_sphere_model_name(FE_FIT_AXIAL), "axial");
+    {
+        fe_sphere_model m;
+        ck_assert_int_eq(fe_sphere_model_parse("ellipsoid", &m), FE_OK);
+        ck_assert_int_eq(m, FE_FIT_ELLIPSOID);
+        ck_assert_int_eq(fe_sphere_model_parse("cube", &m), FE_EINVAL);
+    }
+}
+END_TEST
+
+START_TEST(refuse_planar_data)
+{
+    /* A sensor turned about z only: a circle (plus noise). */
+    enum { N = 2000 };
+    static double x[3 * N];
+    fe_rng g = fe_rng_seed(17);
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    for (size_t i = 0; i < N; i++) {
+        double t = 6.283185307179586 * fe_rng_uniform(&g);
+        x[3 * i] = C0[0] + 400 * cos(t) + 2 * fe_rng_normal(&g);
+        x[3 * i + 1] = C0[1] + 400 * sin(t) + 2 * fe_rng_normal(&g);
+        x[3 * i + 2] = C0[2] + 100 + 2 * fe_rng_normal(&g);
+    }
+    fe_quadric_add_many(&q, x, N, NULL);
+    for (int model = 0; model < 3; model++) {
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, NULL, &f),
+                         FE_EUNDETERMINED);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_PLANAR);
+        ck_assert_double_lt(f.planarity, 1e-3);
+    }
+    ck_assert_ptr_nonnull(strstr(fe_sphere_refusal_string(f.refusal), "plane"));
+}
+END_TEST
+
+START_TEST(refuse_one_hemisphere)
+{
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    ellipsoid_points(x, N, C0, R0, 2.0, 18);
+    for (size_t i = 0; i < N; i++)
+        if (x[3 * i + 2] > C0[2])
+            x[3 * i + 2] = 2 * C0[2] - x[3 * i + 2];
+    fe_quadric_add_many(&q, x, N, NULL);
+    for (int model = 0; model < 3; model++) {
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, NULL, &f),
+                         FE_EUNDETERMINED);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_HEMISPHERE);
+        ck_assert_double_lt(f.extent_hi[2], 0.5);
+    }
+    /* Switching the check off fits it anyway (the caller's choice). */
+    {
+        fe_sphere_options o = fe_sphere_default_options();
+        o.min_extent = 0.0;
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+    }
+}
+END_TEST
+
+START_TEST(refuse_a_hyperboloid)
+{
+    /* Points on x^2 + y^2 - z^2/2 = 1 (|z| <= 1.2): the best quadric is
+       not an ellipsoid. */
+    enum { N = 4000 };
+    static double x[3 * N];
+    fe_rng g = fe_rng_seed(19);
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    for (size_t i = 0; i < N; i++) {
+        double t = 6.283185307179586 * fe_rng_uniform(&g), z = 2.4 * fe_rng_uniform(&g) - 1.2;
+        double r = sqrt(1 + z * z / 2);
+        x[3 * i] = 50 + r * cos(t);
+        x[3 * i + 1] = 20 + r * sin(t);
+        x[3 * i + 2] = -10 + z;
+    }
+    fe_quadric_add_many(&q, x, N, NULL);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_ENOTPD);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_NOT_PD);
+}
+END_TEST
+
+START_TEST(refuse_a_singular_system)
+{
+    /* Six exact poses: +-x, +-y, +-z.  They determine a centre and three
+       scales, not the nine parameters of a full ellipsoid. */
+    enum { N = 60 };
+    double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    int rc;
+    for (size_t i = 0; i < N; i++) {
+        int axis = (int)(i % 6) / 2, sign = i % 2 ? -1 : 1;
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + (j == axis ? sign * R0[j] : 0.0);
+    }
+    fe_quadric_add_many(&q, x, N, NULL);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_OK);
+    for (int j = 0; j < 3; j++)
+        FE_ASSERT_REL(f.offset[j], C0[j], 1e-9);
+    rc = fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f);
+    ck_assert_int_eq(rc, FE_ENOTPD);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_SINGULAR);
+}
+END_TEST
+
+/* ---------------------------------------------------------------- real data */
+
+/* Read the named columns of a recording whose header may follow metadata
+   lines: malloc'd rows x k, NULL if the file or a column is missing. */
+static double *read_columns(const char *path, const char *const *names, int k,
+                            size_t *rows)
+{
+    static char buf[1 << 16];
+    fe_csv_field f[64];
+    fe_csv_reader r;
+    char *line;
+    size_t len, nf, cap = 1024, n = 0;
+    int col[16], header = 0, fd = open(path, O_RDONLY);
+    double *out = malloc(cap * (size_t)k * sizeof *out);
+    *rows = 0;
+    if (fd < 0 || out == NULL) {
+        free(out);
+        if (fd >= 0)
+            close(fd);
+        return NULL;
+    }
+    fe_csv_reader_init(&r, fd, buf, sizeof buf);
+    while (fe_csv_next_line(&r, &line, &len) == FE_OK) {
+        if (fe_csv_split(line, ',', f, 64, &nf, NULL) != FE_OK)
+            continue;
+        if (!header) {
+            int found = 0;
+            for (int j = 0; j < k; j++) {
+                col[j] = -1;
+                for (size_t i = 0; i < nf; i++)
+                    if (strcmp(f[i].text, names[j]) == 0)
+                        col[j] = (int)i;
+                found += col[j] >= 0;
+            }
+            header = found == k;
+            continue;
+        }
+        if (n == cap) {
+            cap *= 2;
+            out = realloc(out, cap * (size_t)k * sizeof *out);
+        }
+        for (int j = 0; j < k; j++)
+            if ((size_t)col[j] >= nf || fe_csv_number(&f[col[j]], &out[n * k + j]) != FE_OK) {
+                close(fd);
+                free(out);
+                return NULL;
+            }
+        n++;
+    }
+    close(fd);
+    *rows = n;
+    return out;
+}
+
+static double *recording(const char *dir, const char *file, const char *const *names,
+                         int k, size_t *n)
+{
+    char path[4096];
+    double *x;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    x = read_columns(path, names, k, n);
+    ck_assert_msg(x != NULL && *n > 0, "cannot read %s", path);
+    return x;
+}
+
+/* Fold rows of `stride` doubles whose first three are the sample. */
+static fe_quadric fold_rows(const double *x, size_t n, size_t stride)
+{
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(fe_quadric_add(&q, x + stride * i), FE_OK);
+    return q;
+}
+
+START_TEST(real_qmc5883l_soft_iron)
+{
+    /* Strong soft iron (semi-axes 1 : 1.5 : 2.2).  CHECK.txt: algebraic
+       sphere 16% RMS, algebraic 9-parameter ellipsoid 2.81% with semi-axes
+       715/1085/1593 and centre (6194.7, 250.3, 3479.6).  Our ellipsoid
+       (Schmidt's residual) measures 2.80% and the same shape to a count or
+       two; the sphere model has no finite optimum under Schmidt's residual
+       (see sphere.org, "The runaway sphere") and is refused as such. */
+    const char *dir = fe_test_data_dir("qmc5883l recording");
+    const char *names[3] = {"mx", "my", "mz"};
+    size_t n;
+    double *x;
+    fe_quadric q;
+    fe_sphere_fit f;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "qmc5883l_tomisuarez/filtered_raw_data.csv", names, 3, &n);
+    ck_assert_uint_eq(n, 22745);
+    q = fold_rows(x, n, 3);
+    ck_assert_int_ge(fe_quadric_regions(&q), 98);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &f), FE_EUNDETERMINED);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_UNBOUNDED);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 3.75, 0.01);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 2.80, 0.01);
+    ck_assert_double_eq_tol(f.axes[0], 716.3, 1.0);
+    ck_assert_double_eq_tol(f.axes[1], 1085.3, 1.0);
+    ck_assert_double_eq_tol(f.axes[2], 1593.4, 1.5);
+    ck_assert_double_eq_tol(f.offset[0], 6194.8, 1.0);
+    ck_assert_double_eq_tol(f.offset[1], 251.3, 1.0);
+    ck_assert_double_eq_tol(f.offset[2], 3476.7, 1.5);
+    ck_assert_double_lt(f.se[0], 1.0);
+    free(x);
+    /* The noisy recording: CHECK.txt's ellipsoid 6.23%, ours 6.12%. */
+    x = recording(dir, "qmc5883l_tomisuarez/noisy_raw_data.csv", names, 3, &n);
+    q = fold_rows(x, n, 3);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 6.12, 0.01);
+    free(x);
+}
+END_TEST
+
+START_TEST(real_ck_explorer_magnetometer)
+{
+    /* CHECK.txt: sphere 2.65%, ellipsoid 1.26%, centre (0.1481, 0.3892,
+       -0.0589) G.  Ours: 2.65%, 2.23% axial, 1.26%. */
+    const char *dir = fe_test_data_dir("ck_explorer recording");
+    const char *names[3] = {"mx", "my", "mz"};
+    size_t n;
+    double *x;
+    fe_quadric q;
+    fe_sphere_fit f;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "ck_explorer_accmag/acc_mag_log.csv", names, 3, &n);
+    ck_assert_uint_eq(n, 12000);
+    q = fold_rows(x, n, 3);
+    ck_assert_int_ge(fe_quadric_regions(&q), 95);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 2.65, 0.01);
+    ck_assert_double_eq_tol(f.radius, 0.3096, 0.0002);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 2.23, 0.01);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 1.26, 0.01);
+    ck_assert_double_eq_tol(f.offset[0], 0.1481, 0.0003);
+    ck_assert_double_eq_tol(f.offset[1], 0.3892, 0.0003);
+    ck_assert_double_eq_tol(f.offset[2], -0.0588, 0.0003);
+    free(x);
+}
+END_TEST
+
+/* Keep rows whose angular rate, minus `bias`, is below `limit` (in the
+   gyro's units); the accelerometer then reads gravity alone. */
+static size_t keep_static(double *x, size_t n, const double bias[3], double limit)
+{
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (int j = 0; j < 3; j++)
+            s += (x[6 * i + 3 + j] - bias[j]) * (x[6 * i + 3 + j] - bias[j]);
+        if (sqrt(s) < limit)
+            memmove(x + 6 * m++, x + 6 * i, 6 * sizeof *x);
+    }
+    return m;
+}
+
+START_TEST(real_imucal_ferraris_static_poses)
+{
+    /* Six static poses and three turns, in m/s^2.  The turns add
+       centripetal and handling accelerations: with every sample the sphere
+       leaves 6.25% and the offset is off by a tenth of a m/s^2.  We keep
+       the samples where the gyroscope reads under 2 deg/s (what a device
+       can do in its fold, with no look-ahead): 8936 of 10376.  CHECK.txt's
+       static means give offsets (+0.54, -0.62, +0.40); the axial fit gives
+       (0.535, -0.617, 0.398) with 0.19% RMS, the sphere 1.07% (the scales
+       differ by 2.7%, which only the axial model can absorb).  Six poses
+       visit few regions (coverage is reported, not required). */
+    const char *dir = fe_test_data_dir("imucal recording");
+    const char *names[6] = {"acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z"};
+    const double nobias[3] = {0, 0, 0};
+    size_t n, m;
+    double *x;
+    fe_quadric q;
+    fe_sphere_fit f;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "imucal_ferraris/example_ferraris_session.csv", names, 6, &n);
+    ck_assert_uint_eq(n, 10376);
+    q = fold_rows(x, n, 6);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 6.25, 0.01);
+    m = keep_static(x, n, nobias, 2.0);
+    ck_assert_uint_eq(m, 8936);
+    q = fold_rows(x, m, 6);
+    ck_assert_int_le(fe_quadric_regions(&q), 25);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 1.07, 0.01);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 0.193, 0.002);
+    ck_assert_double_eq_tol(f.offset[0], 0.535, 0.002);
+    ck_assert_double_eq_tol(f.offset[1], -0.617, 0.002);
+    ck_assert_double_eq_tol(f.offset[2], 0.398, 0.002);
+    ck_assert_double_eq_tol(f.radius, 9.882, 0.002);   /* local g, uncalibrated */
+    free(x);
+}
+END_TEST
+
+START_TEST(real_mpu6050_static_poses)
+{
+    /* Raw counts, 16384 LSB/g nominal, gyro 131 LSB/(deg/s).  The gyro's
+       own bias is measured over the first 1000 samples (the recording
+       starts with 36.5 s at rest) and samples turning faster than 2 deg/s
+       are dropped: 7104 of 10245.  Upstream's Tedaldi fit has the bias
+       (-711.5, 358.5, 1840.1) counts, i.e. a centre (711.5, -358.5,
+       -1840.1); our axial fit finds (706.5, -361.1, -1838.7), within two
+       of its standard errors, at 0.46% RMS. */
+    const char *dir = fe_test_data_dir("mpu6050 recording");
+    const char *names[6] = {"ax", "ay", "az", "gx", "gy", "gz"};
+    double bias[3] = {0, 0, 0};
+    size_t n, m;
+    double *x;
+    fe_quadric q;
+    fe_sphere_fit f;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "mpu6050_accel_tomisuarez/example_data_calibration.csv", names, 6, &n);
+    ck_assert_uint_eq(n, 10245);
+    for (size_t i = 0; i < 1000; i++)
+        for (int j = 0; j < 3; j++)
+            bias[j] += x[6 * i + 3 + j] / 1000.0;
+    m = keep_static(x, n, bias, 2.0 * 131.0);
+    ck_assert_uint_eq(m, 7104);
+    q = fold_rows(x, m, 6);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_OK);
+    ck_assert_double_eq_tol(f.rms_percent, 0.459, 0.002);
+    ck_assert_double_le(fabs(f.offset[0] - 711.5), 3 * f.se[0]);
+    ck_assert_double_le(fabs(f.offset[1] + 358.5), 3 * f.se[1]);
+    ck_assert_double_le(fabs(f.offset[2] + 1840.1), 3 * f.se[2]);
+    ck_assert_double_eq_tol(f.radius, 16486, 2.0);
+    free(x);
+}
+END_TEST
+
+START_TEST(real_ximu3_one_hemisphere_is_refused)
+{
+    /* The magnetometer never turns upside down: about the fitted centre
+       every sample has z < 0 (CHECK.txt: 21/100 regions).  All three
+       models refuse, naming the hemisphere; the sphere fit, with the check
+       off, reaches only from -1.21 to -0.18 of its radius along z. */
+    const char *dir = fe_test_data_dir("x-IMU3 recording");
+    const char *names[3] = {"Magnetometer X (uT)", "Magnetometer Y (uT)",
+                            "Magnetometer Z (uT)"};
+    size_t n;
+    double *x;
+    fe_quadric q;
+    fe_sphere_fit f;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "ximu3_fusion/sensor_data.csv", names, 3, &n);
+    ck_assert_uint_eq(n, 13514);
+    q = fold_rows(x, n, 3);
+    for (int model = 0; model < 3; model++) {
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, NULL, &f),
+                         FE_EUNDETERMINED);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_HEMISPHERE);
+        ck_assert_double_lt(f.extent_hi[2], 0.0);
+    }
+    free(x);
+}
+END_TEST
+
+Suite *fe_sphere_suite(void)
+{
+    Suite *s = suite_create("sphere");
+    TCase *t = tcase_create("fits");
+    TCase *r = tcase_create("recordings");
+    tcase_set_timeout(t, 120);
+    tcase_set_timeout(r, 120);
+    tcase_add_loop_test(t, three_algorithms_agree, 0, 3);
+    tcase_add_test(t, calibration_maps_to_the_unit_sphere);
+    tcase_add_test(t, precision_with_a_large_offset);
+    tcase_add_test(t, merged_shards_fit_like_the_whole);
+    tcase_add_test(t, trace_and_stop);
+    tcase_add_test(t, damping_when_a_step_fails);
+    tcase_add_test(t, refuse_too_few_and_bad_arguments);
+    tcase_add_test(t, refuse_planar_data);
+    tcase_add_test(t, refuse_one_hemisphere);
+    tcase_add_test(t, refuse_a_hyperboloid);
+    tcase_add_test(t, refuse_a_singular_system);
+    tcase_add_test(r, real_qmc5883l_soft_iron);
+    tcase_add_test(r, real_ck_explorer_magnetometer);
+    tcase_add_test(r, real_imucal_ferraris_static_poses);
+    tcase_add_test(r, real_mpu6050_static_poses);
+    tcase_add_test(r, real_ximu3_one_hemisphere_is_refused);
+    suite_add_tcase(s, t);
+    suite_add_tcase(s, r);
+    return s;
+}
