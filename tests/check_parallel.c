@@ -699,6 +699,222 @@ START_TEST(generators_per_thread_equal_one_generator)
 }
 END_TEST
 
+/* ------------------------------------------------------------------------
+   One source, one reader, many workers. */
+
+/* A ring of `nslots` slots for batches of `batch` observations of `obs_size`
+   bytes, with flat accumulations in `accs`; buffers freed by ring_free. */
+static void ring_make(fe_parallel_slot *ring, slot *accs, unsigned nslots,
+                      size_t batch, size_t obs_size)
+{
+    for (unsigned s = 0; s < nslots; s++) {
+        ring[s].obs = malloc(batch * obs_size);
+        ring[s].acc = &accs[s];
+    }
+}
+
+static void ring_free(fe_parallel_slot *ring, unsigned nslots)
+{
+    for (unsigned s = 0; s < nslots; s++)
+        free(ring[s].obs);
+}
+
+START_TEST(pipeline_is_exactly_the_serial_fold)
+{
+    /* The exact, order-sensitive hash: any batch size, ring size and
+       worker count must give the serial fold to the bit. */
+    static const size_t ns[] = {0, 1, 7, 1000, 10007};
+    static const size_t batches[] = {1, 3, 64, 1000};
+    static const unsigned rings[] = {1, 2, 5, 8};
+    fe_accumulator f = hash_accumulator();
+    int wrong = 0;
+    char where[160] = "";
+    for (size_t ni = 0; ni < sizeof ns / sizeof ns[0]; ni++) {
+        size_t n = ns[ni];
+        uint64_t *z = malloc((n + 1) * sizeof *z);
+        hash_acc serial;
+        fe_rng r = fe_rng_seed(500 + ni);
+        for (size_t i = 0; i < n; i++)
+            z[i] = fe_rng_next(&r) >> 1;
+        hash_init(&serial, NULL);
+        fe_fold(&f, &serial, z, n, NULL);
+        for (size_t bi = 0; bi < sizeof batches / sizeof batches[0]; bi++)
+            for (size_t ri = 0; ri < sizeof rings / sizeof rings[0]; ri++)
+                for (unsigned w = 0; w <= 4; w++) {
+                    fe_parallel_slot ring[8];
+                    slot accs[8];
+                    fe_array_source st;
+                    fe_source src;
+                    hash_acc a;
+                    size_t done = 0;
+                    int rc;
+                    ring_make(ring, accs, rings[ri], batches[bi], sizeof z[0]);
+                    fe_source_from_array(&src, &st, z, n, sizeof z[0]);
+                    hash_init(&a, NULL);
+                    rc = fe_parallel_fold_source(&f, &a, &src, w, batches[bi], ring,
+                                                 rings[ri], &done);
+                    if (rc != FE_OK || done != n || memcmp(&a, &serial, sizeof a) != 0) {
+                        wrong = 1;
+                        snprintf(where, sizeof where, "n %zu, batch %zu, %u slots, %u workers: rc %d",
+                                 n, batches[bi], rings[ri], w, rc);
+                    }
+                    ring_free(ring, rings[ri]);
+                }
+        free(z);
+    }
+    ck_assert_msg(!wrong, "pipeline differs from the serial fold at %s", where);
+}
+END_TEST
+
+START_TEST(pipeline_result_does_not_depend_on_workers)
+{
+    /* Mean and variance: bit-identical for 0..4 workers (same batches),
+       and equal to the serial fold to 1e-12. */
+    size_t n = fe_test_quick() ? 20011 : 200011;
+    fe_accumulator f = fe_meanvar_accumulator();
+    unsigned char *z = generate(&cases[0], &f, n, 77);
+    fe_meanvar serial = FE_MEANVAR_EMPTY, first = FE_MEANVAR_EMPTY;
+    int differ = 0, bad = 0;
+    double worst = 0.0;
+    fe_fold(&f, &serial, z, n, NULL);
+    for (unsigned w = 0; w <= 4; w++) {
+        fe_parallel_slot ring[6];
+        slot accs[6];
+        fe_array_source st;
+        fe_source src;
+        fe_meanvar a = FE_MEANVAR_EMPTY;
+        size_t done = 0;
+        ring_make(ring, accs, 6, 4096, sizeof(double));
+        fe_source_from_array(&src, &st, z, n, sizeof(double));
+        bad |= fe_parallel_fold_source(&f, &a, &src, w, 4096, ring, 6, &done) != FE_OK;
+        bad |= done != n;
+        if (w == 0)
+            first = a;
+        differ |= memcmp(&a, &first, sizeof a) != 0;
+        worst = fmax(worst, meanvar_distance(&a, &serial));
+        ring_free(ring, 6);
+    }
+    ck_assert(!bad);
+    ck_assert_msg(!differ, "the result depends on the number of workers");
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g", worst);
+    free(z);
+}
+END_TEST
+
+START_TEST(pipeline_first_refusal_wins)
+{
+    /* A refused observation at p: its index, and the exact fold of what
+       precedes, whatever the batching and the workers. */
+    enum { N = 2003 };
+    static uint64_t z[N];
+    static const size_t at[] = {0, 1, 99, 100, 1001, N - 1};
+    static const size_t batches[] = {1, 7, 100};
+    fe_accumulator f = hash_accumulator();
+    int wrong = 0;
+    fe_rng r = fe_rng_seed(4);
+    for (int i = 0; i < N; i++)
+        z[i] = fe_rng_next(&r) >> 1;
+    for (size_t k = 0; k < sizeof at / sizeof at[0]; k++) {
+        hash_acc serial;
+        hash_init(&serial, NULL);
+        fe_fold(&f, &serial, z, at[k], NULL);
+        z[at[k]] = UINT64_MAX;
+        if (at[k] + 3 < N)
+            z[at[k] + 3] = UINT64_MAX;      /* a later one, ignored */
+        for (size_t bi = 0; bi < 3; bi++)
+            for (unsigned w = 0; w <= 3; w++) {
+                fe_parallel_slot ring[4];
+                slot accs[4];
+                fe_array_source st;
+                fe_source src;
+                hash_acc a;
+                size_t done = 0;
+                ring_make(ring, accs, 4, batches[bi], sizeof z[0]);
+                fe_source_from_array(&src, &st, z, N, sizeof z[0]);
+                hash_init(&a, NULL);
+                wrong |= fe_parallel_fold_source(&f, &a, &src, w, batches[bi], ring, 4,
+                                                 &done) != FE_EINVAL;
+                wrong |= done != at[k] || memcmp(&a, &serial, sizeof a) != 0;
+                ring_free(ring, 4);
+            }
+        z[at[k]] = 1;
+        if (at[k] + 3 < N)
+            z[at[k] + 3] = 2;
+    }
+    ck_assert_msg(!wrong, "a refusal did not leave the exact prefix fold");
+}
+END_TEST
+
+/* A stream of 1000 whose read fails at index 777. */
+static int fails_at_777(void *obs, size_t index, void *ctx)
+{
+    (void)ctx;
+    if (index == 777)
+        return FE_EIO;
+    *(double *)obs = (double)(index % 13);
+    return FE_OK;
+}
+
+START_TEST(pipeline_source_error_after_earlier_batches)
+{
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_generator_source gst;
+    fe_source src;
+    double slot_obs, x[777];
+    fe_parallel_slot ring[4];
+    slot accs[4];
+    fe_meanvar a = FE_MEANVAR_EMPTY, serial = FE_MEANVAR_EMPTY;
+    size_t done = 0;
+    for (int i = 0; i < 777; i++)
+        x[i] = (double)(i % 13);
+    fe_fold(&f, &serial, x, 777, NULL);
+    fe_source_from_generator(&src, &gst, fails_at_777, NULL, &slot_obs, sizeof slot_obs);
+    ring_make(ring, accs, 4, 50, sizeof(double));
+    ck_assert_int_eq(fe_parallel_fold_source(&f, &a, &src, 2, 50, ring, 4, &done), FE_EIO);
+    ck_assert_uint_eq(done, 777);
+    ck_assert_uint_eq(a.n, 777);
+    FE_ASSERT_REL(a.mean, serial.mean, 1e-12);
+    FE_ASSERT_REL(a.m2, serial.m2, 1e-12);
+    ring_free(ring, 4);
+}
+END_TEST
+
+START_TEST(pipeline_bad_arguments_read_nothing)
+{
+    const double x[3] = {1, 2, 3};
+    fe_accumulator f = fe_meanvar_accumulator(), nomerge = f;
+    fe_array_source st;
+    fe_source src;
+    fe_parallel_slot ring[2];
+    slot accs[2];
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    size_t done = 5;
+    int wrong = 0;
+    nomerge.merge = NULL;
+    fe_source_from_array(&src, &st, x, 3, sizeof x[0]);
+    ring_make(ring, accs, 2, 2, sizeof(double));
+    wrong |= fe_parallel_fold_source(NULL, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, NULL, 1, 2, ring, 2, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 0, ring, 2, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, NULL, 2, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 0, &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, FE_PARALLEL_MAX_SLOTS + 1,
+                                     &done) != FE_EINVAL;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, FE_PARALLEL_MAX_THREADS + 1, 2, ring, 2,
+                                     &done) != FE_ESIZE;
+    wrong |= fe_parallel_fold_source(&nomerge, &a, &src, 1, 2, ring, 2, &done) != FE_ENOTSUP;
+    ring[1].acc = ring[0].acc;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+    ring[1].acc = &a;
+    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+    ck_assert_msg(!wrong, "a bad argument was not refused with the right code");
+    ck_assert_uint_eq(done, 0);
+    ck_assert_uint_eq(a.n, 0);
+    ck_assert_uint_eq(st.pos, 0);               /* nothing was read */
+    ring_free(ring, 2);
+}
+END_TEST
+
 Suite *fe_parallel_suite(void)
 {
     Suite *s = suite_create("parallel");
@@ -718,6 +934,11 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, sources_fold_their_concatenation);
     tcase_add_test(t, generators_per_thread_equal_one_generator);
     tcase_add_test(t, a_failing_source_is_a_refusal);
+    tcase_add_test(t, pipeline_is_exactly_the_serial_fold);
+    tcase_add_test(t, pipeline_result_does_not_depend_on_workers);
+    tcase_add_test(t, pipeline_first_refusal_wins);
+    tcase_add_test(t, pipeline_source_error_after_earlier_batches);
+    tcase_add_test(t, pipeline_bad_arguments_read_nothing);
     suite_add_tcase(s, t);
     return s;
 }

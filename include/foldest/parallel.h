@@ -60,5 +60,41 @@ int fe_parallel_fold_sources(const fe_accumulator *f, void *acc,
                              fe_source *const *sources, unsigned count,
                              void *const *partials, size_t *done);
 
+/* One slot of the ring used by fe_parallel_fold_source: caller memory for
+   a batch of observations and for one accumulation. */
+typedef struct fe_parallel_slot {
+    void *obs;      /* batch * f->obs_size bytes, aligned for the observation */
+    void *acc;      /* an accumulation, prepared like a partial */
+} fe_parallel_slot;
+
+/* The largest ring fe_parallel_fold_source accepts. */
+#define FE_PARALLEL_MAX_SLOTS 256
+
+/* fe_parallel_fold_source: fold the single source `src` into `acc` with
+   `workers` worker threads (0: the calling thread does everything).  The
+   calling thread reads `batch` observations at a time into a free slot of
+   `slots` (nslots of them, 1 <= nslots <= FE_PARALLEL_MAX_SLOTS); a worker
+   folds the batch into the slot's accumulation (initialised with fe_init);
+   the calling thread merges the batch accumulations into `acc` in stream
+   order.  The result depends only on `batch` and the data, never on
+   `workers` or scheduling; it equals fe_fold_source up to rounding.
+   Memory: the slots' buffers and accumulations are the caller's, distinct
+   from each other and from `acc`; their content afterwards is unspecified.
+   nslots >= 2 * workers keeps the workers busy.
+   Errors: FE_EINVAL (null or aliased arguments, batch == 0, nslots out of
+   range, src->obs_size != f->obs_size), FE_ESIZE (workers >
+   FE_PARALLEL_MAX_THREADS), FE_ENOTSUP (no merge), FE_ENOMEM (the
+   synchronisation could not be set up): nothing is read.  Otherwise the
+   first refusal in stream order is returned with `*done` its index and
+   `acc` the fold of the observations before it (a step's refusal, or the
+   source's own error after all earlier batches); a merge or init refusal
+   gives *done = the start of its batch.  Cost: a copy of each observation
+   and one merge per batch on the calling thread, plus the steps spread over
+   the workers. */
+int fe_parallel_fold_source(const fe_accumulator *f, void *acc,
+                            fe_source *src, unsigned workers, size_t batch,
+                            const fe_parallel_slot *slots, unsigned nslots,
+                            size_t *done);
+
 #endif /* FOLDEST_PARALLEL_H */
 /* Parallel Fold Declarations ends here */
