@@ -210,7 +210,7 @@ check-install: lib
 	$(MAKE) -s install DESTDIR="$$d" PREFIX=/usr/local >/dev/null; \
 	for e in examples/*.c; do \
 	  PKG_CONFIG_SYSROOT_DIR="$$d" PKG_CONFIG_PATH="$$d/usr/local/lib/pkgconfig" \
-	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest) -lm' _ "$$d" "$$e"; \
+	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest)' _ "$$d" "$$e"; \
 	  echo "built $$e against $$d/usr/local"; \
 	done
 

@@ -5,6 +5,7 @@
 #      here, and a negative control with nothing hidden;
 #   2. the phone free-fall recordings (../shared/data/freefall-drag, or
 #      $FOLDEST_DATA), against a vacuum free-fall simulation of each drop;
+#   3. magnetometer recordings against the best sphere through them;
 # each with a report (Markdown and plots) under $OUT.
 set -e
 B=${1:-build}
@@ -33,6 +34,19 @@ if [ -f "$DATA/freefall-drag/csv/fall_1.csv" ]; then
   args=$(tail -n 1 "$OUT/freefall_sim.txt" | sed 's/^foldest discover//')
   # shellcheck disable=SC2086
   "$FOLDEST" discover $args --report "$OUT/freefall"
+else
+  echo "no recordings at $DATA (set FOLDEST_DATA): skipped"
+fi
+
+say "3. Magnetometers: the best sphere as the simulation"
+if [ -f "$DATA/qmc5883l_tomisuarez/filtered_raw_data.csv" ]; then
+  "$FOLDEST" discover --sphere "$DATA/qmc5883l_tomisuarez/filtered_raw_data.csv" | sed -n '/left out/,$p'
+  echo
+  "$FOLDEST" discover --sphere "$DATA/ck_explorer_accmag/acc_mag_log.csv" --columns mx,my,mz | sed -n '/left out/,$p'
+  echo
+  echo "one hemisphere only (x-IMU3): refused, not explained:"
+  "$FOLDEST" discover --sphere "$DATA/ximu3_fusion/sensor_data.csv" \
+    --columns "Magnetometer X","Magnetometer Y","Magnetometer Z" || true
 else
   echo "no recordings at $DATA (set FOLDEST_DATA): skipped"
 fi

@@ -595,6 +595,21 @@ int fe_discover_select(const fe_discover_acc *a,
     }
     res->ncols = ncols;
     memcpy(res->cols, cols, ncols * sizeof *cols);
-    return fe__fit(a, &w, cols, ncols, res->coef, res->stderr_, &res->final);
+    rc = fe__fit(a, &w, cols, ncols, res->coef, res->stderr_, &res->final);
+    if (rc != FE_OK)
+        return rc;
+    /* Report both BICs with one effective sample size, the final model's
+       (its residual is the best estimate of the noise's correlation), so
+       that they can be compared. */
+    {
+        double ne = res->final.n_eff, n = res->final.n;
+        fe_discover_fit *f[2] = {&res->baseline, &res->final};
+        for (int i = 0; i < 2; i++) {
+            f[i]->bic = ne * log(f[i]->rss > 0 ? f[i]->rss / n : 1e-300)
+                        + (double)f[i]->params * log(ne);
+            f[i]->n_eff = ne;
+        }
+    }
+    return FE_OK;
 }
 /* Select terms by forward selection ends here */

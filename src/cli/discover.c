@@ -207,6 +207,13 @@ static const char fe__discover_help[] =
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
     "  --json                 print one JSON object instead of the story\n"
     "\n"
+    "Three-axis sensors (the best sphere through the samples is the simulation):\n"
+    "  foldest discover --sphere FILE.csv [--columns x,y,z] [--time NAME]\n"
+    "                   [--role COLUMN=temperature] [--holdout F] [--json]\n"
+    "  names axis_gain (unequal scales), cross_axis (soft iron), thermal_offset,\n"
+    "  drift against the sphere's radius and centre (bias, hard_iron); refuses\n"
+    "  data that do not determine the sphere (one hemisphere, a plane).\n"
+    "\n"
     "Terms (recording - simulation = sum of coefficient x term + noise):\n";
 
 typedef struct fe__discover_args {
@@ -764,6 +771,8 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const char *p
 }
 /* Write the report ends here */
 /* [[file:../../literate/cli_discover.org::Run discovery on recordings][Run discovery on recordings]] */
+static int fe__discover_sphere_main(int argc, char **argv);
+
 int fe_cli_discover(int argc, char **argv)
 {
     fe__discover_args a;
@@ -793,6 +802,9 @@ int fe_cli_discover(int argc, char **argv)
     double *per_g = NULL;
 
     memset(&out, 0, sizeof out);
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], "--sphere") == 0)
+            return fe__discover_sphere_main(argc, argv);
     rc = fe__discover_parse(argc, argv, &a, err, sizeof err);
     if (rc == -1) {
         fe__discover_usage(stdout);
@@ -1213,3 +1225,391 @@ cleanup:
     return rc;
 }
 /* Run discovery on recordings ends here */
+/* [[file:../../literate/cli_discover.org::Discover on a three-axis recording][Discover on a three-axis recording]] */
+typedef struct fe__sphere_args {
+    const char *path, *time, *temperature;
+    char *columns;
+    double holdout, alpha;
+    long blocks;
+    int json;
+} fe__sphere_args;
+
+enum { FE__SPH_COLS = 13 };
+
+/* The columns of a sample: 1, u, u_x^2, u_y^2, cross products, (T-T1) u, t-t1. */
+static void fe__sphere_terms(const double x[3], double t, double temp, const double b[3],
+                             double t1, double temp1, double *phi, double *radius)
+{
+    double d[3] = {x[0] - b[0], x[1] - b[1], x[2] - b[2]};
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    double u[3] = {d[0] / len, d[1] / len, d[2] / len};
+    *radius = len;
+    phi[0] = 1.0;
+    phi[1] = u[0];
+    phi[2] = u[1];
+    phi[3] = u[2];
+    phi[4] = u[0] * u[0];
+    phi[5] = u[1] * u[1];
+    phi[6] = u[0] * u[1];
+    phi[7] = u[0] * u[2];
+    phi[8] = u[1] * u[2];
+    phi[9] = (temp - temp1) * u[0];
+    phi[10] = (temp - temp1) * u[1];
+    phi[11] = (temp - temp1) * u[2];
+    phi[12] = t - t1;
+}
+
+static int fe__sphere_read(fe_cli_table *t, const size_t *cols, size_t k, double *v,
+                           char *err, size_t errlen)
+{
+    return fe_cli_table_next(t, cols, k, v, err, errlen);
+}
+
+static int fe__discover_sphere(fe__sphere_args *a)
+{
+    fe_cli_table t;
+    size_t cols[5], k = 3, rows = 0, fit_rows, held;
+    char err[2048];
+    double v[5], t1 = 0, temp1 = 0;
+    fe_quadric q;
+    fe_sphere_fit fit;
+    fe_discover_acc acc;
+    fe_discover_group groups[6] = {
+        {"bias", 0, 1}, {"hard_iron", 1, 3}, {"axis_gain", 4, 2},
+        {"cross_axis", 6, 3}, {"thermal_offset", 9, 3}, {"drift", 12, 1}};
+    const char *desc[6] = {"a different radius", "an offset of the centre",
+                           "unequal per-axis scale", "soft iron or non-orthogonal axes",
+                           "an offset that moves with temperature",
+                           "a field or a gain drifting with time"};
+    size_t base[2] = {0, 1}, ngroups;
+    double *storage = NULL, *work = NULL, phi[FE__SPH_COLS];
+    fe_discover_result *res = NULL;
+    fe_discover_options opt = fe_discover_default_options();
+    int rc, has_time = 0, has_temp = a->temperature != NULL;
+    double oct_n[8] = {0}, oct_s0[8] = {0}, oct_s1[8] = {0}, ms_all = 0;
+
+    rc = fe_cli_table_open(&t, a->path, -1, err, sizeof err);
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest discover: %s\n", err);
+        return rc;
+    }
+    if (strcmp(a->path, "-") == 0) {
+        fprintf(stderr, "foldest discover: --sphere reads the file three times: give a file\n");
+        fe_cli_table_close(&t);
+        return FE_CLI_USAGE;
+    }
+    /* Columns: three axes, then time and temperature when given. */
+    if (a->columns != NULL) {
+        char *names[4];
+        if (fe_cli_split_list(a->columns, names, 4) != 3) {
+            fprintf(stderr, "foldest discover: --columns needs three columns, a,b,c\n");
+            fe_cli_table_close(&t);
+            return FE_CLI_USAGE;
+        }
+        for (int i = 0; i < 3; i++)
+            if ((rc = fe_cli_table_column(&t, names[i], &cols[i], err, sizeof err)) != FE_CLI_OK)
+                goto fail;
+    } else if (t.ncols == 3) {
+        cols[0] = 0;
+        cols[1] = 1;
+        cols[2] = 2;
+    } else {
+        fprintf(stderr, "foldest discover: %s has %zu columns: name the three axes with "
+                        "--columns a,b,c\n", t.name, t.ncols);
+        fe_cli_table_close(&t);
+        return FE_CLI_USAGE;
+    }
+    if (a->time != NULL) {
+        if ((rc = fe_cli_table_column(&t, a->time, &cols[k++], err, sizeof err)) != FE_CLI_OK)
+            goto fail;
+        has_time = 1;
+    }
+    if (has_temp
+        && (rc = fe_cli_table_column(&t, a->temperature, &cols[k++], err, sizeof err)) != FE_CLI_OK)
+        goto fail;
+
+    /* Pass 1: the moments, and the sphere. */
+    fe_quadric_init(&q, NULL);
+    while ((rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK) {
+        if (rows == 0) {
+            t1 = has_time ? v[3] : 0.0;
+            temp1 = has_temp ? v[k - 1] : 0.0;
+        }
+        if (fe_quadric_add(&q, v) != FE_OK) {
+            snprintf(err, sizeof err, "%s:%zu: sample too large", t.name, t.line);
+            rc = FE_CLI_INPUT;
+            goto fail;
+        }
+        rows++;
+    }
+    if (rc != FE_END)
+        goto fail;
+    rc = fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &fit);
+    if (fit.refusal == FE_SPHERE_TOO_FEW || fit.refusal == FE_SPHERE_PLANAR
+        || fit.refusal == FE_SPHERE_HEMISPHERE || fit.refusal == FE_SPHERE_COVERAGE) {
+        if (a->json) {
+            printf("{\"verdict\": \"refused\", \"reason\": ");
+            fe_cli_json_string(stdout, fe_sphere_refusal_string(fit.refusal));
+            printf(", \"coverage\": %.4g, \"n\": %zu}\n", fit.coverage, rows);
+        }
+        fprintf(stderr, "foldest discover: %s: the sphere is not determined by these data "
+                        "(%s; coverage %.0f%% of the regions): nothing to compare against\n",
+                t.name, fe_sphere_refusal_string(fit.refusal), 100.0 * fit.coverage);
+        fe_cli_table_close(&t);
+        return FE_CLI_REFUSED;
+    }
+    /* The sphere itself: the algebraic least-squares sphere
+       |d|^2 = 2 b'.d + c, d = x - x_1, from a second fold (always defined
+       when the data are not planar, unlike the geometric fit, which can run
+       off to a plane when the data are a strong ellipsoid). */
+    {
+        double g[25], w[25], coef[4], rss, ref[3];
+        fe_lsq ls;
+        fe_lsq_init(&ls, 4, g);
+        if ((rc = fe_cli_table_rewind(&t, err, sizeof err)) != FE_CLI_OK)
+            goto fail;
+        for (size_t i = 0; (rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK; i++) {
+            double d[4];
+            if (i == 0)
+                memcpy(ref, v, sizeof ref);
+            d[0] = v[0] - ref[0];
+            d[1] = v[1] - ref[1];
+            d[2] = v[2] - ref[2];
+            d[3] = 1.0;
+            fe_lsq_add(&ls, d, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], 1.0);
+        }
+        if (rc != FE_END)
+            goto fail;
+        if (fe_lsq_solve(&ls, NULL, 4, coef, &rss, NULL, w) != FE_OK) {
+            fprintf(stderr, "foldest discover: %s: no sphere fits these samples\n", t.name);
+            rc = FE_CLI_REFUSED;
+            goto done;
+        }
+        for (int i = 0; i < 3; i++)
+            fit.offset[i] = ref[i] + 0.5 * coef[i];
+        fit.radius = sqrt(coef[3] + 0.25 * (coef[0] * coef[0] + coef[1] * coef[1]
+                                            + coef[2] * coef[2]));
+    }
+    held = (size_t)floor(a->holdout * (double)rows);
+    fit_rows = rows - held;
+    ngroups = has_temp ? 5 : 4;
+    if (has_time)
+        groups[ngroups++] = groups[5];
+    {
+        size_t nst = fe_discover_acc_doubles(FE__SPH_COLS, (size_t)a->blocks);
+        size_t nw = fe_discover_workspace_doubles(FE__SPH_COLS, (size_t)a->blocks);
+        storage = malloc(nst * sizeof *storage);
+        work = malloc(nw * sizeof *work);
+        res = malloc(sizeof *res);
+        if (storage == NULL || work == NULL || res == NULL) {
+            snprintf(err, sizeof err, "out of memory");
+            rc = FE_CLI_IO;
+            goto fail;
+        }
+        if (fe_discover_acc_init(&acc, FE__SPH_COLS, (size_t)a->blocks, fit_rows, 0, storage,
+                                 nst) != FE_OK) {
+            fprintf(stderr, "foldest discover: %s: %zu rows are too few for %ld blocks\n",
+                    t.name, rows, a->blocks);
+            rc = FE_CLI_REFUSED;
+            goto done;
+        }
+        /* Pass 2: the block Gram matrices of the radial residual. */
+        if ((rc = fe_cli_table_rewind(&t, err, sizeof err)) != FE_CLI_OK)
+            goto fail;
+        while ((rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK) {
+            double len;
+            fe__sphere_terms(v, has_time ? v[3] : (double)t.rows, has_temp ? v[k - 1] : 0.0,
+                             fit.offset, t1, temp1, phi, &len);
+            if (fe_discover_add(&acc, phi, len - fit.radius) != FE_OK) {
+                snprintf(err, sizeof err, "%s:%zu: a sample at the centre", t.name, t.line);
+                rc = FE_CLI_INPUT;
+                goto fail;
+            }
+        }
+        if (rc != FE_END)
+            goto fail;
+        opt.alpha = a->alpha;
+        opt.base = base;
+        opt.nbase = 2;
+        rc = fe_discover_select(&acc, groups, ngroups, &opt, res, work, nw);
+        if (rc != FE_OK) {
+            fprintf(stderr, "foldest discover: %s: %s\n", t.name, fe_strerror(rc));
+            rc = FE_CLI_REFUSED;
+            goto done;
+        }
+    }
+    /* Pass 3: the residual by octant of orientation, before and after. */
+    if ((rc = fe_cli_table_rewind(&t, err, sizeof err)) != FE_CLI_OK)
+        goto fail;
+    {
+        size_t i = 0;
+        while ((rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK) {
+            double len, before, after;
+            int o;
+            fe__sphere_terms(v, has_time ? v[3] : (double)t.rows, has_temp ? v[k - 1] : 0.0,
+                             fit.offset, t1, temp1, phi, &len);
+            before = len - fit.radius;
+            after = before;
+            for (size_t j = 0; j < res->ncols; j++)
+                after -= res->coef[j] * phi[res->cols[j]];
+            o = (phi[1] > 0) + 2 * (phi[2] > 0) + 4 * (phi[3] > 0);
+            if (i < fit_rows) {
+                oct_n[o] += 1;
+                oct_s0[o] += before * before;
+                oct_s1[o] += after * after;
+                ms_all += before * before;
+            }
+            i++;
+        }
+        if (rc != FE_END)
+            goto fail;
+        ms_all /= (double)fit_rows;
+    }
+    /* Report. */
+    {
+        const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
+        const char *verdict = res->steps > 0 ? "mismatch explained" : "no significant mismatch";
+        if (a->json) {
+            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu, "
+                   "\"radius\": %.10g, \"offset\": [%.10g, %.10g, %.10g], \"coverage\": %.4g, ",
+                   verdict, rows, held, fit.radius, fit.offset[0], fit.offset[1], fit.offset[2],
+                   fit.coverage);
+            printf("\"baseline\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
+                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, ", b0->rms, 100 * b0->rms / fit.radius,
+                   b0->bic, b0->heldout_rms, b0->lag1);
+            printf("\"final\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
+                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, \"discovered\": [", b1->rms,
+                   100 * b1->rms / fit.radius, b1->bic, b1->heldout_rms, b1->lag1);
+            for (size_t s = 0; s < res->steps; s++) {
+                const fe_discover_group *g = &groups[res->added[s]];
+                printf("%s{\"name\": \"%s\", \"description\": \"%s\", \"coefficients\": [",
+                       s ? ", " : "", g->name, desc[res->added[s] < 5 ? res->added[s] : 5]);
+                for (size_t c = 0; c < g->count; c++)
+                    for (size_t j = 0; j < res->ncols; j++)
+                        if (res->cols[j] == g->first + c)
+                            printf("%s%.6g", c ? ", " : "", res->coef[j]);
+                printf("], \"stderr\": [");
+                for (size_t c = 0; c < g->count; c++)
+                    for (size_t j = 0; j < res->ncols; j++)
+                        if (res->cols[j] == g->first + c)
+                            printf("%s%.3g", c ? ", " : "", res->stderr_[j]);
+                printf("], \"statistic\": %.4g, \"p_value\": %.3g}", res->added_rank[s].statistic,
+                       res->added_rank[s].p_value);
+            }
+            printf("]}\n");
+        } else {
+            printf("%s: %zu samples (%zu held out); the sphere: centre (%.6g, %.6g, %.6g), "
+                   "radius %.6g, coverage %.0f%%\n", t.name, rows, held, fit.offset[0],
+                   fit.offset[1], fit.offset[2], fit.radius, 100 * fit.coverage);
+            printf("baseline (sphere: radius and centre): radial RMS %.4g (%.3g%% of the radius), "
+                   "held out %.4g, lag-1 %.2f\n", b0->rms, 100 * b0->rms / fit.radius,
+                   b0->heldout_rms, b0->lag1);
+            printf("\nwhere it differs (orientation octant of the sample, fitted rows):\n");
+            for (int o = 0; o < 8; o++)
+                if (oct_n[o] > 0)
+                    printf("  octant %c%c%c  %6.0f samples  radial RMS %.4g -> %.4g  (%.2fx the "
+                           "overall mean square)\n", o & 1 ? '+' : '-', o & 2 ? '+' : '-',
+                           o & 4 ? '+' : '-', oct_n[o], sqrt(oct_s0[o] / oct_n[o]),
+                           sqrt(oct_s1[o] / oct_n[o]), oct_s0[o] / oct_n[o] / ms_all);
+            printf("\ncandidates, first step (Hotelling tests over %ld time blocks):\n", a->blocks);
+            for (size_t i = 0; i < res->nranked[0]; i++) {
+                const fe_discover_rank *r = &res->ranking[0][i];
+                printf("  %-16s (%zu columns) RSS drop %10.4g   statistic %8.2f   p = %.2g\n",
+                       groups[r->group].name, groups[r->group].count, r->rss_drop, r->statistic,
+                       r->p_value);
+            }
+            printf("\nwhat the sphere left out:\n");
+            if (res->steps == 0)
+                printf("  nothing significant\n");
+            for (size_t s = 0; s < res->steps; s++) {
+                const fe_discover_group *g = &groups[res->added[s]];
+                printf("  %zu. %s (%s): F = %.1f, p = %.2g; coefficients / radius:", s + 1,
+                       g->name, desc[res->added[s] < 5 ? res->added[s] : 5],
+                       res->added_rank[s].statistic, res->added_rank[s].p_value);
+                for (size_t c = 0; c < g->count; c++)
+                    for (size_t j = 0; j < res->ncols; j++)
+                        if (res->cols[j] == g->first + c)
+                            printf(" %.4g +/- %.2g", res->coef[j] / fit.radius,
+                                   res->stderr_[j] / fit.radius);
+                printf("\n");
+            }
+            printf("\nfit: radial RMS %.4g%% -> %.4g%% of the radius, BIC %.6g -> %.6g, lag-1 "
+                   "%.2f -> %.2f\n", 100 * b0->rms / fit.radius, 100 * b1->rms / fit.radius,
+                   b0->bic, b1->bic, b0->lag1, b1->lag1);
+            if (held > 0)
+                printf("held out: radial RMS %.4g%% -> %.4g%%\n", 100 * b0->heldout_rms / fit.radius,
+                       100 * b1->heldout_rms / fit.radius);
+            printf("\nverdict: %s\n", verdict);
+        }
+    }
+    rc = FE_CLI_OK;
+    goto done;
+fail:
+    fprintf(stderr, "foldest discover: %s\n", err);
+done:
+    fe_cli_table_close(&t);
+    free(storage);
+    free(work);
+    free(res);
+    return rc;
+}
+/* Discover on a three-axis recording ends here */
+/* [[file:../../literate/cli_discover.org::Parse the three-axis options][Parse the three-axis options]] */
+static int fe__discover_sphere_main(int argc, char **argv)
+{
+    fe__sphere_args a = {NULL, NULL, NULL, NULL, 0.2, 0.05, 20, 0};
+    char err[512];
+    for (int i = 1; i < argc; i++) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int rc = FE_CLI_OK;
+        if (strcmp(o, "--json") == 0) {
+            a.json = 1;
+            continue;
+        }
+        if (v == NULL) {
+            fprintf(stderr, "foldest discover: %s needs a value\n", o);
+            return FE_CLI_USAGE;
+        }
+        i++;
+        if (strcmp(o, "--sphere") == 0)
+            a.path = v;
+        else if (strcmp(o, "--columns") == 0)
+            a.columns = argv[i];
+        else if (strcmp(o, "--time") == 0)
+            a.time = v;
+        else if (strcmp(o, "--role") == 0) {
+            const char *eq = strchr(v, '=');
+            if (eq == NULL || strcmp(eq + 1, "temperature") != 0) {
+                snprintf(err, sizeof err, "--role with --sphere: COLUMN=temperature");
+                rc = FE_CLI_USAGE;
+            } else {
+                argv[i][eq - v] = '\0';
+                a.temperature = v;
+            }
+        } else if (strcmp(o, "--holdout") == 0) {
+            rc = fe_cli_parse_double(o, v, &a.holdout, err, sizeof err);
+            if (rc == FE_CLI_OK && !(a.holdout >= 0.0 && a.holdout < 0.9)) {
+                snprintf(err, sizeof err, "--holdout: %s is not in [0, 0.9)", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--alpha") == 0) {
+            rc = fe_cli_parse_double(o, v, &a.alpha, err, sizeof err);
+        } else if (strcmp(o, "--blocks") == 0) {
+            rc = fe_cli_parse_long(o, v, &a.blocks, err, sizeof err);
+            if (rc == FE_CLI_OK && (a.blocks < 4 || a.blocks > FE_DISCOVER_MAX_BLOCKS)) {
+                snprintf(err, sizeof err, "--blocks: %s is not in [4, %d]", v,
+                         FE_DISCOVER_MAX_BLOCKS);
+                rc = FE_CLI_USAGE;
+            }
+        } else {
+            snprintf(err, sizeof err, "unknown option '%s' with --sphere", o);
+            rc = FE_CLI_USAGE;
+        }
+        if (rc != FE_CLI_OK) {
+            fprintf(stderr, "foldest discover: %s\n", err);
+            return rc;
+        }
+    }
+    return fe__discover_sphere(&a);
+}
+/* Parse the three-axis options ends here */
