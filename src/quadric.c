@@ -139,8 +139,20 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
 }
 /* Fold one sample into the moments ends here */
 /* [[file:../literate/quadric.org::Sum the moments of a block][Sum the moments of a block]] */
+/* No clones under ThreadSanitizer: the loader runs the clone's resolver
+   before the sanitizer's runtime is up, and the instrumented resolver
+   crashes. */
+#if defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define FE__QUADRIC_TSAN 1
+#endif
+#endif
+#if defined(__SANITIZE_THREAD__)
+#define FE__QUADRIC_TSAN 1
+#endif
+
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__) \
-    && !defined(FE_NO_CLONES)
+    && !defined(FE_NO_CLONES) && !defined(FE__QUADRIC_TSAN)
 #define FE__QUADRIC_KERNEL __attribute__((target_clones("avx2", "default")))
 #else
 #define FE__QUADRIC_KERNEL
