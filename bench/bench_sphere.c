@@ -25,14 +25,10 @@ static void points(double *x, size_t n, uint64_t seed)
 {
     fe_rng g = fe_rng_seed(seed);
     for (size_t i = 0; i < n; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = sqrt(s);
+        double v[3];
+        fe_rng_unit_vector(&g, v);
         for (int j = 0; j < 3; j++)
-            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 2.0 * fe_rng_normal(&g);
+            x[3 * i + j] = C0[j] + R0[j] * v[j] + 2.0 * fe_rng_normal(&g);
     }
 }
 

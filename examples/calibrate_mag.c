@@ -42,16 +42,6 @@ static size_t read_recording(const char *path, double *x, size_t max)
     return n;
 }
 
-/* A square root by Newton's method: the example links with foldest alone
-   (`pkg-config --libs foldest` has no -lm), so it calls nothing from libm. */
-static double root(double a)
-{
-    double r = a > 1.0 ? a : 1.0;
-    for (int k = 0; k < 60 && a > 0.0; k++)
-        r = 0.5 * (r + a / r);
-    return a > 0.0 ? r : 0.0;
-}
-
 /* A synthetic magnetometer: hard iron (6000, 250, 3500) counts, soft iron
    stretching the 1100-count field into an ellipsoid, noise of 3 counts. */
 static size_t synthesise(double *x, size_t n)
@@ -60,15 +50,11 @@ static size_t synthesise(double *x, size_t n)
     const double b[3] = {6000, 250, 3500};
     fe_rng g = fe_rng_seed(4);
     for (size_t i = 0; i < n; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = root(s);
+        double v[3];
+        fe_rng_unit_vector(&g, v);
         for (int r = 0; r < 3; r++)
             x[3 * i + r] = b[r] + 3.0 * fe_rng_normal(&g)
-                         + 1100.0 * (S[3 * r] * v[0] + S[3 * r + 1] * v[1] + S[3 * r + 2] * v[2]) / s;
+                         + 1100.0 * (S[3 * r] * v[0] + S[3 * r + 1] * v[1] + S[3 * r + 2] * v[2]);
     }
     return n;
 }

@@ -12,7 +12,8 @@
 
    The 6 entries of S are the global parameters, each session's offset a
    local block of 3: an arrow-shaped least-squares problem solved by
-   Levenberg-Marquardt with the Schur complement (lm.h).
+   Levenberg-Marquardt with the Schur complement: fe_sessions_fit
+   (sessions.h).
 
    1. Synthetic sessions with known truth.
    2. Real recordings (../shared/data, or FOLDEST_DATA), skipped when absent:
@@ -29,104 +30,13 @@
 
 #include <foldest.h>
 
-enum { MAXS = 8 };
-
-struct magcal {
-    size_t nsess;
-    const double *m[MAXS];      /* readings, 3 per row */
-    size_t n[MAXS];
-    int one_offset;             /* all sessions in block 0 */
-};
-
-static void sym(const double *s, double S[3][3])
+static int magcal_fit(const fe_sessions *c, double *x, fe_lm_result *res)
 {
-    S[0][0] = s[0]; S[0][1] = S[1][0] = s[1]; S[0][2] = S[2][0] = s[2];
-    S[1][1] = s[3]; S[1][2] = S[2][1] = s[4]; S[2][2] = s[5];
-}
-
-/* The residuals and their gradients: with d = m - o, h = S d, rho = |h|,
-   d rho / d S_kl = (h_k d_l + h_l d_k) / rho (k != l; h_k d_k / rho on the
-   diagonal) and d rho / d o = -S h / rho. */
-static int magcal_model(const double *x, fe_lm_sink *sink, void *ctx)
-{
-    const struct magcal *c = ctx;
-    double S[3][3];
-    sym(x, S);
-    for (size_t b = 0; b < c->nsess; b++) {
-        size_t blk = c->one_offset ? 0 : b;
-        const double *o = x + 6 + 3 * blk;
-        for (size_t i = 0; i < c->n[b]; i++) {
-            const double *m = c->m[b] + 3 * i;
-            double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h[3], rho, jg[6], jl[3];
-            int rc;
-            for (int k = 0; k < 3; k++)
-                h[k] = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
-            rho = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-            jg[0] = h[0] * d[0] / rho;
-            jg[1] = (h[0] * d[1] + h[1] * d[0]) / rho;
-            jg[2] = (h[0] * d[2] + h[2] * d[0]) / rho;
-            jg[3] = h[1] * d[1] / rho;
-            jg[4] = (h[1] * d[2] + h[2] * d[1]) / rho;
-            jg[5] = h[2] * d[2] / rho;
-            for (int k = 0; k < 3; k++)
-                jl[k] = -(S[k][0] * h[0] + S[k][1] * h[1] + S[k][2] * h[2]) / rho;
-            rc = fe_lm_emit(sink, rho - 1.0, 1.0, jg, blk, jl);
-            if (rc != FE_OK)
-                return rc;
-        }
-    }
-    return FE_OK;
-}
-
-/* Start: each offset at its session's centroid, S = I / mean radius. */
-static void magcal_start(const struct magcal *c, double *x)
-{
-    double r = 0.0;
-    size_t total = 0, nblk = c->one_offset ? 1 : c->nsess;
-    memset(x, 0, (6 + 3 * nblk) * sizeof *x);
-    for (size_t b = 0; b < c->nsess; b++) {
-        double *o = x + 6 + 3 * (c->one_offset ? 0 : b), cen[3] = {0, 0, 0};
-        for (size_t i = 0; i < c->n[b]; i++)
-            for (int k = 0; k < 3; k++)
-                cen[k] += c->m[b][3 * i + k] / (double)c->n[b];
-        for (size_t i = 0; i < c->n[b]; i++) {
-            const double *m = c->m[b] + 3 * i;
-            r += sqrt((m[0] - cen[0]) * (m[0] - cen[0]) + (m[1] - cen[1]) * (m[1] - cen[1])
-                      + (m[2] - cen[2]) * (m[2] - cen[2]));
-        }
-        total += c->n[b];
-        for (int k = 0; k < 3; k++)
-            o[k] += cen[k] / (double)(c->one_offset ? c->nsess : 1);
-    }
-    x[0] = x[3] = x[5] = (double)total / r;
-}
-
-static double magcal_rms(const struct magcal *c, const double *x, size_t b)
-{
-    double S[3][3], q = 0.0;
-    const double *o = x + 6 + 3 * (c->one_offset ? 0 : b);
-    sym(x, S);
-    for (size_t i = 0; i < c->n[b]; i++) {
-        const double *m = c->m[b] + 3 * i;
-        double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h2 = 0.0;
-        for (int k = 0; k < 3; k++) {
-            double h = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
-            h2 += h * h;
-        }
-        q += (sqrt(h2) - 1.0) * (sqrt(h2) - 1.0);
-    }
-    return sqrt(q / (double)c->n[b]);
-}
-
-static int magcal_fit(const struct magcal *c, double *x, fe_lm_result *res)
-{
-    fe_lm_problem p = {6, 3, c->one_offset ? 1 : c->nsess, magcal_model, (void *)c};
-    double *w = malloc(fe_lm_work(&p, FE_LM_SCHUR) * sizeof *w);
+    double *w = malloc(fe_sessions_work(c) * sizeof *w);
     int rc;
     if (w == NULL)
         return FE_ENOMEM;
-    magcal_start(c, x);
-    rc = fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, NULL, NULL, res);
+    rc = fe_sessions_fit(c, x, w, res);
     free(w);
     return rc;
 }
@@ -140,7 +50,7 @@ static int synthetic(void)
     const double off[NS][3] = {{0.3, -0.2, 0.5}, {1.5, 0.1, -0.4}, {-0.7, 0.9, 0.2}, {0.0, -1.2, 0.8}};
     static double m[NS][PER * 3];
     double x[6 + 3 * NS], S[3][3], worst = 0.0;
-    struct magcal c = {NS, {0}, {0}, 0};
+    fe_sessions c = {NS, {0}, {0}, 0};
     fe_rng g = fe_rng_seed(5);
     fe_lm_result res;
     int rc;
@@ -165,7 +75,7 @@ static int synthetic(void)
     for (int b = 0; b < NS; b++)
         printf("   session %d offset (%7.4f %7.4f %7.4f), truth (%7.4f %7.4f %7.4f)\n", b,
                x[6 + 3 * b], x[7 + 3 * b], x[8 + 3 * b], off[b][0], off[b][1], off[b][2]);
-    sym(x, S);
+    fe_sessions_matrix(x, S);
     for (int k = 0; k < 3; k++)
         for (int l = 0; l < 3; l++) {
             double sa = S[k][0] * A[0][l] + S[k][1] * A[1][l] + S[k][2] * A[2][l];
@@ -216,7 +126,7 @@ static double *read_csv3(const char *path, int col, size_t skip, size_t *n)
 static double compare(const char *title, const char *unit, const double *m1, size_t n1,
                     const double *m2, size_t n2)
 {
-    struct magcal joint = {2, {m1, m2}, {n1, n2}, 0}, common = joint, one;
+    fe_sessions joint = {2, {m1, m2}, {n1, n2}, 0}, common = joint, one;
     double xj[12], xc[9], xs[9], rms_sep[2], rms_j[2], rms_c[2], rssj = 0, rssc = 0, F;
     fe_lm_result r;
     int rc;
@@ -227,16 +137,16 @@ static double compare(const char *title, const char *unit, const double *m1, siz
     printf("   shared S, one offset per session: %s after %d iterations\n", fe_strerror(rc),
            r.iterations);
     for (int b = 0; b < 2; b++) {
-        one = (struct magcal){1, {joint.m[b]}, {joint.n[b]}, 0};
+        one = (fe_sessions){1, {joint.m[b]}, {joint.n[b]}, 0};
         magcal_fit(&one, xs, &r);
-        rms_sep[b] = magcal_rms(&one, xs, 0);
-        rms_j[b] = magcal_rms(&joint, xj, (size_t)b);
+        rms_sep[b] = fe_sessions_rms(&one, xs, 0);
+        rms_j[b] = fe_sessions_rms(&joint, xj, (size_t)b);
         printf("   session %d offset (%.4g, %.4g, %.4g) %s; alone: (%.4g, %.4g, %.4g)\n", b + 1,
                xj[6 + 3 * b], xj[7 + 3 * b], xj[8 + 3 * b], unit, xs[6], xs[7], xs[8]);
     }
     magcal_fit(&common, xc, &r);
     for (int b = 0; b < 2; b++) {
-        rms_c[b] = magcal_rms(&common, xc, (size_t)b);
+        rms_c[b] = fe_sessions_rms(&common, xc, (size_t)b);
         rssj += (double)joint.n[b] * rms_j[b] * rms_j[b];
         rssc += (double)joint.n[b] * rms_c[b] * rms_c[b];
     }

@@ -18,6 +18,7 @@
 #include "foldest/lsq.h"
 #include "foldest/schur.h"
 #include "foldest/lm.h"
+#include "foldest/sessions.h"
 #include "foldest/kalman.h"
 #include "foldest/parallel.h"
 #include "foldest/quadric.h"

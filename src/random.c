@@ -61,4 +61,19 @@ double fe_rng_normal(fe_rng *r)
     r->has_spare = 1;
     return radius * cos(two_pi * u2);
 }
+
+void fe_rng_unit_vector(fe_rng *r, double u[3])
+{
+    double s;
+    do {
+        s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            u[j] = fe_rng_normal(r);
+            s += u[j] * u[j];
+        }
+    } while (!(s > 0.0));
+    s = sqrt(s);
+    for (int j = 0; j < 3; j++)
+        u[j] /= s;
+}
 /* Random Generator ends here */

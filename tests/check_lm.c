@@ -357,102 +357,13 @@ END_TEST
 
 /* --------------------------------- multi-session magnetometer calibration */
 
-/* Sessions of raw readings m; the model |S (m - o_s)| = 1 with S symmetric
-   (6 globals: s00 s01 s02 s11 s12 s22) and one offset o_s per session. */
-struct magcal {
-    size_t nsess;
-    const double *m[8];
-    size_t n[8];
-    int one_offset;          /* all sessions share block 0 */
-};
-
-static void sym(const double *s, double S[3][3])
+static int magcal_fit(const fe_sessions *c, double *x, fe_lm_result *res)
 {
-    S[0][0] = s[0]; S[0][1] = S[1][0] = s[1]; S[0][2] = S[2][0] = s[2];
-    S[1][1] = s[3]; S[1][2] = S[2][1] = s[4]; S[2][2] = s[5];
-}
-
-static int magcal_model(const double *x, fe_lm_sink *sink, void *ctx)
-{
-    const struct magcal *c = ctx;
-    double S[3][3];
-    sym(x, S);
-    for (size_t b = 0; b < c->nsess; b++) {
-        size_t blk = c->one_offset ? 0 : b;
-        const double *o = x + 6 + 3 * blk;
-        for (size_t i = 0; i < c->n[b]; i++) {
-            const double *m = c->m[b] + 3 * i;
-            double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h[3], rho, jg[6], jl[3];
-            int rc;
-            for (int k = 0; k < 3; k++)
-                h[k] = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
-            rho = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-            jg[0] = h[0] * d[0] / rho;
-            jg[1] = (h[0] * d[1] + h[1] * d[0]) / rho;
-            jg[2] = (h[0] * d[2] + h[2] * d[0]) / rho;
-            jg[3] = h[1] * d[1] / rho;
-            jg[4] = (h[1] * d[2] + h[2] * d[1]) / rho;
-            jg[5] = h[2] * d[2] / rho;
-            for (int k = 0; k < 3; k++)
-                jl[k] = -(S[k][0] * h[0] + S[k][1] * h[1] + S[k][2] * h[2]) / rho;
-            rc = fe_lm_emit(sink, rho - 1.0, 1.0, jg, blk, jl);
-            if (rc != FE_OK)
-                return rc;
-        }
-    }
-    return FE_OK;
-}
-
-/* Start: S = I / (mean distance to the session centroid), o_s = centroid. */
-static void magcal_start(const struct magcal *c, double *x)
-{
-    double r = 0.0;
-    size_t total = 0;
-    memset(x, 0, (6 + 3 * (c->one_offset ? 1 : c->nsess)) * sizeof *x);
-    for (size_t b = 0; b < c->nsess; b++) {
-        double *o = x + 6 + 3 * (c->one_offset ? 0 : b);
-        double cen[3] = {0, 0, 0};
-        for (size_t i = 0; i < c->n[b]; i++)
-            for (int k = 0; k < 3; k++)
-                cen[k] += c->m[b][3 * i + k] / (double)c->n[b];
-        for (size_t i = 0; i < c->n[b]; i++) {
-            const double *m = c->m[b] + 3 * i;
-            r += sqrt((m[0] - cen[0]) * (m[0] - cen[0]) + (m[1] - cen[1]) * (m[1] - cen[1])
-                      + (m[2] - cen[2]) * (m[2] - cen[2]));
-        }
-        total += c->n[b];
-        for (int k = 0; k < 3; k++)
-            o[k] += cen[k] / (c->one_offset ? (double)c->nsess : 1.0);
-    }
-    r /= (double)total;
-    x[0] = x[3] = x[5] = 1.0 / r;
-}
-
-/* Root-mean-square of |S(m - o)| - 1 over session b. */
-static double magcal_rms(const struct magcal *c, const double *x, size_t b)
-{
-    double S[3][3], q = 0.0;
-    const double *o = x + 6 + 3 * (c->one_offset ? 0 : b);
-    sym(x, S);
-    for (size_t i = 0; i < c->n[b]; i++) {
-        const double *m = c->m[b] + 3 * i;
-        double d[3] = {m[0] - o[0], m[1] - o[1], m[2] - o[2]}, h2 = 0.0;
-        for (int k = 0; k < 3; k++) {
-            double h = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
-            h2 += h * h;
-        }
-        q += (sqrt(h2) - 1.0) * (sqrt(h2) - 1.0);
-    }
-    return sqrt(q / (double)c->n[b]);
-}
-
-static int magcal_fit(const struct magcal *c, double *x, fe_lm_result *r)
-{
-    fe_lm_problem p = {6, 3, c->one_offset ? 1 : c->nsess, magcal_model, (void *)c};
-    double *w = lm_work(&p, FE_LM_SCHUR);
+    double *w = malloc(fe_sessions_work(c) * sizeof *w);
     int rc;
-    magcal_start(c, x);
-    rc = fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, NULL, NULL, r);
+    if (w == NULL)
+        return FE_ENOMEM;
+    rc = fe_sessions_fit(c, x, w, res);
     free(w);
     return rc;
 }
@@ -466,7 +377,7 @@ START_TEST(magnetometer_sessions_synthetic)
     const double off[NS][3] = {{0.3, -0.2, 0.5}, {1.5, 0.1, -0.4}, {-0.7, 0.9, 0.2}, {0.0, -1.2, 0.8}};
     static double m[NS][PER * 3];
     double x[6 + 3 * NS], S[3][3], err_off = 0.0, err_S = 0.0;
-    struct magcal c = {NS, {0}, {0}, 0};
+    fe_sessions c = {NS, {0}, {0}, 0};
     fe_rng g = fe_rng_seed(21);
     fe_lm_result r;
 
@@ -490,7 +401,7 @@ START_TEST(magnetometer_sessions_synthetic)
         ck_assert_int_eq(magcal_fit(&c, x, &r), FE_OK);
         /* S A = I and the offsets, to rounding (noise free) or to the
            noise's reach (sd = 0.01, 2000 readings). */
-        sym(x, S);
+        fe_sessions_matrix(x, S);
         err_S = err_off = 0.0;
         for (int k = 0; k < 3; k++)
             for (int l = 0; l < 3; l++) {
@@ -550,7 +461,7 @@ START_TEST(magnetometer_sessions_real)
     const char *dir = fe_test_data_dir("magnetometer_sessions_real");
     double *m1, *m2, xj[12], xc[12], xs[2][12], rms_joint[2], rms_sep[2], rms_common[2];
     size_t n1 = 0, n2 = 0;
-    struct magcal joint = {2, {0}, {0}, 0}, common, one;
+    fe_sessions joint = {2, {0}, {0}, 0}, common, one;
     fe_lm_result r;
 
     if (dir == NULL)
@@ -579,15 +490,15 @@ START_TEST(magnetometer_sessions_real)
     ck_assert_int_eq(magcal_fit(&joint, xj, &r), FE_OK);
     /* Each session alone: its own matrix and offset (9 parameters each). */
     for (int b = 0; b < 2; b++) {
-        one = (struct magcal){1, {joint.m[b]}, {joint.n[b]}, 0};
+        one = (fe_sessions){1, {joint.m[b]}, {joint.n[b]}, 0};
         ck_assert_int_eq(magcal_fit(&one, xs[b], &r), FE_OK);
-        rms_sep[b] = magcal_rms(&one, xs[b], 0);
-        rms_joint[b] = magcal_rms(&joint, xj, (size_t)b);
+        rms_sep[b] = fe_sessions_rms(&one, xs[b], 0);
+        rms_joint[b] = fe_sessions_rms(&joint, xj, (size_t)b);
     }
     /* One matrix and one offset for both. */
     ck_assert_int_eq(magcal_fit(&common, xc, &r), FE_OK);
     for (int b = 0; b < 2; b++)
-        rms_common[b] = magcal_rms(&common, xc, (size_t)b);
+        rms_common[b] = fe_sessions_rms(&common, xc, (size_t)b);
     fprintf(stderr, "magnetometer sessions (QMC5883L filtered / noisy): radial RMS "
                     "separate %.4f / %.4f, shared matrix %.4f / %.4f, shared matrix and offset "
                     "%.4f / %.4f\n", rms_sep[0], rms_sep[1], rms_joint[0], rms_joint[1],
@@ -606,7 +517,7 @@ START_TEST(magnetometer_sessions_real)
             between += (xj[6 + k] - xj[9 + k]) * (xj[6 + k] - xj[9 + k]);
         for (int b = 0; b < 2; b++) {
             size_t n = joint.n[b], h = n / 2;
-            struct magcal halves = {2, {joint.m[b], joint.m[b] + 3 * h}, {h, n - h}, 0};
+            fe_sessions halves = {2, {joint.m[b], joint.m[b] + 3 * h}, {h, n - h}, 0};
             double xh[12], d = 0.0;
             ck_assert_int_eq(magcal_fit(&halves, xh, &r), FE_OK);
             for (int k = 0; k < 3; k++)

@@ -6,22 +6,6 @@
 #include "foldest.h"
 #include "testutil.h"
 
-/* n samples on an ellipsoid (centre c, semi-axes r) with noise. */
-static void ellipsoid_points(double *x, size_t n, const double c[3],
-                             const double r[3], double noise, uint64_t seed)
-{
-    fe_rng g = fe_rng_seed(seed);
-    for (size_t i = 0; i < n; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = sqrt(s);
-        for (int j = 0; j < 3; j++)
-            x[3 * i + j] = c[j] + r[j] * v[j] / s + noise * fe_rng_normal(&g);
-    }
-}
 
 /* Largest difference of two moment vectors, each moment relative to the
    scale N R^degree of its degree. */
@@ -86,7 +70,7 @@ START_TEST(step_equals_block)
     fe_quadric one = FE_QUADRIC_EMPTY, many = FE_QUADRIC_EMPTY;
     size_t done = 0;
     int rc = FE_OK;
-    ellipsoid_points(x, N, C0, R0, 2.0, 1);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 1);
     for (size_t i = 0; i < N && rc == FE_OK; i++)
         rc = fe_quadric_add(&one, x + 3 * i);
     ck_assert_int_eq(rc, FE_OK);
@@ -106,7 +90,7 @@ START_TEST(two_shards_equal_one)
     static double x[3 * N];
     fe_accumulator f = fe_quadric_accumulator(NULL);
     fe_quadric whole, a, b;
-    ellipsoid_points(x, N, C0, R0, 2.0, 2);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 2);
     ck_assert_int_eq(fe_init(&f, &whole), FE_OK);
     ck_assert_int_eq(fe_fold(&f, &whole, x, N, NULL), FE_OK);
     ck_assert_int_eq(fe_init(&f, &a), FE_OK);
@@ -129,7 +113,7 @@ START_TEST(merge_every_split_and_associativity)
     fe_quadric whole = FE_QUADRIC_EMPTY, p = FE_QUADRIC_EMPTY,
                q = FE_QUADRIC_EMPTY, r = FE_QUADRIC_EMPTY, left, right;
     int bad = 0;
-    ellipsoid_points(x, N, C0, R0, 1.0, 3);
+    fe_test_ellipsoid_points(x, N, C0, R0, 1.0, 3);
     ck_assert_int_eq(fe_quadric_add_many(&whole, x, N, NULL), FE_OK);
     for (size_t s = 0; s <= N; s++) {
         fe_quadric a = FE_QUADRIC_EMPTY, b = FE_QUADRIC_EMPTY;
@@ -164,7 +148,7 @@ START_TEST(recentre_equals_accumulating_there)
     static double x[3 * N];
     const double there[3] = {90, -60, 40};
     fe_quadric a = FE_QUADRIC_EMPTY, b;
-    ellipsoid_points(x, N, C0, R0, 2.0, 4);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 4);
     ck_assert_int_eq(fe_quadric_add_many(&a, x, N, NULL), FE_OK);
     ck_assert_int_eq(fe_quadric_init(&b, there), FE_OK);
     ck_assert_int_eq(fe_quadric_add_many(&b, x, N, NULL), FE_OK);
@@ -188,7 +172,7 @@ START_TEST(bad_samples_leave_it_unchanged)
     enum { N = 1000, BAD = 613 };
     static double x[3 * N];
     const double nonfinite[3] = {NAN, INFINITY, -INFINITY};
-    ellipsoid_points(x, N, C0, R0, 2.0, 5);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 5);
     for (int t = 0; t < 3; t++) {
         fe_quadric q = FE_QUADRIC_EMPTY, before, slow = FE_QUADRIC_EMPTY;
         double bad[3] = {1, 2, 3};
@@ -284,7 +268,7 @@ START_TEST(coverage_ignores_an_initial_rest_and_sees_a_hemisphere)
     fe_quadric_add_many(&h, rest, REST, NULL);
     ck_assert_int_ge(fe_quadric_regions(&h), 50);   /* the noise, alone */
     /* Then turned through the upper hemisphere only. */
-    ellipsoid_points(x, N, C0, R0, 2.0, 8);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 8);
     for (size_t i = 0; i < N; i++)
         if (x[3 * i + 2] < C0[2])
             x[3 * i + 2] = 2 * C0[2] - x[3 * i + 2];
@@ -305,7 +289,7 @@ START_TEST(coverage_ignores_an_initial_rest_and_sees_a_hemisphere)
     }
     ck_assert_int_eq(nexact, 50);
     /* The whole sphere. */
-    ellipsoid_points(x, N, C0, R0, 2.0, 9);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 9);
     fe_quadric_add_many(&q, rest, REST, NULL);
     fe_quadric_add_many(&q, x, N, NULL);
     ck_assert_int_eq(fe_quadric_regions(&q), 100);

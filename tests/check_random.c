@@ -52,6 +52,31 @@ START_TEST(uniform_and_normal_moments)
 }
 END_TEST
 
+START_TEST(unit_vectors_are_unit_and_uniform)
+{
+    /* Length 1, and each coordinate's mean 0 and variance 1/3 (uniform on
+       the sphere), within 5 standard errors. */
+    enum { N = 100000 };
+    fe_rng r = fe_rng_seed(3);
+    fe_meanvar c[3] = {FE_MEANVAR_EMPTY, FE_MEANVAR_EMPTY, FE_MEANVAR_EMPTY};
+    double worst = 0.0;
+    for (int i = 0; i < N; i++) {
+        double u[3], len;
+        fe_rng_unit_vector(&r, u);
+        len = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        worst = fabs(len - 1.0) > worst ? fabs(len - 1.0) : worst;
+        for (int j = 0; j < 3; j++)
+            fe_meanvar_add(&c[j], u[j]);
+    }
+    ck_assert_double_le(worst, 1e-15);
+    for (int j = 0; j < 3; j++) {
+        ck_assert_double_eq_tol(c[j].mean, 0.0, 5 * sqrt(1.0 / 3 / N));
+        /* Var(u^2) = E u^4 - 1/9 = 1/5 - 1/9 for a uniform direction. */
+        ck_assert_double_eq_tol(fe_meanvar_variance(&c[j]), 1.0 / 3, 5 * sqrt((0.2 - 1.0 / 9) / N));
+    }
+}
+END_TEST
+
 Suite *fe_random_suite(void)
 {
     Suite *s = suite_create("random");
@@ -59,6 +84,7 @@ Suite *fe_random_suite(void)
     tcase_add_test(t, same_seed_same_stream);
     tcase_add_test(t, known_first_values);
     tcase_add_test(t, uniform_and_normal_moments);
+    tcase_add_test(t, unit_vectors_are_unit_and_uniform);
     suite_add_tcase(s, t);
     return s;
 }

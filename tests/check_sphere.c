@@ -9,21 +9,6 @@
 #include "foldest.h"
 #include "testutil.h"
 
-static void ellipsoid_points(double *x, size_t n, const double c[3],
-                             const double r[3], double noise, uint64_t seed)
-{
-    fe_rng g = fe_rng_seed(seed);
-    for (size_t i = 0; i < n; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = sqrt(s);
-        for (int j = 0; j < 3; j++)
-            x[3 * i + j] = c[j] + r[j] * v[j] / s + noise * fe_rng_normal(&g);
-    }
-}
 
 /* Largest parameter difference relative to the field: offsets and scales
    divided by the radius R, entries of A_x (of size 1/R^2) times R^2. */
@@ -61,7 +46,7 @@ START_TEST(three_algorithms_agree)
     size_t wl = fe_sphere_naive_workspace(n, model);
     fe_sphere_fit streaming, stored, naive;
     int rc;
-    ellipsoid_points(x, n, C0, R0, 2.0, 11);
+    fe_test_ellipsoid_points(x, n, C0, R0, 2.0, 11);
     streaming = fit_moments(x, n, model, &rc);
     ck_assert_int_eq(rc, FE_OK);
     ck_assert_int_eq(fe_sphere_fit_stored(x, n, model, NULL, &stored), FE_OK);
@@ -101,7 +86,7 @@ START_TEST(calibration_maps_to_the_unit_sphere)
     fe_sphere_fit f;
     double worst = 0.0;
     int rc;
-    ellipsoid_points(x, N, C0, R0, 0.0, 12);
+    fe_test_ellipsoid_points(x, N, C0, R0, 0.0, 12);
     f = fit_moments(x, N, FE_FIT_ELLIPSOID, &rc);
     ck_assert_int_eq(rc, FE_OK);
     for (size_t i = 0; i < N; i++) {
@@ -127,7 +112,7 @@ START_TEST(precision_with_a_large_offset)
     for (int model = 0; model < 3; model++) {
         fe_sphere_fit streaming, stored;
         int rc;
-        ellipsoid_points(x, N, c, r, 1e-3, 13);
+        fe_test_ellipsoid_points(x, N, c, r, 1e-3, 13);
         streaming = fit_moments(x, N, (fe_sphere_model)model, &rc);
         ck_assert_int_eq(rc, FE_OK);
         ck_assert_int_eq(fe_sphere_fit_stored(x, N, (fe_sphere_model)model, NULL, &stored), FE_OK);
@@ -142,7 +127,7 @@ START_TEST(precision_with_a_large_offset)
         fe_quadric raw;
         fe_sphere_fit f;
         int rc;
-        ellipsoid_points(x, N, c, r, 1e-3, 13);
+        fe_test_ellipsoid_points(x, N, c, r, 1e-3, 13);
         fe_quadric_init(&raw, origin);
         fe_quadric_add_many(&raw, x, N, NULL);
         rc = fe_sphere_fit_moments(&raw, FE_FIT_AXIAL, NULL, &f);
@@ -159,7 +144,7 @@ START_TEST(merged_shards_fit_like_the_whole)
     fe_accumulator acc = fe_quadric_accumulator(NULL);
     fe_quadric a, b, whole;
     fe_sphere_fit fa, fw;
-    ellipsoid_points(x, N, C0, R0, 2.0, 14);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 14);
     fe_init(&acc, &a);
     fe_init(&acc, &b);
     fe_init(&acc, &whole);
@@ -194,7 +179,7 @@ START_TEST(trace_and_stop)
     fe_sphere_options o = fe_sphere_default_options();
     fe_sphere_fit f;
     int calls = 0;
-    ellipsoid_points(x, N, C0, R0, 2.0, 15);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 15);
     fe_quadric_add_many(&q, x, N, NULL);
     o.trace = count_iterations;
     o.trace_ctx = &calls;
@@ -263,7 +248,7 @@ START_TEST(refuse_too_few_and_bad_arguments)
     fe_quadric q = FE_QUADRIC_EMPTY;
     fe_sphere_fit f;
     double w[10];
-    ellipsoid_points(x, 6, C0, R0, 2.0, 16);
+    fe_test_ellipsoid_points(x, 6, C0, R0, 2.0, 16);
     fe_quadric_add_many(&q, x, 6, NULL);
     ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, NULL, &f), FE_ETOOFEW);
     ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
@@ -312,7 +297,7 @@ START_TEST(refuse_one_hemisphere)
     static double x[3 * N];
     fe_quadric q = FE_QUADRIC_EMPTY;
     fe_sphere_fit f;
-    ellipsoid_points(x, N, C0, R0, 2.0, 18);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 18);
     for (size_t i = 0; i < N; i++)
         if (x[3 * i + 2] > C0[2])
             x[3 * i + 2] = 2 * C0[2] - x[3 * i + 2];

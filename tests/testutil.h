@@ -3,10 +3,13 @@
 #define FE_TESTUTIL_H
 
 #include <check.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "foldest/random.h"
 
 /* Assert |got - want| <= rel * max(|want|, tiny): a relative tolerance. */
 #define FE_ASSERT_REL(got, want, rel)                                        \
@@ -43,6 +46,20 @@ static inline const char *fe_test_data_dir(const char *why)
     }
     fclose(f);
     return d;
+}
+
+/* n samples x[3i..3i+2] on the axis-aligned ellipsoid with centre c and
+   semi-axes r, plus normal noise of standard deviation `noise`. */
+static inline void fe_test_ellipsoid_points(double *x, size_t n, const double c[3],
+                                            const double r[3], double noise, uint64_t seed)
+{
+    fe_rng g = fe_rng_seed(seed);
+    for (size_t i = 0; i < n; i++) {
+        double v[3];
+        fe_rng_unit_vector(&g, v);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = c[j] + r[j] * v[j] + noise * fe_rng_normal(&g);
+    }
 }
 
 #endif /* FE_TESTUTIL_H */

@@ -19,43 +19,12 @@ FE_MPI_DEFINE_REDUCTION(mv, fe_meanvar, fe_meanvar_accumulator());
 
 enum { SEND_PIECE = 1 << 24 };
 
-/* The fraction of CPU time other processes used during the half second
-   before the run (from /proc/stat; -1 when unknown): a busy machine cannot
-   show a parallel speed-up. */
-static double busy_fraction(void)
-{
-    unsigned long long v[2][8];
-    for (int k = 0; k < 2; k++) {
-        FILE *f = fopen("/proc/stat", "r");
-        int got = f != NULL
-                  ? fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu",
-                           &v[k][0], &v[k][1], &v[k][2], &v[k][3], &v[k][4],
-                           &v[k][5], &v[k][6], &v[k][7])
-                  : 0;
-        if (f != NULL)
-            fclose(f);
-        if (got != 8)
-            return -1.0;
-        if (k == 0) {
-            struct timespec half = {0, 500000000};
-            nanosleep(&half, NULL);
-        }
-    }
-    {
-        unsigned long long total = 0, idle;
-        for (int i = 0; i < 8; i++)
-            total += v[1][i] - v[0][i];
-        idle = (v[1][3] - v[0][3]) + (v[1][4] - v[0][4]);
-        return total > 0 ? 1.0 - (double)idle / (double)total : -1.0;
-    }
-}
-
 int main(int argc, char **argv)
 {
     size_t n = argc > 1 ? (size_t)strtod(argv[1], NULL) : 100000000;
     size_t begin, end, m;
     int rank, size, ok = 1;
-    double busy = busy_fraction();
+    double busy = fe_bench_busy_fraction();
     double *x = NULL, t_serial = 1e300, t_mpi = 1e300;
     fe_accumulator f = fe_meanvar_accumulator();
     fe_meanvar serial = FE_MEANVAR_EMPTY;

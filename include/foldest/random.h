@@ -25,5 +25,9 @@ double fe_rng_uniform(fe_rng *r);
 /* fe_rng_normal: a standard normal deviate, N(0, 1). */
 double fe_rng_normal(fe_rng *r);
 
+/* fe_rng_unit_vector: u[0..2] uniform on the unit sphere (three normal
+   deviates, normalised). */
+void fe_rng_unit_vector(fe_rng *r, double u[3]);
+
 #endif /* FOLDEST_RANDOM_H */
 /* Random Declarations ends here */

@@ -470,16 +470,20 @@ static void fe__json_number(FILE *f, double x)
         fprintf(f, "null");
 }
 
+/* `, "key": number`. */
+static void fe__json_pair(FILE *f, const char *key, double x)
+{
+    fprintf(f, ", \"%s\": ", key);
+    fe__json_number(f, x);
+}
+
 static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
 {
     fprintf(f, "\"%s\": {\"rms\": ", name);
     fe__json_number(f, fit->rms);
-    fprintf(f, ", \"bic\": ");
-    fe__json_number(f, fit->bic);
-    fprintf(f, ", \"heldout_rms\": ");
-    fe__json_number(f, fit->heldout_rms);
-    fprintf(f, ", \"lag1\": ");
-    fe__json_number(f, fit->lag1);
+    fe__json_pair(f, "bic", fit->bic);
+    fe__json_pair(f, "heldout_rms", fit->heldout_rms);
+    fe__json_pair(f, "lag1", fit->lag1);
     fprintf(f, ", \"params\": %zu}", fit->params);
 }
 
@@ -506,22 +510,17 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
             fprintf(f, "\"recording\": %d, \"end_recording\": %d, \"start\": ", l->pair + 1,
                     l->pair1 + 1);
             fe__json_number(f, l->t0);
-            fprintf(f, ", \"end\": ");
-            fe__json_number(f, l->t1);
+            fe__json_pair(f, "end", l->t1);
         } else {
             fprintf(f, "\"variable\": \"%s\", \"region\": ", l->variable);
             fe_cli_json_string(f, l->region);
         }
         fprintf(f, ", \"rows\": %.0f, \"statistic\": ", l->n);
         fe__json_number(f, fabs(l->z) > fabs(l->t) ? l->z : l->t);
-        fprintf(f, ", \"mean_residual_before\": ");
-        fe__json_number(f, l->mean_before);
-        fprintf(f, ", \"mean_residual_after\": ");
-        fe__json_number(f, l->mean_after);
-        fprintf(f, ", \"ms_ratio_before\": ");
-        fe__json_number(f, l->ms_ratio_before);
-        fprintf(f, ", \"ms_ratio_after\": ");
-        fe__json_number(f, l->ms_ratio_after);
+        fe__json_pair(f, "mean_residual_before", l->mean_before);
+        fe__json_pair(f, "mean_residual_after", l->mean_after);
+        fe__json_pair(f, "ms_ratio_before", l->ms_ratio_before);
+        fe__json_pair(f, "ms_ratio_after", l->ms_ratio_after);
         fprintf(f, "}");
     }
     fprintf(f, "], \"discovered\": [");
@@ -532,20 +531,16 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         fe_catalog_explain(t->name, coef, se, words, sizeof words);
         fprintf(f, "%s{\"name\": \"%s\", \"description\": ", s ? ", " : "", t->name);
         fe_cli_json_string(f, t->description);
-        fprintf(f, ", \"coefficient\": ");
-        fe__json_number(f, coef);
-        fprintf(f, ", \"stderr\": ");
-        fe__json_number(f, se);
+        fe__json_pair(f, "coefficient", coef);
+        fe__json_pair(f, "stderr", se);
         fprintf(f, ", \"interval95\": [");
         fe__json_number(f, coef - r->t_critical * se);
         fprintf(f, ", ");
         fe__json_number(f, coef + r->t_critical * se);
         fprintf(f, "], \"statistic\": ");
         fe__json_number(f, r->added_rank[s].statistic);
-        fprintf(f, ", \"p_value\": ");
-        fe__json_number(f, r->added_rank[s].p_value);
-        fprintf(f, ", \"rss_drop\": ");
-        fe__json_number(f, r->added_rank[s].rss_drop);
+        fe__json_pair(f, "p_value", r->added_rank[s].p_value);
+        fe__json_pair(f, "rss_drop", r->added_rank[s].rss_drop);
         fprintf(f, ", \"explanation\": ");
         fe_cli_json_string(f, words);
         fprintf(f, ", \"indistinguishable_from\": [");
@@ -572,10 +567,8 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         fprintf(f, "%s{\"name\": \"%s\", \"rss_drop\": ", i ? ", " : "",
                 o->c->terms[k->group].name);
         fe__json_number(f, k->rss_drop);
-        fprintf(f, ", \"statistic\": ");
-        fe__json_number(f, k->statistic);
-        fprintf(f, ", \"p_value\": ");
-        fe__json_number(f, k->p_value);
+        fe__json_pair(f, "statistic", k->statistic);
+        fe__json_pair(f, "p_value", k->p_value);
         fprintf(f, ", \"redundant\": %s}", k->redundant ? "true" : "false");
     }
     fprintf(f, "]}\n");
