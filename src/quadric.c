@@ -3,7 +3,7 @@
 #include "foldest/error.h"
 #include "foldest/quadric.h"
 
-enum { FE__QUADRIC_BLOCK = 512, FE__QUADRIC_LANES = 4 };
+enum { FE__QUADRIC_BLOCK = 512 };
 
 /* The exponents (a, b, c) of moment k, in the order of m[]. */
 static const unsigned char fe__quadric_exp[FE_QUADRIC_MOMENTS][3] = {
@@ -138,7 +138,7 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
     return FE_OK;
 }
 /* Fold one sample into the moments ends here */
-/* [[file:../literate/quadric.org::Sum the moments of a block][Sum the moments of a block]] */
+/* [[file:../literate/quadric.org::Compile the kernel for four and eight lanes][Compile the kernel for four and eight lanes]] */
 /* No clones under ThreadSanitizer: the loader runs the clone's resolver
    before the sanitizer's runtime is up, and the instrumented resolver
    crashes. */
@@ -152,17 +152,38 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
 #endif
 
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__) \
-    && !defined(FE_NO_CLONES) && !defined(FE__QUADRIC_TSAN)
-#define FE__QUADRIC_KERNEL __attribute__((target_clones("avx2", "default")))
+    && !defined(FE_NO_CLONES)
+#define FE__QUADRIC_X86 1
+#endif
+
+#if defined(__GNUC__)
+#define FE__PREFETCH(p) __builtin_prefetch((p), 0, 3)
+#else
+#define FE__PREFETCH(p) ((void)(p))
+#endif
+
+/* Contract x * y + s into one fused multiply-add: GCC needs asking. */
+#if defined(__GNUC__) && !defined(__clang__)
+#define FE__QUADRIC_CONTRACT optimize("fp-contract=fast"),
+#define FE__QUADRIC_WIDE_TARGET target("avx512f,fma,prefer-vector-width=512")
+#else
+#define FE__QUADRIC_CONTRACT
+#define FE__QUADRIC_WIDE_TARGET target("avx512f,fma")
+#endif
+
+#if defined(FE__QUADRIC_X86) && !defined(FE__QUADRIC_TSAN)
+#define FE__QUADRIC_KERNEL \
+    __attribute__((FE__QUADRIC_CONTRACT target_clones("fma", "default")))
 #else
 #define FE__QUADRIC_KERNEL
 #endif
 
-enum { FE__L = FE__QUADRIC_LANES };
-
+#define FE__L 4
+#define FE__QUADRIC_BLOCK_FN fe__quadric_block4
 FE__QUADRIC_KERNEL
-static void fe__quadric_block(const double *b, int n, const double ref[3],
-                              double out[35], double rlo[3], double rhi[3])
+static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
+                                 const double *next, int nnext,
+                                 double out[35], double rlo[3], double rhi[3])
 {
     double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
     double a[9][FE__L] = {{0}}, c[9][FE__L] = {{0}}, q[8][FE__L] = {{0}},
@@ -209,15 +230,22 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
             rhi[j] = hi[j][l] > rhi[j] ? hi[j][l] : rhi[j];
         }
     }
-    /* The moments, in four groups of lanes. */
-    for (i = 0; i + FE__L <= n; i += FE__L)
+    /* The moments, in four groups of lanes; each group asks for every
+       fourth cache line of the next block (eight doubles a line). */
+#define FE__QUADRIC_AHEAD(g) \
+    if (8 * (4 * (i / FE__L) + (g)) < 3 * nnext) \
+        FE__PREFETCH(next + 8 * (4 * (i / FE__L) + (g)))
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(0);
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
             a[0][l] += x; a[1][l] += y; a[2][l] += z;
             a[3][l] += x * x; a[4][l] += x * y; a[5][l] += x * z;
             a[6][l] += y * y; a[7][l] += y * z; a[8][l] += z * z;
         }
-    for (i = 0; i + FE__L <= n; i += FE__L)
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(1);
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
             double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
@@ -226,7 +254,9 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
             c[3][l] += xy * y; c[4][l] += xy * z; c[5][l] += xz * z;
             c[6][l] += yy * y; c[7][l] += yy * z; c[8][l] += yz * z;
         }
-    for (i = 0; i + FE__L <= n; i += FE__L)
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(2);
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
             double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
@@ -235,7 +265,9 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
             q[3][l] += xx * yy; q[4][l] += xx * yz; q[5][l] += xx * zz;
             q[6][l] += xy * yy; q[7][l] += xy * yz;
         }
-    for (i = 0; i + FE__L <= n; i += FE__L)
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(3);
         for (l = 0; l < FE__L; l++) {
             double x = X[i + l], y = Y[i + l], z = Z[i + l];
             double xy = x * y, xz = x * z, yy = y * y, yz = y * z,
@@ -244,6 +276,8 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
             r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
             r[6][l] += zz * zz; r[7][l] += zz * z;
         }
+    }
+#undef FE__QUADRIC_AHEAD
     for (k = 0; k < 35; k++)
         out[k] = 0.0;
     out[0] = (double)n;
@@ -266,7 +300,151 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
             out[k] += p[k];
     }
 }
-/* Sum the moments of a block ends here */
+#undef FE__L
+#undef FE__QUADRIC_BLOCK_FN
+
+#if defined(FE__QUADRIC_X86)
+#define FE__L 8
+#define FE__QUADRIC_BLOCK_FN fe__quadric_block8
+__attribute__((FE__QUADRIC_CONTRACT FE__QUADRIC_WIDE_TARGET))
+static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
+                                 const double *next, int nnext,
+                                 double out[35], double rlo[3], double rhi[3])
+{
+    double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
+    double a[9][FE__L] = {{0}}, c[9][FE__L] = {{0}}, q[8][FE__L] = {{0}},
+           r[8][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
+    int i, l, k;
+
+    /* Copy relative to the reference; extremes of the relative
+       coordinates, in lanes. */
+    for (l = 0; l < FE__L; l++) {
+        lo[0][l] = hi[0][l] = b[0] - ref[0];
+        lo[1][l] = hi[1][l] = b[1] - ref[1];
+        lo[2][l] = hi[2][l] = b[2] - ref[2];
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L)
+        for (l = 0; l < FE__L; l++) {
+            double x = b[3 * (i + l)] - ref[0], y = b[3 * (i + l) + 1] - ref[1],
+                   z = b[3 * (i + l) + 2] - ref[2];
+            X[i + l] = x;
+            Y[i + l] = y;
+            Z[i + l] = z;
+            lo[0][l] = x < lo[0][l] ? x : lo[0][l];
+            hi[0][l] = x > hi[0][l] ? x : hi[0][l];
+            lo[1][l] = y < lo[1][l] ? y : lo[1][l];
+            hi[1][l] = y > hi[1][l] ? y : hi[1][l];
+            lo[2][l] = z < lo[2][l] ? z : lo[2][l];
+            hi[2][l] = z > hi[2][l] ? z : hi[2][l];
+        }
+    for (; i < n; i++) {
+        X[i] = b[3 * i] - ref[0];
+        Y[i] = b[3 * i + 1] - ref[1];
+        Z[i] = b[3 * i + 2] - ref[2];
+        lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
+        hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
+        lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
+        hi[1][0] = Y[i] > hi[1][0] ? Y[i] : hi[1][0];
+        lo[2][0] = Z[i] < lo[2][0] ? Z[i] : lo[2][0];
+        hi[2][0] = Z[i] > hi[2][0] ? Z[i] : hi[2][0];
+    }
+    for (int j = 0; j < 3; j++) {
+        rlo[j] = lo[j][0];
+        rhi[j] = hi[j][0];
+        for (l = 1; l < FE__L; l++) {
+            rlo[j] = lo[j][l] < rlo[j] ? lo[j][l] : rlo[j];
+            rhi[j] = hi[j][l] > rhi[j] ? hi[j][l] : rhi[j];
+        }
+    }
+    /* The moments, in four groups of lanes; each group asks for every
+       fourth cache line of the next block (eight doubles a line). */
+#define FE__QUADRIC_AHEAD(g) \
+    if (8 * (4 * (i / FE__L) + (g)) < 3 * nnext) \
+        FE__PREFETCH(next + 8 * (4 * (i / FE__L) + (g)))
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(0);
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            a[0][l] += x; a[1][l] += y; a[2][l] += z;
+            a[3][l] += x * x; a[4][l] += x * y; a[5][l] += x * z;
+            a[6][l] += y * y; a[7][l] += y * z; a[8][l] += z * z;
+        }
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(1);
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
+                   yz = y * z;
+            c[0][l] += xx * x; c[1][l] += xx * y; c[2][l] += xx * z;
+            c[3][l] += xy * y; c[4][l] += xy * z; c[5][l] += xz * z;
+            c[6][l] += yy * y; c[7][l] += yy * z; c[8][l] += yz * z;
+        }
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(2);
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
+                   yz = y * z, zz = z * z;
+            q[0][l] += xx * xx; q[1][l] += xx * xy; q[2][l] += xx * xz;
+            q[3][l] += xx * yy; q[4][l] += xx * yz; q[5][l] += xx * zz;
+            q[6][l] += xy * yy; q[7][l] += xy * yz;
+        }
+    }
+    for (i = 0; i + FE__L <= n; i += FE__L) {
+        FE__QUADRIC_AHEAD(3);
+        for (l = 0; l < FE__L; l++) {
+            double x = X[i + l], y = Y[i + l], z = Z[i + l];
+            double xy = x * y, xz = x * z, yy = y * y, yz = y * z,
+                   zz = z * z;
+            r[0][l] += xy * zz; r[1][l] += xz * zz; r[2][l] += yy * yy;
+            r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
+            r[6][l] += zz * zz; r[7][l] += zz * z;
+        }
+    }
+#undef FE__QUADRIC_AHEAD
+    for (k = 0; k < 35; k++)
+        out[k] = 0.0;
+    out[0] = (double)n;
+    for (l = 0; l < FE__L; l++) {
+        for (k = 0; k < 9; k++)
+            out[1 + k] += a[k][l];
+        for (k = 0; k < 9; k++)
+            out[10 + k] += c[k][l];
+        out[19] += r[7][l];             /* the ninth of r is the tenth cubic */
+        for (k = 0; k < 8; k++)
+            out[20 + k] += q[k][l];
+        for (k = 0; k < 7; k++)
+            out[28 + k] += r[k][l];
+    }
+    /* The tail that does not fill the lanes. */
+    for (; i < n; i++) {
+        double p[35];
+        fe__quadric_monomials(X[i], Y[i], Z[i], p);
+        for (k = 1; k < 35; k++)
+            out[k] += p[k];
+    }
+}
+#undef FE__L
+#undef FE__QUADRIC_BLOCK_FN
+#endif
+
+/* The block's moment sums, extremes relative to ref; next (nnext
+   samples, or NULL and 0) is the block to prefetch. */
+static void fe__quadric_block(const double *b, int n, const double ref[3],
+                              const double *next, int nnext, double out[35],
+                              double rlo[3], double rhi[3])
+{
+#if defined(FE__QUADRIC_X86)
+    if (__builtin_cpu_supports("avx512f")) {
+        fe__quadric_block8(b, n, ref, next, nnext, out, rlo, rhi);
+        return;
+    }
+#endif
+    fe__quadric_block4(b, n, ref, next, nnext, out, rlo, rhi);
+}
+/* Compile the kernel for four and eight lanes ends here */
 /* [[file:../literate/quadric.org::Fold an array block by block][Fold an array block by block]] */
 int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
                         size_t *done)
@@ -285,7 +463,10 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
         int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1;
 
         if (fast) {             /* a non-finite sample makes a sum non-finite */
-            fe__quadric_block(b, (int)m, q->ref, sums, rlo, rhi);
+            size_t rest = n - k - m;
+            int nnext = rest < FE__QUADRIC_BLOCK ? (int)rest : FE__QUADRIC_BLOCK;
+            fe__quadric_block(b, (int)m, q->ref, nnext > 0 ? b + 3 * m : NULL,
+                              nnext, sums, rlo, rhi);
             for (int j = 0; j < FE_QUADRIC_MOMENTS; j++) {
                 next[j] = q->m[j] + sums[j];
                 fast = fast && fe__finite(next[j]);
