@@ -579,6 +579,99 @@ static int fe__sphere_finish(const fe__sphere_problem *pr, const fe_quadric *q,
     return FE_OK;
 }
 /* Express the fit in the sensor's units ends here */
+/* [[file:../literate/sphere.org::Fit the algebraic sphere][Fit the algebraic sphere]] */
+static int fe__sphere_algebraic(const fe__sphere_problem *pr,
+                                const fe_quadric *q,
+                                const fe_sphere_options *opt,
+                                fe_sphere_fit *fit)
+{
+    static const int sq[3] = {4, 7, 9};
+    double N[16], Ni[16], gam[4], h[4], tt = 0.0, rss, s2, d[3], ss;
+    double beta[FE__P], H[FE__P * FE__P], g[FE__P], cost, D[2][4];
+    double sigma = pr->sigma, n = q->m[0];
+    fe_sphere_options loose = *opt;     /* extents checked below */
+    int rc;
+
+    loose.min_extent = 0.0;
+    for (int k = 0; k < 4; k++) {
+        h[k] = 0.0;
+        for (int l = 0; l < 4; l++)
+            N[k * 4 + l] = pr->phi[k * 10 + l];
+        for (int c = 0; c < 3; c++)
+            h[k] += pr->phi[k * 10 + sq[c]];
+        gam[k] = h[k];
+    }
+    for (int c = 0; c < 3; c++)
+        for (int e = 0; e < 3; e++)
+            tt += pr->phi[sq[c] * 10 + sq[e]];
+    memcpy(Ni, N, sizeof Ni);
+    rc = fe__sphere_posv(4, 1, Ni, gam);
+    if (rc != FE_OK) {
+        fit->refusal = rc == FE_ENOTPD ? FE_SPHERE_SINGULAR : fit->refusal;
+        return rc;
+    }
+    for (int j = 0; j < 3; j++)
+        d[j] = 0.5 * gam[1 + j];
+    ss = gam[0] + d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (!(ss > 0.0)) {
+        fit->refusal = FE_SPHERE_DEGENERATE;
+        return FE_ENOTPD;
+    }
+    memset(beta, 0, sizeof beta);
+    memcpy(beta, d, sizeof d);
+    beta[3] = sqrt(ss);
+    rc = pr->build(pr, beta, &cost, H, g);
+    if (rc != FE_OK)
+        return rc;
+    fit->refusal = FE_SPHERE_ACCEPTED;
+    fit->algebraic = 1;
+    rc = fe__sphere_finish(pr, q, &loose, beta, cost, H, fit);
+    if (rc != FE_OK)
+        return rc;
+    /* One-sided data: along some axis the samples do not reach both sides
+       of the centre by min_extent of the box's half-width. */
+    for (int j = 0; j < 3; j++) {
+        double hb = 0.5 * (q->hi[j] - q->lo[j]);
+        if (fmin(q->hi[j] - fit->offset[j], fit->offset[j] - q->lo[j])
+            < opt->min_extent * hb) {
+            fit->refusal = FE_SPHERE_HEMISPHERE;
+            rc = FE_EUNDETERMINED;
+        }
+    }
+    /* The linear estimator's covariance, carried to (b, s) in the sensor's
+       units: b_j = c_j + sigma gam_j / 2, s = sigma sqrt(gam_0 + |d|^2). */
+    rss = fmax(tt - (gam[0] * h[0] + gam[1] * h[1] + gam[2] * h[2] + gam[3] * h[3]), 0.0);
+    s2 = rss / (n - 4.0);
+    memcpy(Ni, N, sizeof Ni);
+    {
+        double inv[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        int rc2 = fe__sphere_posv(4, 4, Ni, inv);
+        if (rc2 != FE_OK)
+            return rc2;
+        for (int k = 0; k < 4; k++)
+            for (int l = 0; l < 4; l++)
+                Ni[k * 4 + l] = s2 * inv[k * 4 + l];
+    }
+    memset(fit->cov, 0, sizeof fit->cov);
+    for (int a = 0; a < 4; a++)         /* D[0], D[1]: derivatives of */
+        for (int b = 0; b < 4; b++) {   /* parameters a, b by gam */
+            double ca = 0.0;
+            for (int k = 0; k < 4; k++) {
+                D[0][k] = a < 3 ? (k == a + 1 ? 0.5 * sigma : 0.0)
+                                : sigma * (k == 0 ? 0.5 : 0.5 * d[k - 1]) / beta[3];
+                D[1][k] = b < 3 ? (k == b + 1 ? 0.5 * sigma : 0.0)
+                                : sigma * (k == 0 ? 0.5 : 0.5 * d[k - 1]) / beta[3];
+            }
+            for (int k = 0; k < 4; k++)
+                for (int l = 0; l < 4; l++)
+                    ca += D[0][k] * Ni[k * 4 + l] * D[1][l];
+            fit->cov[a * 4 + b] = ca;
+        }
+    for (int a = 0; a < 4; a++)
+        fit->se[a] = sqrt(fit->cov[a * 4 + a]);
+    return rc;
+}
+/* Fit the algebraic sphere ends here */
 /* [[file:../literate/sphere.org::Fit from moments or from stored samples][Fit from moments or from stored samples]] */
 static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
                           const fe_sphere_options *opt, fe__sphere_problem *pr,
@@ -619,7 +712,6 @@ static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
     if (rc != FE_OK)
         return rc;
     if (stored) {               /* keep the samples, take the frame */
-        memcpy(setup.phi, pr->phi, sizeof setup.phi);
         setup.xyz = pr->xyz;
         setup.n = pr->n;
         setup.work = pr->work;
@@ -630,6 +722,9 @@ static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
     *pr = setup;
     rc = fe__sphere_iterate(pr, opt, beta, &cost, H, &fit->iterations,
                             &fit->refusal);
+    if (rc == FE_EUNDETERMINED && model == FE_FIT_SPHERE
+        && fit->refusal == FE_SPHERE_UNBOUNDED)
+        return fe__sphere_algebraic(pr, q, opt, fit);
     if (rc == FE_ENOCONV || rc == FE_EUNDETERMINED || rc == FE_ENOTPD)
         return fe__sphere_diagnose(q, model, opt, fit, rc);
     if (rc != FE_OK)
