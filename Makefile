@@ -73,9 +73,14 @@ $(STATIC): $(LIB_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
+# The shared library exports the public fe_ names and nothing else (a
+# version script: no fe__ helper, no compiler-made symbol such as Clang's
+# ifunc resolvers, leaks into users' link namespace).
 $(SHARED): $(LIB_OBJ)
 	@mkdir -p $(@D)
-	$(CC) -shared -Wl,-soname,libfoldest.so.$(SOVERSION) -o $@ $^ $(EXT_LIBS)
+	@printf '{\n  global: fe_[a-z]*;\n  local: *;\n};\n' > $(B)/lib/libfoldest.map
+	$(CC) -shared -Wl,-soname,libfoldest.so.$(SOVERSION) -Wl,--version-script=$(B)/lib/libfoldest.map \
+	  -o $@ $(LIB_OBJ) $(EXT_LIBS)
 	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so.$(SOVERSION)
 	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so
 
