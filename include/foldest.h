@@ -15,6 +15,7 @@
 #include "foldest/discover.h"
 #include "foldest/catalog.h"
 #include "foldest/synth.h"
+#include "foldest/model.h"
 #include "foldest/lsq.h"
 #include "foldest/schur.h"
 #include "foldest/lm.h"
