@@ -21,6 +21,7 @@
 #include "foldest/lm.h"
 #include "foldest/sessions.h"
 #include "foldest/kalman.h"
+#include "foldest/locate.h"
 #include "foldest/parallel.h"
 #include "foldest/quadric.h"
 #include "foldest/sphere.h"
