@@ -10,7 +10,8 @@
 #include "foldest/special.h"
 /* Locate Includes ends here */
 /* [[file:../literate/locate.org::Fold a report into its block][Fold a report into its block]] */
-int fe_innovations_init(fe_innovations *a, size_t blocks, uint64_t total)
+int fe_innovations_init(fe_innovations *a, size_t blocks, uint64_t total,
+                        uint64_t row0)
 {
     if (a == NULL)
         return FE_EINVAL;
@@ -18,9 +19,13 @@ int fe_innovations_init(fe_innovations *a, size_t blocks, uint64_t total)
         return FE_ESIZE;
     if (total < 2 * (uint64_t)blocks)
         return FE_ETOOFEW;
+    if (row0 >= total)
+        return FE_ESIZE;
     memset(a, 0, sizeof *a);
     a->blocks = blocks;
     a->total = total;
+    a->row0 = row0;
+    a->first_linked = 1;
     return FE_OK;
 }
 
@@ -35,7 +40,7 @@ int fe_innovations_add(fe_innovations *a, double t, const fe_kalman_report *r)
         return FE_ENONFINITE;
     if (r->nis < 0.0)
         return FE_EINVAL;
-    if (a->n >= a->total)
+    if (a->row0 + a->n >= a->total)
         return FE_ESIZE;
     if (r->whitened != NULL) {
         dim = r->b < FE_KALMAN_MONITOR_DIM ? r->b : FE_KALMAN_MONITOR_DIM;
@@ -51,7 +56,7 @@ int fe_innovations_add(fe_innovations *a, double t, const fe_kalman_report *r)
             pairs = (double)d;
         }
     }
-    bk = &a->block[(size_t)(a->n * a->blocks / a->total)];
+    bk = &a->block[(size_t)((a->row0 + a->n) * a->blocks / a->total)];
     if (bk->n == 0) {
         bk->t0 = t;
         bk->pair = a->recording;
@@ -67,6 +72,11 @@ int fe_innovations_add(fe_innovations *a, double t, const fe_kalman_report *r)
     bk->acf_terms += pairs;
     if (dim > 0)
         memcpy(a->prev, r->whitened, dim * sizeof *a->prev);
+    if (a->n == 0) {
+        if (dim > 0)
+            memcpy(a->first, r->whitened, dim * sizeof *a->first);
+        a->first_dim = dim;
+    }
     a->prev_dim = dim;
     a->have_prev = dim > 0;
     a->n++;
@@ -80,8 +90,60 @@ void fe_innovations_break(fe_innovations *a)
     a->have_prev = 0;
     if (a->n > 0)
         a->recording++;
+    else
+        a->first_linked = 0;
 }
 /* Fold a report into its block ends here */
+/* [[file:../literate/locate.org::Merge consecutive parts][Merge consecutive parts]] */
+int fe_innovations_merge(fe_innovations *a, const fe_innovations *b)
+{
+    int shift;
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (a->blocks != b->blocks || a->total != b->total || b->row0 != a->row0 + a->n)
+        return FE_EMISMATCH;
+    if (b->n == 0)
+        return FE_OK;
+    shift = a->n == 0 ? a->recording : a->recording + (b->first_linked ? 0 : 1);
+    if (a->n > 0 && a->have_prev && b->first_linked && b->first_dim > 0) {
+        size_t d = a->prev_dim < b->first_dim ? a->prev_dim : b->first_dim;
+        fe_innovation_block *bk = &a->block[(size_t)(b->row0 * a->blocks / a->total)];
+        for (size_t i = 0; i < d; i++)
+            bk->acf += a->prev[i] * b->first[i];
+        bk->acf_terms += (double)d;
+    }
+    for (size_t k = 0; k < a->blocks; k++) {
+        fe_innovation_block *x = &a->block[k];
+        const fe_innovation_block *y = &b->block[k];
+        if (y->n == 0)
+            continue;
+        if (x->n == 0) {
+            x->t0 = y->t0;
+            x->pair = y->pair + shift;
+        }
+        x->t1 = y->t1;
+        x->pair1 = y->pair1 + shift;
+        x->n += y->n;
+        x->dof += y->dof;
+        x->nis += y->nis;
+        x->acf += y->acf;
+        x->acf_terms += y->acf_terms;
+        x->sq += y->sq;
+        x->sq_terms += y->sq_terms;
+    }
+    if (a->n == 0) {
+        memcpy(a->first, b->first, sizeof a->first);
+        a->first_dim = b->first_dim;
+        a->first_linked = b->first_linked;
+    }
+    memcpy(a->prev, b->prev, sizeof a->prev);
+    a->prev_dim = b->prev_dim;
+    a->have_prev = b->have_prev;
+    a->recording = shift + b->recording;
+    a->n += b->n;
+    return FE_OK;
+}
+/* Merge consecutive parts ends here */
 /* [[file:../literate/locate.org::Test one block][Test one block]] */
 static void fe__block_tests(const fe_innovation_block *b, double *z_nis, double *p_nis,
                             double *z_acf, double *p_acf)

@@ -34,7 +34,7 @@ static void run_tracker(uint64_t seed, double c, fe_innovations *inn)
     truth[1] = x0[1] + 1.0 * fe_rng_normal(&rng);
     ck_assert_int_eq(fe_kalman_init(&k, 2, 1, mem, sizeof mem / sizeof mem[0]), FE_OK);
     ck_assert_int_eq(fe_kalman_set_prior(&k, x0, P0), FE_OK);
-    ck_assert_int_eq(fe_innovations_init(inn, BLOCKS, STEPS), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(inn, BLOCKS, STEPS, 0), FE_OK);
     for (int s = 0; s < STEPS; s++) {
         fe_kalman_report rep = {0, 0, 0, NULL, &w, NULL};
         fe_kalman_track_obs o = {{Phi, NULL, NULL, 0, Xi}, {1, A, &z, Z}};
@@ -121,7 +121,7 @@ START_TEST(block_statistics_match_a_direct_computation)
     fe_located l;
     size_t n;
     char json[1024];
-    ck_assert_int_eq(fe_innovations_init(&inn, 4, 40), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&inn, 4, 40, 0), FE_OK);
     for (int i = 0; i < 40; i++) {
         fe_kalman_report r = {1, 0, 0, NULL, &w, NULL};
         w = fe_rng_normal(&rng);
@@ -163,14 +163,63 @@ START_TEST(block_statistics_match_a_direct_computation)
 }
 END_TEST
 
+START_TEST(merge_of_consecutive_parts_equals_whole)
+{
+    /* Reports of two dimensions (whitened vectors sometimes missing) with
+       recording breaks, folded whole and in three parts cut at awkward
+       places (one cut right at a break), merged: the same blocks. */
+    enum { N = 997, K = 7 };
+    const size_t cut1 = 200, cut2 = 613;
+    fe_innovations whole, p[3];
+    fe_rng rng = fe_rng_seed(21);
+    int rc = FE_OK;
+    ck_assert_int_eq(fe_innovations_init(&whole, K, N, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&p[0], K, N, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&p[1], K, N, cut1), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&p[2], K, N, cut2), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        double w[2] = {fe_rng_normal(&rng), fe_rng_normal(&rng)};
+        fe_kalman_report r = {2, w[0] * w[0] + w[1] * w[1], 0, NULL, i % 37 ? w : NULL, NULL};
+        fe_innovations *part = &p[i < cut1 ? 0 : i < cut2 ? 1 : 2];
+        if (i == 150 || i == cut2 || i == 800) {
+            fe_innovations_break(&whole);
+            fe_innovations_break(part);
+        }
+        rc |= fe_innovations_add(&whole, 0.5 * (double)i, &r);
+        rc |= fe_innovations_add(part, 0.5 * (double)i, &r);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_int_eq(fe_innovations_merge(&p[0], &p[2]), FE_EMISMATCH);
+    ck_assert_int_eq(fe_innovations_merge(&p[1], &p[2]), FE_OK);
+    ck_assert_int_eq(fe_innovations_merge(&p[0], &p[1]), FE_OK);
+    ck_assert_uint_eq(p[0].n, N);
+    ck_assert_int_eq(p[0].recording, whole.recording);
+    ck_assert_int_eq(whole.recording, 3);
+    for (size_t k = 0; k < K; k++) {
+        const fe_innovation_block *x = &p[0].block[k], *y = &whole.block[k];
+        ck_assert_double_eq(x->n, y->n);
+        ck_assert_double_eq(x->acf_terms, y->acf_terms);
+        ck_assert_double_eq(x->sq_terms, y->sq_terms);
+        ck_assert_double_eq(x->t0, y->t0);
+        ck_assert_double_eq(x->t1, y->t1);
+        ck_assert_int_eq(x->pair, y->pair);
+        ck_assert_int_eq(x->pair1, y->pair1);
+        FE_ASSERT_REL(x->nis, y->nis, 1e-12);
+        FE_ASSERT_REL(x->sq, y->sq, 1e-12);
+        ck_assert_double_eq_tol(x->acf, y->acf, 1e-12 * y->sq);
+    }
+}
+END_TEST
+
 START_TEST(refusals_leave_the_accumulation_unchanged)
 {
     fe_innovations inn, before;
     double w = 1.0, bad = NAN;
     fe_kalman_report r = {1, 1.0, 0, NULL, &w, NULL};
-    ck_assert_int_eq(fe_innovations_init(&inn, 1, 100), FE_ESIZE);
-    ck_assert_int_eq(fe_innovations_init(&inn, 10, 19), FE_ETOOFEW);
-    ck_assert_int_eq(fe_innovations_init(&inn, 10, 100), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&inn, 1, 100, 0), FE_ESIZE);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 19, 0), FE_ETOOFEW);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 100, 100), FE_ESIZE);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 100, 0), FE_OK);
     ck_assert_int_eq(fe_innovations_add(&inn, 0.0, &r), FE_OK);
     memcpy(&before, &inn, sizeof inn);
     r.whitened = &bad;
@@ -193,6 +242,7 @@ Suite *fe_locate_suite(void)
     TCase *t = tcase_create("locate");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, block_statistics_match_a_direct_computation);
+    tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);

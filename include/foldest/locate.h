@@ -44,18 +44,24 @@ typedef struct fe_innovation_block {
 typedef struct fe_innovations {
     size_t blocks;              /* K */
     uint64_t total;             /* reports expected in all */
-    uint64_t n;                 /* reports folded */
-    int recording;              /* current recording (from 0) */
+    uint64_t row0;              /* global index of this part's first report */
+    uint64_t n;                 /* reports folded into this part */
+    int recording;              /* current recording (from 0 in this part) */
     int have_prev;              /* a whitened vector to pair with */
-    size_t prev_dim;
-    double prev[FE_KALMAN_MONITOR_DIM];
+    int first_linked;           /* the first report follows the previous part */
+    size_t prev_dim, first_dim;
+    double prev[FE_KALMAN_MONITOR_DIM];     /* the last whitened vector */
+    double first[FE_KALMAN_MONITOR_DIM];    /* the first one (for merge) */
     fe_innovation_block block[FE_DISCOVER_MAX_BLOCKS];
 } fe_innovations;
 
-/* fe_innovations_init: empty, for `total` reports in `blocks` blocks
-   (2..FE_DISCOVER_MAX_BLOCKS).  Errors: FE_EINVAL (NULL), FE_ESIZE
-   (blocks), FE_ETOOFEW (fewer than 2 reports per block). */
-int fe_innovations_init(fe_innovations *a, size_t blocks, uint64_t total);
+/* fe_innovations_init: empty, for `total` reports of a whole stream in
+   `blocks` blocks (2..FE_DISCOVER_MAX_BLOCKS); this part starts at global
+   report `row0` (0 unless the stream is split).  Errors: FE_EINVAL
+   (NULL), FE_ESIZE (blocks, or row0 >= total), FE_ETOOFEW (fewer than 2
+   reports per block). */
+int fe_innovations_init(fe_innovations *a, size_t blocks, uint64_t total,
+                        uint64_t row0);
 
 /* fe_innovations_add: fold the report of one filter step at time t (its
    whitened vector may be NULL: the NIS alone is then tested).  Errors:
@@ -66,6 +72,12 @@ int fe_innovations_add(fe_innovations *a, double t, const fe_kalman_report *r);
 /* fe_innovations_break: the next report starts a new recording: no
    lag-one pair is formed across. */
 void fe_innovations_break(fe_innovations *a);
+
+/* fe_innovations_merge: a <- a (+) b, b holding the reports right after
+   a's (b->row0 == a->row0 + a->n); equal to folding them in one part, up
+   to rounding.  FE_EMISMATCH otherwise or when the shapes differ; a is
+   then unchanged.  O(K). */
+int fe_innovations_merge(fe_innovations *a, const fe_innovations *b);
 
 /* fe_innovations_locate: the located time windows at family-wise level
    alpha (0 < alpha < 1; 0.05 is the engine's), at most `max` of them into
