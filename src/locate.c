@@ -233,7 +233,7 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
 /* [[file:../literate/locate.org::Write a located window as JSON][Write a located window as JSON]] */
 static int fe__json_num(char *buf, size_t len, size_t *at, const char *key, double v)
 {
-    int n = isfinite(v) ? snprintf(buf + *at, len - *at, ", \"%s\": %.17g", key, v)
+    int n = isfinite(v) ? snprintf(buf + *at, len - *at, ", \"%s\": %.10g", key, v)
                         : snprintf(buf + *at, len - *at, ", \"%s\": null", key);
     if (n < 0 || (size_t)n >= len - *at)
         return FE_ESIZE;
