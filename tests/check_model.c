@@ -211,6 +211,7 @@ START_TEST(a_right_model_discovers_nothing)
         found += mc.r->steps > 0;
         free_case(&mc);
     }
+    fprintf(stderr, "model: right model, false discoveries %u/%u\n", found, seeds);
     ck_assert_msg(found <= 1, "false discoveries %u/%u", found, seeds);
 }
 END_TEST
