@@ -35,11 +35,17 @@ int fe_model_acc_init(fe_model_acc *a, const fe_model *m, const fe_catalog *c,
         if (!isfinite(m->theta0[i])
             || (m->typical != NULL && !(isfinite(m->typical[i]) && m->typical[i] > 0.0)))
             return FE_ENONFINITE;
+    memset(a, 0, sizeof *a);            /* padding too: the state is all defined */
     rc = fe_discover_acc_init(&a->acc, p + c->count, blocks, fit_rows, 0, storage,
                               storage_doubles);
     if (rc != FE_OK)
         return rc;
-    a->model = *m;
+    a->model.p = p;
+    a->model.names = m->names;
+    a->model.predict = m->predict;
+    a->model.jacobian = m->jacobian;
+    a->model.forward = m->forward;
+    a->model.user = m->user;
     a->catalog = c;
     for (size_t i = 0; i < p; i++) {
         double th = m->theta0[i], tau = m->typical != NULL ? m->typical[i] : 1.0;
@@ -64,10 +70,6 @@ int fe_model_acc_init(fe_model_acc *a, const fe_model *m, const fe_catalog *c,
         a->groups[p + j].first = p + j;
         a->groups[p + j].count = 1;
     }
-    a->have_pend = a->have_before = 0;
-    a->before_t = a->before_y = 0.0;
-    memset(&a->pend, 0, sizeof a->pend);
-    memset(a->pend_jac, 0, sizeof a->pend_jac);
     return FE_OK;
 }
 /* Set up a model accumulation ends here */
