@@ -550,6 +550,67 @@ START_TEST(discover_rows_out_of_order_are_refused)
 }
 END_TEST
 
+START_TEST(discover_empty_parts_copy_and_rebind)
+{
+    /* An empty part that carries a break, merged between two parts, cuts
+       the lag chain as the serial break does; a copy is deep; a struct and
+       storage copied as bytes and rebound read the same. */
+    enum { N = 60 };
+    size_t nd = fe_discover_acc_doubles(DISC_M, DISC_K);
+    double *s1 = malloc(nd * sizeof *s1), *s2 = malloc(nd * sizeof *s1),
+           *s3 = malloc(nd * sizeof *s1), *sw = malloc(nd * sizeof *s1),
+           *moved = malloc(nd * sizeof *s1);
+    double phi[N][DISC_M], r[N];
+    fe_discover_acc a, b, c, whole, copy;
+    fe_rng g = fe_rng_seed(5);
+    for (int i = 0; i < N; i++) {
+        for (int k = 0; k < DISC_M; k++)
+            phi[i][k] = 1.0 + fe_rng_normal(&g);
+        r[i] = fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(disc_bind(&whole, sw, N), FE_OK);
+    ck_assert_int_eq(disc_bind(&a, s1, N), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, DISC_M, DISC_K, whole.fit_rows, 30, s2, nd), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&c, DISC_M, DISC_K, whole.fit_rows, 30, s3, nd), FE_OK);
+    for (int i = 0; i < N; i++) {
+        if (i == 30)
+            fe_discover_break(&whole);
+        ck_assert_int_eq(fe_discover_add(&whole, phi[i], r[i]), FE_OK);
+        ck_assert_int_eq(fe_discover_add(i < 30 ? &a : &c, phi[i], r[i]), FE_OK);
+    }
+    fe_discover_break(&b);                      /* empty, but a break */
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &c), FE_OK);
+    ck_assert_uint_eq(a.n, N);
+    /* Linking rows 29 and 30 would add a lag product of relative size
+       about 1/30, far above rounding. */
+    ck_assert_double_le(rel_array(s1, sw, nd), 1e-12);
+    ck_assert_int_eq(disc_bind(&b, s2, N), FE_OK);
+    ck_assert_int_eq(fe_discover_copy(&b, &a), FE_OK);
+    ck_assert_ptr_eq(b.gram, s2);
+    ck_assert_mem_eq(s2, s1, nd * sizeof *s1);
+    s2[0] += 1.0;
+    ck_assert_double_ne(s1[0], s2[0]);
+    ck_assert_int_eq(disc_bind(&c, s3, 2 * N), FE_OK);
+    ck_assert_int_eq(fe_discover_copy(&c, &a), FE_EMISMATCH);   /* other fit_rows */
+    /* Bytes and rebind. */
+    memcpy(&copy, &a, sizeof copy);
+    memcpy(moved, s1, nd * sizeof *moved);
+    ck_assert_int_eq(fe_discover_rebind(&copy, moved), FE_OK);
+    ck_assert_ptr_eq(copy.gram, moved);
+    ck_assert(copy.lag - copy.gram == a.lag - a.gram && copy.first - copy.gram == a.first - a.gram
+              && copy.last - copy.gram == a.last - a.gram
+              && copy.counts - copy.gram == a.counts - a.gram);
+    copy.m = 0;
+    ck_assert_int_eq(fe_discover_rebind(&copy, moved), FE_ESIZE);
+    free(s1);
+    free(s2);
+    free(s3);
+    free(sw);
+    free(moved);
+}
+END_TEST
+
 START_TEST(folds_onto_a_nonempty_accumulation)
 {
     /* acc on entry already holds a fold: the parallel fold continues it,
@@ -1278,6 +1339,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, flat_accumulators_equal_serial);
     tcase_add_test(t, bound_accumulators_equal_serial);
     tcase_add_test(t, discover_rows_out_of_order_are_refused);
+    tcase_add_test(t, discover_empty_parts_copy_and_rebind);
     tcase_add_test(t, folds_onto_a_nonempty_accumulation);
     tcase_add_test(t, precision_at_large_offset);
     tcase_add_test(t, product_equals_serial);
