@@ -22,11 +22,21 @@ size_t fe_discover_acc_doubles(size_t m, size_t blocks)
     return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1;
 }
 
+static void fe__discover_layout(fe_discover_acc *a, double *storage)
+{
+    size_t dim = a->m + 1;
+    a->gram = storage;
+    a->lag = a->gram + (a->blocks + 1) * dim * dim;
+    a->first = a->lag + dim * dim;
+    a->last = a->first + dim;
+    a->counts = a->last + dim;
+}
+
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
                          uint64_t fit_rows, uint64_t row0, double *storage,
                          size_t storage_doubles)
 {
-    size_t dim = m + 1, need;
+    size_t need;
     if (a == NULL || storage == NULL)
         return FE_EINVAL;
     if (m == 0 || m > FE_DISCOVER_MAX_COLUMNS || blocks < 2
@@ -45,11 +55,7 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     a->n = 0;
     a->have_prev = 0;
     a->first_linked = 1;
-    a->gram = storage;
-    a->lag = a->gram + (blocks + 1) * dim * dim;
-    a->first = a->lag + dim * dim;
-    a->last = a->first + dim;
-    a->counts = a->last + dim;
+    fe__discover_layout(a, storage);
     return FE_OK;
 }
 
@@ -77,6 +83,8 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     if (!isfinite(r))
         return FE_ENONFINITE;
     z[a->m] = r;
+    if (a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        return FE_EINVAL;       /* a part that does not know its place */
     row = a->row0 + a->n;
     k = fe__discover_block(a, row);
     g = a->gram + k * dim * dim;
@@ -118,11 +126,17 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     size_t dim, total;
     if (a == NULL || b == NULL)
         return FE_EINVAL;
-    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
-        || b->row0 != a->row0 + a->n)
+    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows)
         return FE_EMISMATCH;
-    if (b->n == 0)
+    if (b->n == 0) {            /* the identity, carrying b's break if any */
+        if (!b->first_linked)
+            fe_discover_break(a);
         return FE_OK;
+    }
+    if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        a->row0 = b->row0;      /* an empty part adopts b's place */
+    else if (b->row0 != a->row0 + a->n)
+        return FE_EMISMATCH;
     dim = a->m + 1;
     total = (a->blocks + 1) * dim * dim;
     for (size_t i = 0; i < total; i++)
@@ -147,6 +161,112 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     return FE_OK;
 }
 /* Merge consecutive accumulations ends here */
+/* [[file:../literate/discover.org::Fold rows that carry their index][Fold rows that carry their index]] */
+int fe_discover_rebind(fe_discover_acc *a, double *storage)
+{
+    if (a == NULL || storage == NULL)
+        return FE_EINVAL;
+    if (a->m == 0 || a->m > FE_DISCOVER_MAX_COLUMNS || a->blocks < 2
+        || a->blocks > FE_DISCOVER_MAX_BLOCKS)
+        return FE_ESIZE;
+    fe__discover_layout(a, storage);
+    return FE_OK;
+}
+
+int fe_discover_reset(fe_discover_acc *a)
+{
+    if (a == NULL || a->gram == NULL)
+        return FE_EINVAL;
+    memset(a->gram, 0, fe_discover_acc_doubles(a->m, a->blocks) * sizeof *a->gram);
+    a->row0 = FE_DISCOVER_ROW_UNKNOWN;
+    a->n = 0;
+    a->have_prev = 0;
+    a->first_linked = 1;
+    return FE_OK;
+}
+
+int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row)
+{
+    uint64_t row0;
+    int have_prev, first_linked, rc;
+    if (a == NULL || row == NULL || row->index == FE_DISCOVER_ROW_UNKNOWN)
+        return FE_EINVAL;
+    row0 = a->row0;
+    have_prev = a->have_prev;
+    first_linked = a->first_linked;
+    if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        a->row0 = row->index;
+    else if (row->index != a->row0 + a->n)
+        return FE_EINVAL;
+    if (row->starts_recording)
+        fe_discover_break(a);
+    rc = fe_discover_add(a, row->phi, row->r);
+    if (rc != FE_OK) {          /* undo the place and the break */
+        a->row0 = row0;
+        a->have_prev = have_prev;
+        a->first_linked = first_linked;
+    }
+    return rc;
+}
+
+int fe_discover_copy(fe_discover_acc *dst, const fe_discover_acc *src)
+{
+    double *storage;
+    if (dst == NULL || src == NULL || dst->gram == NULL || src->gram == NULL)
+        return FE_EINVAL;
+    if (dst->m != src->m || dst->blocks != src->blocks
+        || dst->fit_rows != src->fit_rows)
+        return FE_EMISMATCH;
+    if (dst == src)
+        return FE_OK;
+    storage = dst->gram;
+    memcpy(storage, src->gram,
+           fe_discover_acc_doubles(src->m, src->blocks) * sizeof *storage);
+    *dst = *src;
+    fe__discover_layout(dst, storage);
+    return FE_OK;
+}
+
+static int fe__discover_init_fn(void *acc, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_reset(acc);
+}
+
+static int fe__discover_step_fn(void *acc, const void *obs, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_add_row(acc, obs);
+}
+
+static int fe__discover_merge_fn(void *acc, const void *other, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_merge(acc, other);
+}
+
+static int fe__discover_copy_fn(void *dst, const void *src, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_copy(dst, src);
+}
+
+fe_accumulator fe_discover_accumulator(void)
+{
+    fe_accumulator f = {
+        .name = "discover",
+        .acc_size = sizeof(fe_discover_acc),
+        .obs_size = sizeof(fe_discover_row),
+        .init = fe__discover_init_fn,
+        .step = fe__discover_step_fn,
+        .step_many = NULL,
+        .merge = fe__discover_merge_fn,
+        .copy = fe__discover_copy_fn,
+        .ctx = NULL,
+    };
+    return f;
+}
+/* Fold rows that carry their index ends here */
 /* [[file:../literate/discover.org::Workspace layout][Workspace layout]] */
 typedef struct fe__ws {
     double *g;          /* M x M total Gram of fitted rows, full */
