@@ -214,6 +214,46 @@ check-install: lib
 	  echo "built $$e against $$d/usr/local"; \
 	done
 
+# ---------------------------------------------------------------- fuzzing
+# libFuzzer harnesses (tests/fuzz/fuzz_*.c), clang with ASan and UBSan; the
+# library and the command line are rebuilt instrumented ($(B)/fuzz), the
+# CLI with its main renamed fe_cli_main.  `make fuzz` runs each harness
+# FUZZ_TIME seconds from its seed corpus (tests/fuzz/corpus/NAME, kept in
+# git) into $(B)/fuzz/corpus/NAME; a crash leaves $(B)/fuzz/crash-* and
+# fails.  Replay one: $(B)/fuzz/fuzz_NAME /absolute/FILE (FE_FUZZ_VERBOSE=1
+# shows the command line's messages; fuzz_cli runs in a scratch directory).
+FUZZ_CC      ?= clang
+FUZZ_TIME    ?= 120
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_CFLAGS  := $(WARN) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link
+FUZZERS      := $(patsubst tests/fuzz/%.c,$(B)/fuzz/%,$(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_LIB_OBJ := $(patsubst src/%.c,$(B)/fuzz/obj/%.o,$(LIB_SRC))
+FUZZ_CLI_OBJ := $(patsubst src/cli/%.c,$(B)/fuzz/obj/cli/%.o,$(CLI_SRC))
+
+$(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Iinclude $(EXT_CFLAGS) -c $< -o $@
+$(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -Iinclude -Isrc/cli -c $< -o $@
+$(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
+	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
+
+fuzz-build: $(FUZZERS)
+
+fuzz: $(FUZZERS)
+	@set -e; for f in $(FUZZERS); do n=$$(basename $$f); \
+	  mkdir -p $(B)/fuzz/corpus/$$n tests/fuzz/corpus/$$n; \
+	  echo "== $$n for $(FUZZ_TIME) s"; \
+	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  $$f -max_total_time=$(FUZZ_TIME) -timeout=20 -rss_limit_mb=2048 -max_len=4096 \
+	    -print_final_stats=1 -artifact_prefix=$(abspath $(B)/fuzz)/ \
+	    $(abspath $(B)/fuzz/corpus)/$$n $(abspath tests/fuzz/corpus)/$$n > $(B)/fuzz/$$n.log 2>&1 \
+	    || { tail -60 $(B)/fuzz/$$n.log; echo "fuzz: $$n failed; see $(B)/fuzz/$$n.log"; exit 1; }; \
+	  grep -E '^stat::(number_of_executed_units|new_units_added)' $(B)/fuzz/$$n.log | tr '\n' ' '; echo; \
+	done
+
 # ---------------------------------------------------------------- static analysis
 # cppcheck and clang-tidy (configuration: .clang-tidy) over src/ and
 # include/; any finding fails.  Headers are checked through the sources that
