@@ -346,7 +346,7 @@ static int fe__sphere_iterate(const fe__sphere_problem *pr,
         if (rc != FE_OK)
             return rc;
         accepted = isfinite(St) && St <= *cost * (1.0 + 1e-10);
-        converged = lambda == 0.0 && smax <= opt->xtol * (1.0 + bmax);
+        converged = lambda <= 1e-2 && smax <= opt->xtol * (1.0 + bmax);
         if (accepted) {
             memcpy(beta, trial, (size_t)p * sizeof *beta);
             memcpy(H, Ht, (size_t)(p * p) * sizeof *H);

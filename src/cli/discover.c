@@ -852,6 +852,17 @@ int fe_cli_discover(int argc, char **argv)
     }
     if (rc != FE_END)
         goto fail;
+    /* A file with a header and no rows is malformed input (status 3), not
+       a comparison with too few rows (a refusal). */
+    for (size_t i = 0; i < a.npairs; i++) {
+        const fe_cli_table *empty = a.pairs[i].real.rows == 0 ? &a.pairs[i].real
+                                  : a.pairs[i].sim.rows == 0 ? &a.pairs[i].sim : NULL;
+        if (empty != NULL) {
+            fprintf(stderr, "foldest discover: %s: no data rows\n", empty->name);
+            rc = FE_CLI_INPUT;
+            goto cleanup;
+        }
+    }
     out.skipped = st.skipped;
     scale.temperature_kelvin = kelvin[2];
     scale.ambient_kelvin = kelvin[3];
@@ -1351,6 +1362,11 @@ static int fe__discover_sphere(fe__sphere_args *a)
     }
     if (rc != FE_END)
         goto fail;
+    if (rows == 0) {            /* malformed input, not a refusal */
+        snprintf(err, sizeof err, "%s: no data rows", t.name);
+        rc = FE_CLI_INPUT;
+        goto fail;
+    }
     /* The refusal, not the status, decides here: a fit that fails still
        names its refusal. */
     (void)fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &fit);
