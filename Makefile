@@ -86,7 +86,7 @@ $(B)/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(CC) $(WARN) $(CFLAGS) -Iinclude -Isrc/cli -c $< -o $@
 $(CLI): $(CLI_OBJ) $(STATIC)
 	@mkdir -p $(@D)
-	$(if $(CLI_OBJ),$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
+	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
 
 # ---------------------------------------------------------------- examples, bench
 examples: $(EXAMPLES)
@@ -159,7 +159,7 @@ TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"'
 
 $(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
-	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS)
+	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS) $(LDFLAGS)
 
 $(B)/san/%.o: src/%.c $(HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
@@ -253,6 +253,23 @@ fuzz: $(FUZZERS)
 	    || { tail -60 $(B)/fuzz/$$n.log; echo "fuzz: $$n failed; see $(B)/fuzz/$$n.log"; exit 1; }; \
 	  grep -E '^stat::(number_of_executed_units|new_units_added)' $(B)/fuzz/$$n.log | tr '\n' ' '; echo; \
 	done
+
+# ---------------------------------------------------------------- coverage
+# The library and the command line rebuilt with gcov instrumentation in
+# $(B)/cov, every suite run once (the CLI suites run the instrumented
+# foldest), and gcovr's line and branch coverage of src/: a summary on the
+# terminal, per file in $(B)/cov/coverage.txt and $(B)/cov/branches.txt,
+# HTML in $(B)/cov/html/.  What stays uncovered, and why: README.md.
+COV_B := $(B)/cov
+coverage: $(B)/.deps
+	@rm -rf $(COV_B)/obj $(COV_B)/html && find $(COV_B) -name '*.gcda' -delete 2>/dev/null || true
+	$(MAKE) -s B=$(COV_B) CFLAGS='-O0 -g --coverage -fprofile-update=atomic' LDFLAGS=--coverage $(COV_B)/tests/check_foldest examples
+	@mkdir -p $(COV_B)/html
+	FE_TEST_QUICK=1 $(COV_B)/tests/check_foldest
+	gcovr -r . --filter 'src/' --object-directory $(COV_B)/obj --txt $(COV_B)/coverage.txt \
+	  --html-details $(COV_B)/html/index.html --print-summary
+	@gcovr -r . --filter 'src/' --object-directory $(COV_B)/obj --branches --txt $(COV_B)/branches.txt
+	@echo "per file: $(COV_B)/coverage.txt (lines), $(COV_B)/branches.txt; open $(COV_B)/html/index.html"
 
 # ---------------------------------------------------------------- static analysis
 # cppcheck and clang-tidy (configuration: .clang-tidy) over src/ and

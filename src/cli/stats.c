@@ -34,9 +34,9 @@ int fe_cli_stats(int argc, char **argv)
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
             columns = argv[++i];
         } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
-            if (fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK
-                || skip < 0) {
-                fprintf(stderr, "foldest stats: %s\n", skip < 0 ? "--skip: negative" : err);
+            int bad = fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK;
+            if (bad || skip < 0) {
+                fprintf(stderr, "foldest stats: %s\n", bad ? err : "--skip: negative");
                 return FE_CLI_USAGE;
             }
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
