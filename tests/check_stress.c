@@ -360,6 +360,36 @@ START_TEST(levenberg_marquardt_from_absurd_starts)
 }
 END_TEST
 
+START_TEST(overflowing_rows_are_refused_whole)
+{
+    /* Finite values whose products overflow (found by the fuzzer): the row
+       is refused and not one double of the accumulation changes; large
+       values whose products are finite take the careful path and count. */
+    enum { M = 2, K = 4 };
+    double mem[1024], snap[1024], phi[M];
+    size_t nd = fe_discover_acc_doubles(M, K);
+    fe_discover_acc a, as;
+    ck_assert_uint_le(nd, 1024);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, mem, nd), FE_OK);
+    phi[0] = 1.0, phi[1] = 2.0;
+    ck_assert_int_eq(fe_discover_add(&a, phi, 0.5), FE_OK);
+    phi[0] = 1e120, phi[1] = -3e110;                    /* squares 1e240: fine */
+    ck_assert_int_eq(fe_discover_add(&a, phi, 1e105), FE_OK);
+    ck_assert(all_finite(mem, nd));
+    memcpy(snap, mem, nd * sizeof *mem);
+    as = a;
+    phi[0] = 1e200;                                     /* square overflows */
+    ck_assert_int_eq(fe_discover_add(&a, phi, 1.0), FE_ENONFINITE);
+    ck_assert_mem_eq(mem, snap, nd * sizeof *mem);
+    ck_assert_mem_eq(&a, &as, sizeof a);
+    /* The caller drops the row and carries on. */
+    phi[0] = 3.0, phi[1] = 4.0;
+    ck_assert_int_eq(fe_discover_add(&a, phi, 1.0), FE_OK);
+    ck_assert(all_finite(mem, nd));
+    ck_assert_uint_eq(a.n, 3);
+}
+END_TEST
+
 Suite *fe_stress_suite(void)
 {
     Suite *s = suite_create("stress");
@@ -372,6 +402,7 @@ Suite *fe_stress_suite(void)
     tcase_add_test(t, near_singular_kalman_denominators);
     tcase_add_test(t, rank_deficient_least_squares);
     tcase_add_test(t, levenberg_marquardt_from_absurd_starts);
+    tcase_add_test(t, overflowing_rows_are_refused_whole);
     suite_add_tcase(s, t);
     return s;
 }
