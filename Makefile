@@ -240,6 +240,9 @@ $(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $
 	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
 	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
 
+# Keep the instrumented objects (make would delete them as intermediates).
+.SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+
 fuzz-build: $(FUZZERS)
 
 fuzz: $(FUZZERS)
