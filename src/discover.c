@@ -66,6 +66,15 @@ static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
     return (size_t)(row * a->blocks / a->fit_rows);
 }
 
+/* Some value above 1e100 in magnitude: products may overflow. */
+static int fe__discover_large(const double *z, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (fabs(z[i]) > 1e100)
+            return 1;
+    return 0;
+}
+
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
 {
     size_t dim, k;
@@ -88,6 +97,19 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     row = a->row0 + a->n;
     k = fe__discover_block(a, row);
     g = a->gram + k * dim * dim;
+    if (fe__discover_large(z, dim) || (a->have_prev && k < a->blocks
+                                       && fe__discover_large(a->last, dim))) {
+        /* The slow path: every new sum must be finite before any is written. */
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = i; j < dim; j++)
+                if (!isfinite(g[i * dim + j] + z[i] * z[j]))
+                    return FE_ENONFINITE;
+        if (a->have_prev && k < a->blocks)
+            for (size_t i = 0; i < dim; i++)
+                for (size_t j = 0; j < dim; j++)
+                    if (!isfinite(a->lag[i * dim + j] + z[i] * a->last[j]))
+                        return FE_ENONFINITE;
+    }
     /* Add z z^T to the block's upper triangle. */
     for (size_t i = 0; i < dim; i++) {
         double zi = z[i];
@@ -363,7 +385,7 @@ static void fe__solve(const fe__model *mo, double *x, size_t nrhs)
         return;
     for (size_t i = 0; i < mo->n; i++)
         for (size_t r = 0; r < nrhs; r++)
-            x[i * nrhs + r] *= mo->scale[i];
+            x[i * nrhs + r] *= mo->scale[i]; /* NOLINT(clang-analyzer-core.uninitialized.Assign): callers fill x[0 .. n*nrhs) */
     LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', (lapack_int)mo->n, (lapack_int)nrhs,
                    mo->chol, (lapack_int)mo->n, x, (lapack_int)nrhs);
     for (size_t i = 0; i < mo->n; i++)

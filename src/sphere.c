@@ -1,5 +1,6 @@
 /* Tangled from literate/sphere.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/sphere.org::Sphere Fit Includes][Sphere Fit Includes]] */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -243,7 +244,7 @@ static int fe__sphere_build_stored(const fe__sphere_problem *pr,
                                    const double *beta, double *cost,
                                    double *H, double *g)
 {
-    double d[3], a[6], P[9 * FE__P], J[FE__P], s = 0.0;
+    double d[3], a[6], P[9 * FE__P], J[FE__P] = {0}, s = 0.0;
     int p = pr->p;
 
     fe__sphere_unpack(pr->model, beta, d, a, P);
@@ -308,6 +309,21 @@ static int fe__sphere_posv(int n, int nrhs, double *A, double *b)
 }
 /* Solve a symmetric positive definite system ends here */
 /* [[file:../literate/sphere.org::Iterate Gauss-Newton with Levenberg-Marquardt damping][Iterate Gauss-Newton with Levenberg-Marquardt damping]] */
+/* The decrease of S the linear model predicts for `step`:
+   -2 g.step - step' H step (H: upper triangle used). */
+static double fe__sphere_predicted(int p, const double *g, const double *H,
+                                   const double *step)
+{
+    double gs = 0.0, hs = 0.0;
+    for (int k = 0; k < p; k++) {
+        gs += g[k] * step[k];
+        hs += H[k * p + k] * step[k] * step[k];
+        for (int l = k + 1; l < p; l++)
+            hs += 2.0 * H[k * p + l] * step[k] * step[l];
+    }
+    return -2.0 * gs - hs;
+}
+
 static int fe__sphere_iterate(const fe__sphere_problem *pr,
                               const fe_sphere_options *opt, double *beta,
                               double *cost, double *H, int *iterations,
@@ -346,7 +362,10 @@ static int fe__sphere_iterate(const fe__sphere_problem *pr,
         if (rc != FE_OK)
             return rc;
         accepted = isfinite(St) && St <= *cost * (1.0 + 1e-10);
-        converged = lambda == 0.0 && smax <= opt->xtol * (1.0 + bmax);
+        converged = lambda <= 1e-2
+                    && (smax <= opt->xtol * (1.0 + bmax)
+                        || fe__sphere_predicted(p, g, H, step)
+                           <= 16.0 * DBL_EPSILON * fmax((double)pr->n, 1.0));
         if (accepted) {
             memcpy(beta, trial, (size_t)p * sizeof *beta);
             memcpy(H, Ht, (size_t)(p * p) * sizeof *H);
@@ -436,6 +455,13 @@ static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
     fit->frame_scale = pr->sigma;
     if (!(h[0] > 0.0 && h[1] > 0.0 && h[2] > 0.0)) {
         fit->refusal = FE_SPHERE_PLANAR;
+        return FE_EUNDETERMINED;
+    }
+    /* The frame divides moments of degree 4 by sigma^4: a spread so small
+       (below about 1e-77) that sigma^4 is not a normal double cannot be
+       represented there. */
+    if (!(pow(pr->sigma, 4) >= DBL_MIN)) {
+        fit->refusal = FE_SPHERE_DEGENERATE;
         return FE_EUNDETERMINED;
     }
     moved = *q;
@@ -717,6 +743,7 @@ static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
         setup.work = pr->work;
         setup.build = pr->build;
     } else {
+        setup.n = (size_t)fe_quadric_count(q);  /* for the convergence test only */
         setup.build = fe__sphere_build_moments;
     }
     *pr = setup;

@@ -82,9 +82,9 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
         } else if (strcmp(argv[i], "--apply") == 0 && i + 1 < argc) {
             a->apply = argv[++i];
         } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
-            if (fe_cli_parse_long("--skip", argv[++i], &a->skip, err, sizeof err) != FE_CLI_OK
-                || a->skip < 0) {
-                fprintf(stderr, "foldest calibrate: %s\n", a->skip < 0 ? "--skip: negative" : err);
+            int bad = fe_cli_parse_long("--skip", argv[++i], &a->skip, err, sizeof err) != FE_CLI_OK;
+            if (bad || a->skip < 0) {
+                fprintf(stderr, "foldest calibrate: %s\n", bad ? err : "--skip: negative");
                 return FE_CLI_USAGE;
             }
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
