@@ -57,6 +57,10 @@ int fe_innovations_add(fe_innovations *a, double t, const fe_kalman_report *r)
         }
     }
     bk = &a->block[(size_t)((a->row0 + a->n) * a->blocks / a->total)];
+    /* Finite values can have squares or sums that are not: refuse them,
+       with the accumulation unchanged. */
+    if (!isfinite(bk->nis + r->nis) || !isfinite(bk->sq + sq) || !isfinite(bk->acf + acf))
+        return FE_ENONFINITE;
     if (bk->n == 0) {
         bk->t0 = t;
         bk->pair = a->recording;
@@ -145,10 +149,26 @@ int fe_innovations_merge(fe_innovations *a, const fe_innovations *b)
 }
 /* Merge consecutive parts ends here */
 /* [[file:../literate/locate.org::Test one block][Test one block]] */
+/* The lag-one autocorrelation, mean product over mean square, divided in
+   the order that neither overflows nor underflows for squares that are
+   tiny but not zero: 1 with *rho, or 0 when there is none to report (no
+   pairs, no energy, or a ratio that is not finite). */
+static int fe__lag1(double acf, double acf_terms, double sq, double sq_terms, double *rho)
+{
+    double v;
+    if (!(acf_terms > 0 && sq > 0 && sq_terms > 0))
+        return 0;
+    v = (acf / sq) * (sq_terms / acf_terms);
+    if (!isfinite(v))
+        return 0;
+    *rho = v;
+    return 1;
+}
+
 static void fe__block_tests(const fe_innovation_block *b, double *z_nis, double *p_nis,
                             double *z_acf, double *p_acf)
 {
-    double p = b->dof > 0 ? fe_chi2_upper(b->nis, b->dof) : 1.0;
+    double p = b->dof > 0 ? fe_chi2_upper(b->nis, b->dof) : 1.0, rho;
     if (!(p > DBL_MIN))
         p = DBL_MIN;
     if (p > 1.0)
@@ -157,20 +177,33 @@ static void fe__block_tests(const fe_innovation_block *b, double *z_nis, double 
     *z_nis = p < 1.0 ? -fe_normal_quantile(p) : -INFINITY;
     *z_acf = 0.0;
     *p_acf = 1.0;
-    if (b->acf_terms > 0 && b->sq > 0) {
-        double rho = (b->acf / b->acf_terms) / (b->sq / b->sq_terms);
+    if (fe__lag1(b->acf, b->acf_terms, b->sq, b->sq_terms, &rho)) {
         *z_acf = rho * sqrt(b->acf_terms);
         *p_acf = erfc(fabs(*z_acf) / sqrt(2.0));
     }
 }
 /* Test one block ends here */
 /* [[file:../literate/locate.org::Locate the windows][Locate the windows]] */
+/* Pool a block's sum (over `count` terms) into a running mean of `*total`
+   terms: the weights add to one, so the mean stays within the range of
+   the blocks' means. */
+static void fe__pool(double *mean, double *total, double sum, double count)
+{
+    double all = *total + count;
+    if (!(count > 0))
+        return;
+    *mean = *mean * (*total / all) + sum / all;
+    *total = all;
+}
+
 int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out,
                           size_t max, size_t *nout)
 {
     size_t count = 0;
     int open = 0;                       /* the last block extended a window */
     fe_located cur;
+    /* The window's pooled figures as running means (per degree of freedom,
+       per pair, per term), which cannot overflow as sums of blocks can. */
     double dof = 0, nis = 0, acf = 0, acf_terms = 0, sq = 0, sq_terms = 0;
     if (a == NULL || nout == NULL || (max > 0 && out == NULL) || !(alpha > 0.0)
         || !(alpha < 1.0))
@@ -187,8 +220,9 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
         }
         if (open && (!hit || b->pair != cur.pair1)) {
             /* close the window */
-            cur.mean_nis = dof > 0 ? nis / dof : 0.0;
-            cur.lag1 = acf_terms > 0 && sq > 0 ? (acf / acf_terms) / (sq / sq_terms) : 0.0;
+            cur.mean_nis = nis;
+            if (!fe__lag1(acf, 1.0, sq, 1.0, &cur.lag1))
+                cur.lag1 = 0.0;
             if (count < max)
                 out[count] = cur;
             count++;
@@ -219,12 +253,9 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
             cur.test = pn <= pa ? "nis" : "innovation_acf";
             cur.p_value = pn <= pa ? pn : pa;
         }
-        dof += b->dof;
-        nis += b->nis;
-        acf += b->acf;
-        acf_terms += b->acf_terms;
-        sq += b->sq;
-        sq_terms += b->sq_terms;
+        fe__pool(&nis, &dof, b->nis, b->dof);
+        fe__pool(&acf, &acf_terms, b->acf, b->acf_terms);
+        fe__pool(&sq, &sq_terms, b->sq, b->sq_terms);
     }
     *nout = count;
     return FE_OK;

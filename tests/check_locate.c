@@ -236,6 +236,39 @@ START_TEST(refusals_leave_the_accumulation_unchanged)
 }
 END_TEST
 
+START_TEST(huge_values_are_refused_and_nothing_infinite_escapes)
+{
+    /* Finite reports whose squares or block sums overflow are refused with
+       the accumulation unchanged (found by fuzz_steps), and what is located
+       from reports near the top of the range is finite: windows pool
+       running means, not sums. */
+    fe_innovations inn, before;
+    fe_located out[4];
+    size_t nout = 0;
+    double w[2] = {1e200, -1e200};
+    fe_kalman_report r = {2, 1.0, 0, NULL, w, NULL};
+    ck_assert_int_eq(fe_innovations_init(&inn, 2, 40, 0), FE_OK);
+    memcpy(&before, &inn, sizeof inn);
+    ck_assert_int_eq(fe_innovations_add(&inn, 0.0, &r), FE_ENONFINITE);
+    ck_assert_mem_eq(&inn, &before, sizeof inn);
+    w[0] = 1e150;
+    w[1] = 1e-310;                      /* a denormal beside a huge value */
+    r.nis = 1e308;
+    for (int i = 0; i < 40; i++) {
+        int rc = fe_innovations_add(&inn, (double)i, &r);
+        ck_assert(rc == FE_OK || rc == FE_ENONFINITE);
+        w[1] = -w[1];
+    }
+    ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, out, 4, &nout), FE_OK);
+    ck_assert_uint_ge(nout, 1);
+    for (size_t i = 0; i < nout && i < 4; i++) {
+        ck_assert(isfinite(out[i].mean_nis) && isfinite(out[i].lag1) && isfinite(out[i].z)
+                  && isfinite(out[i].t) && isfinite(out[i].n));
+        ck_assert(out[i].p_value >= 0.0 && out[i].p_value <= 1.0);
+    }
+}
+END_TEST
+
 Suite *fe_locate_suite(void)
 {
     Suite *s = suite_create("locate");
@@ -244,6 +277,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, block_statistics_match_a_direct_computation);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);
     suite_add_tcase(s, t);

@@ -278,18 +278,160 @@ done:
     free(snap);
 }
 
+/* Discovery's generic-fold path: rows that carry their index, in order or
+   not, starting recordings now and then. */
+static void fuzz_discover_rows(in *s, unsigned shape)
+{
+    size_t m = 1 + shape % 3, K = 2;
+    size_t nd = fe_discover_acc_doubles(m, K);
+    double *mem = calloc(nd, sizeof *mem), *snap = calloc(nd, sizeof *snap), phi[3];
+    fe_discover_acc a, as;
+    uint64_t next = byte(s);
+    int rc;
+    if (mem == NULL || snap == NULL
+        || fe_discover_acc_init(&a, m, K, 8, FE_DISCOVER_ROW_UNKNOWN, mem, nd) != FE_OK)
+        goto done;
+    while (s->n > 0) {
+        fe_discover_row row;
+        unsigned how = byte(s);
+        fill(s, phi, m);
+        row.phi = phi;
+        row.r = number(s);
+        row.index = (how & 3) == 3 ? next + byte(s) : next;  /* sometimes out of order */
+        row.starts_recording = (how & 4) != 0;
+        memcpy(&as, &a, sizeof a);
+        STEP(fe_discover_add_row(&a, &row), mem, nd * sizeof *mem, snap);
+        if (rc != FE_OK) {
+            REQUIRE(memcmp(&as, &a, sizeof a) == 0);
+        } else {
+            REQUIRE(finite_all(mem, nd));
+            next = row.index + 1;
+        }
+    }
+done:
+    free(mem);
+    free(snap);
+}
+
+/* A Kalman filter's reports folded by time block, then located. */
+static void fuzz_innovations(in *s, unsigned shape)
+{
+    fe_innovations a, as;
+    fe_located out[8];
+    double w[3];
+    size_t nout = 0;
+    int rc;
+    if (fe_innovations_init(&a, 2 + shape % 3, 64, 0) != FE_OK)
+        return;
+    while (s->n > 0) {
+        fe_kalman_report r = {0, 0, 0, NULL, NULL, NULL};
+        unsigned how = byte(s);
+        double t = number(s);
+        r.b = how % 4;                       /* 0 is refused */
+        r.nis = number(s);
+        fill(s, w, 3);
+        r.whitened = (how & 4) ? w : NULL;
+        memcpy(&as, &a, sizeof a);
+        rc = fe_innovations_add(&a, t, &r);
+        if (rc != FE_OK)
+            REQUIRE(memcmp(&as, &a, sizeof a) == 0);
+        REQUIRE(fe_strerror(rc) != NULL);
+        if ((how & 8) && rc == FE_OK)
+            fe_innovations_break(&a);
+    }
+    rc = fe_innovations_locate(&a, 0.05, out, 8, &nout);
+    REQUIRE(fe_strerror(rc) != NULL);
+    if (rc == FE_OK)
+        for (size_t i = 0; i < nout && i < 8; i++)
+            REQUIRE(out[i].p_value >= 0.0 && out[i].p_value <= 1.0 && isfinite(out[i].n)
+                    && isfinite(out[i].t0) && isfinite(out[i].t1));
+}
+
+/* A model given as callbacks: y = th0 + th1 u + th2 exp(x), which
+   overflows for large positions; analytic or finite-difference Jacobian. */
+static int model_predict(const fe_sample *x, const double *th, double *y, void *user)
+{
+    (void)user;
+    *y = th[0] + th[1] * x->input + th[2] * exp(x->position);
+    return FE_OK;
+}
+
+static int model_jacobian(const fe_sample *x, const double *th, double *jac, void *user)
+{
+    (void)th;
+    (void)user;
+    jac[0] = 1.0;
+    jac[1] = x->input;
+    jac[2] = exp(x->position);
+    return FE_OK;
+}
+
+static void fuzz_model(in *s, unsigned shape)
+{
+    static const double theta0[3] = {0.5, 1.0, 0.1};
+    fe_catalog_scale sc;
+    fe_catalog c;
+    fe_model md;
+    fe_model_acc a, *as = malloc(sizeof *as);
+    fe_sample x0 = {0, 0, 0, 0, 0.1, 0.2, 20, 20, 1}, x1 = {1, 0, 0, 0, -0.1, -0.3, 21, 20, 0};
+    size_t nd;
+    double *mem = NULL, *snap = NULL;
+    int rc;
+    memset(&sc, 0, sizeof sc);
+    memset(&md, 0, sizeof md);
+    if (as == NULL || fe_catalog_scale_add(&sc, &x0) != FE_OK
+        || fe_catalog_scale_add(&sc, &x1) != FE_OK
+        || fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT, &sc) != FE_OK)
+        goto done;
+    md.p = 3;
+    md.theta0 = theta0;
+    md.predict = model_predict;
+    md.jacobian = (shape & 1) ? model_jacobian : NULL;
+    md.forward = (shape >> 1) & 1;
+    nd = fe_model_acc_doubles(3, c.count, 2);
+    mem = calloc(nd, sizeof *mem);
+    snap = calloc(nd, sizeof *snap);
+    if (nd == 0 || mem == NULL || snap == NULL
+        || fe_model_acc_init(&a, &md, &c, 2, 8, mem, nd) != FE_OK)
+        goto done;
+    while (s->n > 0) {
+        fe_sample x;
+        memset(&x, 0, sizeof x);
+        x.t = number(s);
+        x.real = number(s);
+        x.position = number(s);
+        x.velocity = number(s);
+        x.input = number(s);
+        memcpy(as, &a, sizeof a);
+        STEP(fe_model_add(&a, &x), mem, nd * sizeof *mem, snap);
+        if (rc != FE_OK)
+            REQUIRE(memcmp(as, &a, sizeof a) == 0);
+        else
+            REQUIRE(finite_all(mem, nd));
+        if (byte(s) == 0xff)
+            fe_model_break(&a);
+    }
+done:
+    free(as);
+    free(mem);
+    free(snap);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     in s = {data, size};
     unsigned which = byte(&s), shape = byte(&s);
-    switch (which % 6) {
+    switch (which % 9) {
     case 0: fuzz_meanvar(&s); break;
     case 1: fuzz_quadric(&s, shape); break;
     case 2: fuzz_lsq(&s, shape); break;
     case 3: fuzz_schur(&s, shape); break;
     case 4: fuzz_kalman(&s, shape); break;
-    default: fuzz_discover(&s, shape); break;
+    case 5: fuzz_discover(&s, shape); break;
+    case 6: fuzz_discover_rows(&s, shape); break;
+    case 7: fuzz_innovations(&s, shape); break;
+    default: fuzz_model(&s, shape); break;
     }
     return 0;
 }
