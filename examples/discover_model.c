@@ -105,10 +105,12 @@ int main(void)
     }
     printf("  (the generator hid quadratic drag with coefficient %.4g)\n", gen.coefficient);
 
-    fe_model_theta(&acc, res, theta, se);
+    rc = fe_model_theta(&acc, res, theta, se);
     printf("\nthe model's parameters, re-fitted with it:\n");
     for (int i = 0; i < 3; i++)
         printf("  %-13s %.5f +/- %.5f (nominal %.5f)\n", names[i], theta[i], se[i], theta0[i]);
+    if (rc == FE_EUNDETERMINED)
+        printf("  (a parameter with +/- 0 was set aside: the data cannot determine it)\n");
     free(storage);
     free(work);
     free(res);

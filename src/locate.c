@@ -174,7 +174,8 @@ static void fe__block_tests(const fe_innovation_block *b, double *z_nis, double 
     if (p > 1.0)
         p = 1.0;
     *p_nis = p;
-    *z_nis = p < 1.0 ? -fe_normal_quantile(p) : -INFINITY;
+    /* p = 1 (a block of zero NIS) would make z infinite: at most 1 - eps. */
+    *z_nis = -fe_normal_quantile(p < 1.0 - DBL_EPSILON ? p : 1.0 - DBL_EPSILON);
     *z_acf = 0.0;
     *p_acf = 1.0;
     if (fe__lag1(b->acf, b->acf_terms, b->sq, b->sq_terms, &rho)) {

@@ -225,19 +225,24 @@ int fe_model_group_is_term(const fe_model_acc *a, size_t g, size_t *term)
 int fe_model_theta(const fe_model_acc *a, const fe_discover_result *r,
                    double *theta, double *se)
 {
+    int rc = FE_OK;
     if (a == NULL || r == NULL || theta == NULL)
         return FE_EINVAL;
     for (size_t i = 0; i < a->model.p; i++) {
+        int found = 0;
         theta[i] = a->theta0[i];
         if (se != NULL)
-            se[i] = NAN;
+            se[i] = 0.0;
         for (size_t j = 0; j < r->ncols; j++)
             if (r->cols[j] == i) {
                 theta[i] += r->coef[j];
                 if (se != NULL)
                     se[i] = r->stderr_[j];
+                found = 1;
             }
+        if (!found)             /* set aside: the data cannot determine it */
+            rc = FE_EUNDETERMINED;
     }
-    return FE_OK;
+    return rc;
 }
 /* Select and read the result ends here */

@@ -269,6 +269,74 @@ START_TEST(huge_values_are_refused_and_nothing_infinite_escapes)
 }
 END_TEST
 
+START_TEST(arguments_merges_that_do_not_fit_and_json)
+{
+    fe_innovations a, b, before;
+    fe_located out[4], one;
+    double w = 1.0;
+    fe_kalman_report r = {1, 1.0, 0, NULL, &w, NULL};
+    size_t nout = 7;
+    char buf[512], tiny[8];
+    ck_assert_int_eq(fe_innovations_init(NULL, 4, 40, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_init(&a, FE_DISCOVER_MAX_BLOCKS + 1, 4000, 0), FE_ESIZE);
+    ck_assert_int_eq(fe_innovations_init(&a, 4, 40, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_add(NULL, 0.0, &r), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_add(&a, 0.0, NULL), FE_EINVAL);
+    fe_innovations_break(NULL);
+    /* A part that ends is full: one report more is refused. */
+    for (int i = 0; i < 40; i++)
+        ck_assert_int_eq(fe_innovations_add(&a, (double)i, &r), FE_OK);
+    memcpy(&before, &a, sizeof a);
+    ck_assert_int_eq(fe_innovations_add(&a, 40.0, &r), FE_ESIZE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    /* Merges: NULL, other shapes, parts that do not follow, an empty b. */
+    ck_assert_int_eq(fe_innovations_init(&b, 4, 40, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_merge(NULL, &b), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_merge(&a, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_merge(&a, &b), FE_EMISMATCH);    /* b starts at 0 */
+    ck_assert_int_eq(fe_innovations_init(&b, 5, 40, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_merge(&a, &b), FE_EMISMATCH);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_int_eq(fe_innovations_init(&b, 4, 40, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&a, 4, 40, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_merge(&a, &b), FE_OK);          /* both empty */
+    ck_assert_uint_eq(a.n, 0);
+    /* Locate: arguments; a block of zero NIS whose innovations alternate in
+       sign is located by its autocorrelation with a finite NIS statistic. */
+    ck_assert_int_eq(fe_innovations_locate(NULL, 0.05, out, 4, &nout), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.05, out, 4, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.05, NULL, 4, &nout), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.0, out, 4, &nout), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_locate(&a, 1.0, out, 4, &nout), FE_EINVAL);
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.05, NULL, 0, &nout), FE_OK);
+    ck_assert_uint_eq(nout, 0);
+    r.nis = 0.0;
+    for (int i = 0; i < 40; i++) {
+        w = i % 2 ? 1.0 : -1.0;
+        ck_assert_int_eq(fe_innovations_add(&a, (double)i, &r), FE_OK);
+    }
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.05, out, 0, &nout), FE_OK);
+    ck_assert_uint_eq(nout, 1);                 /* counted, none written */
+    ck_assert_int_eq(fe_innovations_locate(&a, 0.05, out, 4, &nout), FE_OK);
+    ck_assert_uint_eq(nout, 1);
+    ck_assert(isfinite(out[0].z) && isfinite(out[0].t) && out[0].lag1 < -0.9);
+    ck_assert_str_eq(out[0].test, "innovation_acf");
+    /* JSON: the keys, a buffer too small, NULLs. */
+    ck_assert_int_eq(fe_located_json(&out[0], buf, sizeof buf), FE_OK);
+    ck_assert_ptr_nonnull(strstr(buf, "\"test\": \"innovation_acf\""));
+    ck_assert_ptr_nonnull(strstr(buf, "\"lag1\""));
+    ck_assert_int_eq(buf[0], '{');
+    ck_assert_int_eq(buf[strlen(buf) - 1], '}');
+    ck_assert_int_eq(fe_located_json(&out[0], tiny, sizeof tiny), FE_ESIZE);
+    ck_assert_int_eq(fe_located_json(NULL, buf, sizeof buf), FE_EINVAL);
+    ck_assert_int_eq(fe_located_json(&out[0], NULL, sizeof buf), FE_EINVAL);
+    one = out[0];
+    one.mean_nis = INFINITY;                    /* written as null, not inf */
+    ck_assert_int_eq(fe_located_json(&one, buf, sizeof buf), FE_OK);
+    ck_assert_ptr_null(strstr(buf, "inf"));
+}
+END_TEST
+
 Suite *fe_locate_suite(void)
 {
     Suite *s = suite_create("locate");
@@ -278,6 +346,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
+    tcase_add_test(t, arguments_merges_that_do_not_fit_and_json);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);
     suite_add_tcase(s, t);

@@ -47,6 +47,31 @@ static int failing_predict(const fe_sample *s, const double *th, double *y, void
 }
 
 static const double theta0[3] = {1.0, 0.4, 0.15};
+
+/* Fails only away from theta0: the finite-difference evaluations. */
+static int failing_away_predict(const fe_sample *s, const double *th, double *y, void *user)
+{
+    (void)user;
+    if (th[1] != theta0[1])
+        return FE_ESTOPPED;
+    return rig_predict(s, th, y, user);
+}
+
+static int failing_jacobian(const fe_sample *s, const double *th, double *jac, void *user)
+{
+    (void)s;
+    (void)th;
+    (void)user;
+    jac[0] = jac[1] = jac[2] = 0.0;
+    return FE_ESTOPPED;
+}
+
+static int nan_jacobian(const fe_sample *s, const double *th, double *jac, void *user)
+{
+    int rc = rig_jacobian(s, th, jac, user);
+    jac[2] = NAN;
+    return rc;
+}
 static const char *const names[3] = {"input_gain_param", "frequency", "damping"};
 
 typedef struct {
@@ -311,6 +336,111 @@ START_TEST(refusals_leave_the_accumulation_unchanged)
 }
 END_TEST
 
+START_TEST(arguments_and_failing_callbacks)
+{
+    fe_catalog_scale sc = {0};
+    fe_catalog c;
+    fe_model m = {3, theta0, names, rig_predict, rig_jacobian, 0, NULL, NULL};
+    fe_model bad = m;
+    double zero_typical[3] = {1, 0, 1}, th[3], se[3], *st, *copy;
+    fe_model_acc a, before;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    size_t nst, base[1], term;
+    fe_sample s = {0};
+    ck_assert_ptr_nonnull(r);
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT,
+                                     &sc), FE_OK);
+    nst = fe_model_acc_doubles(3, c.count, 4);
+    ck_assert_uint_eq(fe_model_acc_doubles(3, FE_DISCOVER_MAX_COLUMNS, 4), 0);
+    st = malloc(nst * sizeof *st);
+    copy = malloc(nst * sizeof *st);
+    ck_assert_int_eq(fe_model_acc_init(NULL, &m, &c, 4, 100, st, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_model_acc_init(&a, NULL, &c, 4, 100, st, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_model_acc_init(&a, &m, NULL, 4, 100, st, nst), FE_EINVAL);
+    bad.theta0 = NULL;
+    ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_EINVAL);
+    bad = m;
+    bad.p = 0;
+    ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_EINVAL);
+    bad.p = FE_MODEL_MAX_PARAMS + 1;
+    ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_EINVAL);
+    bad = m;
+    bad.typical = zero_typical;
+    ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_ENONFINITE);
+    /* Names: given, or made. */
+    ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);
+    ck_assert_str_eq(fe_model_group_name(&a, 1), "frequency");
+    ck_assert_ptr_null(fe_model_group_name(&a, a.ngroups));
+    ck_assert_ptr_null(fe_model_group_name(NULL, 0));
+    ck_assert_int_eq(fe_model_group_is_term(&a, 0, &term), 0);
+    ck_assert_int_eq(fe_model_group_is_term(&a, 3, &term), 1);
+    ck_assert_uint_eq(term, 0);
+    ck_assert_int_eq(fe_model_group_is_term(&a, 3, NULL), 1);
+    ck_assert_int_eq(fe_model_group_is_term(NULL, 3, &term), 0);
+    bad = m;
+    bad.names = NULL;
+    ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_OK);
+    ck_assert_str_eq(fe_model_group_name(&a, 1), "theta2");
+    /* Rows: failing and non-finite Jacobians, failing finite differences,
+       NULL arguments; every refusal leaves the accumulation as it was. */
+    ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);
+    s.t = 1;
+    s.input = 0.5;
+    s.real = 0.3;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+    memcpy(&before, &a, sizeof a);
+    memcpy(copy, st, nst * sizeof *st);
+    s.t = 2;
+    a.model.jacobian = failing_jacobian;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ESTOPPED);
+    a.model.jacobian = nan_jacobian;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
+    a.model.jacobian = NULL;
+    a.model.predict = failing_away_predict;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ESTOPPED);
+    a.model.forward = 1;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ESTOPPED);
+    a.model = before.model;
+    ck_assert_int_eq(fe_model_add(NULL, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_model_add(&a, NULL), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    /* Selecting: NULLs, a held row, bad base terms. */
+    for (int i = 2; i < 40; i++) {
+        s.t = i;
+        s.position = 0.01 * i * (i % 3);
+        s.velocity = 0.02 * (i % 5);
+        s.input = (i % 7) * 0.1;
+        s.real = 0.1 * (i % 4);
+        ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+    }
+    {
+        size_t nw = fe_model_workspace_doubles(&a);
+        double *w = malloc(nw * sizeof *w);
+        ck_assert_uint_eq(fe_model_workspace_doubles(NULL), 0);
+        ck_assert_int_eq(fe_model_select(&a, NULL, r, w, nw), FE_EINVAL);   /* row held */
+        ck_assert_int_eq(fe_model_break(NULL), FE_EINVAL);
+        ck_assert_int_eq(fe_model_break(&a), FE_OK);
+        ck_assert_int_eq(fe_model_select(NULL, NULL, r, w, nw), FE_EINVAL);
+        ck_assert_int_eq(fe_model_select(&a, NULL, NULL, w, nw), FE_EINVAL);
+        o.nbase = 1;
+        o.base = NULL;
+        ck_assert_int_eq(fe_model_select(&a, &o, r, w, nw), FE_EINVAL);
+        base[0] = c.count;
+        o.base = base;
+        ck_assert_int_eq(fe_model_select(&a, &o, r, w, nw), FE_EINVAL);
+        ck_assert_int_eq(fe_model_theta(NULL, r, th, se), FE_EINVAL);
+        ck_assert_int_eq(fe_model_theta(&a, NULL, th, se), FE_EINVAL);
+        ck_assert_int_eq(fe_model_theta(&a, r, NULL, se), FE_EINVAL);
+        free(w);
+    }
+    free(st);
+    free(copy);
+    free(r);
+}
+END_TEST
+
 Suite *fe_model_suite(void)
 {
     Suite *s = suite_create("model");
@@ -318,6 +448,7 @@ Suite *fe_model_suite(void)
     tcase_set_timeout(t, 600);
     tcase_add_test(t, finite_difference_steps_and_calls);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, arguments_and_failing_callbacks);
     tcase_add_test(t, analytic_and_numerical_jacobians_discover_the_same);
     tcase_add_test(t, concealed_effects_are_found_through_the_model);
     tcase_add_test(t, a_right_model_discovers_nothing);

@@ -113,7 +113,10 @@ int fe_model_group_is_term(const fe_model_acc *a, size_t g, size_t *term);
 
 /* fe_model_theta: the parameters the fit prefers, theta0 + delta (one
    Gauss-Newton step taken with the discovered terms in the model), and
-   their batch-means standard errors (se may be NULL).  FE_EINVAL on NULL. */
+   their batch-means standard errors (se may be NULL).  FE_EINVAL on NULL;
+   FE_EUNDETERMINED when the selection set a parameter's column aside as
+   redundant (the data cannot determine it): that one keeps theta0 and
+   se 0, the others are filled as usual.  Every number written is finite. */
 int fe_model_theta(const fe_model_acc *a, const fe_discover_result *r,
                    double *theta, double *se);
 
