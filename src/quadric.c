@@ -88,10 +88,10 @@ static int fe__quadric_full(const fe_quadric *q)
 {
     double c[3];
     float size = fe__quadric_frame(q, c);
-    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
-        if (q->seen[r] < size)
-            return 0;
-    return 1;
+    int stale = 0;
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++)  /* no early exit: vectorises */
+        stale |= q->seen[r] < size;
+    return !stale;
 }
 
 static void fe__quadric_mark(fe_quadric *q, int region, float size)
@@ -460,7 +460,7 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
         size_t m = n - k < FE__QUADRIC_BLOCK ? n - k : FE__QUADRIC_BLOCK;
         const double *b = x + 3 * k;
         double lo[3], hi[3], rlo[3], rhi[3], sums[35], next[35];
-        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1;
+        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1, full = 0;
 
         if (fast) {             /* a non-finite sample makes a sum non-finite */
             size_t rest = n - k - m;
@@ -488,7 +488,8 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
                         lo[j] = v < lo[j] ? v : lo[j];
                         hi[j] = v > hi[j] ? v : hi[j];
                     }
-            if (!fe__quadric_full(q))
+            full = fe__quadric_full(q);
+            if (!full)
                 for (int j = 0; j < 3; j++)
                     fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
         }
@@ -499,7 +500,7 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
                 q->lo[j] = lo[j];
                 q->hi[j] = hi[j];
             }
-            if (!fe__quadric_full(q)) {
+            if (!(full && inside) && !fe__quadric_full(q)) {
                 double c[3];
                 float size = fe__quadric_frame(q, c);
                 for (size_t i = 0; i < m; i++)
