@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include <cblas.h>
 #include <lapacke.h>
 
 #include "foldest/discover.h"
@@ -16,10 +17,36 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
 }
 /* Discovery Includes ends here */
 /* [[file:../literate/discover.org::Fold a row into its block][Fold a row into its block]] */
+/* Rows per panel in fe_discover_add_rows (the scratch holds one more). */
+enum { FE__DISCOVER_PANEL = 128 };
+
 size_t fe_discover_acc_doubles(size_t m, size_t blocks)
 {
     size_t dim = m + 1;
-    return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1;
+    return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1
+           + dim * dim + (FE__DISCOVER_PANEL + 1) * dim;
+}
+
+/* The first global row of block k (k = K: the first held-out row). */
+static uint64_t fe__discover_cut(const fe_discover_acc *a, size_t k)
+{
+    if (k >= a->blocks)
+        return a->fit_rows;
+    return ((uint64_t)k * a->fit_rows + a->blocks - 1) / a->blocks;
+}
+
+static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
+{
+    if (row >= a->fit_rows)
+        return a->blocks;                       /* held out */
+    return (size_t)(row * a->blocks / a->fit_rows);
+}
+
+/* Point the block tracker at global row `row`. */
+static void fe__discover_seek(fe_discover_acc *a, uint64_t row)
+{
+    a->block = fe__discover_block(a, row);
+    a->next_cut = a->block < a->blocks ? fe__discover_cut(a, a->block + 1) : UINT64_MAX;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -50,20 +77,36 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     a->first = a->lag + dim * dim;
     a->last = a->first + dim;
     a->counts = a->last + dim;
+    a->work = a->counts + blocks + 1;
+    fe__discover_seek(a, row0);
     return FE_OK;
 }
 
-static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
+/* Add the folded z p^T to T: z_i p_i on the diagonal, z_i p_j + p_i z_j above. */
+static void fe__discover_lag_pair(double *t, size_t dim, const double *z, const double *p)
 {
-    if (row >= a->fit_rows)
-        return a->blocks;                       /* held out */
-    return (size_t)(row * a->blocks / a->fit_rows);
+    for (size_t i = 0; i < dim; i++) {
+        double zi = z[i], pi = p[i];
+        double *ti = t + i * dim;
+        ti[i] += zi * pi;
+        for (size_t j = i + 1; j < dim; j++)
+            ti[j] += zi * p[j] + pi * z[j];
+    }
+}
+
+/* Move the block tracker past the next `rows` rows. */
+static void fe__discover_advance(fe_discover_acc *a, uint64_t rows)
+{
+    uint64_t next = a->row0 + a->n + rows;
+    while (next >= a->next_cut) {
+        a->block++;
+        a->next_cut = a->block < a->blocks ? fe__discover_cut(a, a->block + 1) : UINT64_MAX;
+    }
 }
 
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
 {
     size_t dim, k;
-    uint64_t row;
     double z[FE_DISCOVER_MAX_COLUMNS + 1], *g;
 
     if (a == NULL || phi == NULL)
@@ -77,8 +120,7 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     if (!isfinite(r))
         return FE_ENONFINITE;
     z[a->m] = r;
-    row = a->row0 + a->n;
-    k = fe__discover_block(a, row);
+    k = a->block;
     g = a->gram + k * dim * dim;
     /* Add z z^T to the block's upper triangle. */
     for (size_t i = 0; i < dim; i++) {
@@ -90,15 +132,14 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
             gi[j] += zi * z[j];
     }
     a->counts[k] += 1.0;
-    /* Add z_t z_{t-1}^T when the previous row is a fitted neighbour. */
+    /* Add z_t z_{t-1}^T, folded, when the previous row is a fitted neighbour. */
     if (a->have_prev && k < a->blocks)
-        for (size_t i = 0; i < dim; i++)
-            for (size_t j = 0; j < dim; j++)
-                a->lag[i * dim + j] += z[i] * a->last[j];
+        fe__discover_lag_pair(a->lag, dim, z, a->last);
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
     a->have_prev = k < a->blocks;
+    fe__discover_advance(a, 1);
     a->n++;
     return FE_OK;
 }
@@ -134,19 +175,127 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     /* The lag product across the cut. */
     if (a->n > 0 && a->have_prev && b->first_linked
         && fe__discover_block(a, b->row0) < a->blocks)
-        for (size_t i = 0; i < dim; i++)
-            for (size_t j = 0; j < dim; j++)
-                a->lag[i * dim + j] += b->first[i] * a->last[j];
+        fe__discover_lag_pair(a->lag, dim, b->first, a->last);
     if (a->n == 0) {
         memcpy(a->first, b->first, dim * sizeof *a->first);
         a->first_linked = b->first_linked;
     }
     memcpy(a->last, b->last, dim * sizeof *a->last);
     a->have_prev = b->have_prev;
+    a->block = b->block;
+    a->next_cut = b->next_cut;
     a->n += b->n;
     return FE_OK;
 }
 /* Merge consecutive accumulations ends here */
+/* [[file:../literate/discover.org::Fold a panel of rows][Fold a panel of rows]] */
+/* Copy up to q rows into the panel Z (scratch rows 1..q; row 0 is kept for
+   the row before the panel), checking every value; the count of rows
+   before the first that is not finite. */
+static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ldphi,
+                                const double *r, size_t q)
+{
+    size_t dim = a->m + 1, m = a->m;
+    double *z = a->work + dim * dim + dim;
+    for (size_t t = 0; t < q; t++) {
+        const double *pt = phi + t * ldphi;
+        double *zt = z + t * dim, bad = 0.0;
+        for (size_t i = 0; i < m; i++) {
+            zt[i] = pt[i];
+            bad += pt[i] - pt[i];               /* NaN unless finite */
+        }
+        zt[m] = r[t];
+        bad += r[t] - r[t];
+        if (bad != 0.0)
+            return t;
+    }
+    return q;
+}
+
+/* Fold the q loaded rows (all in block a->block). */
+static void fe__discover_panel(fe_discover_acc *a, size_t q)
+{
+    size_t dim = a->m + 1, k = a->block;
+    double *x = a->work, *c = x + dim * dim, *z = c + dim;
+    double *g = a->gram + k * dim * dim, *t = a->lag;
+    int fitted = k < a->blocks, linked = fitted && a->have_prev;
+    size_t pairs = linked ? q : q - 1;
+
+    /* X = Z^T Z, into the block. */
+    cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)q, 1.0, z,
+                (int)dim, 0.0, x, (int)dim);
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = i; j < dim; j++)
+            g[i * dim + j] += x[i * dim + j];
+    a->counts[k] += (double)q;
+    if (a->n == 0)
+        memcpy(a->first, z, dim * sizeof *z);
+    if (fitted && pairs > 0) {
+        double diag[FE_DISCOVER_MAX_COLUMNS + 1], sign = linked ? 1.0 : -1.0;
+        double *c0 = linked ? c : z, *cp = z + (q - 1) * dim;
+        if (linked)
+            memcpy(c, a->last, dim * sizeof *c);
+        /* The diagonal directly: T_ii += sum_s c_{s,i} c_{s-1,i}. */
+        for (size_t i = 0; i < dim; i++)
+            diag[i] = t[i * dim + i];
+        for (size_t s = 1; s <= pairs; s++) {
+            const double *cs = c0 + s * dim, *cr = cs - dim;
+            for (size_t i = 0; i < dim; i++)
+                diag[i] += cs[i] * cr[i];
+        }
+        /* Above it: 2X +- c_0 c_0^T - c_p c_p^T, ... */
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = i + 1; j < dim; j++)
+                t[i * dim + j] += 2.0 * x[i * dim + j] + sign * c0[i] * c0[j] - cp[i] * cp[j];
+        memcpy(a->last, cp, dim * sizeof *cp);
+        /* ... - D, from the differences made in place, last row first. */
+        for (size_t s = pairs; s > 0; s--) {
+            double *cs = c0 + s * dim;
+            const double *cr = cs - dim;
+            for (size_t i = 0; i < dim; i++)
+                cs[i] -= cr[i];
+        }
+        cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)pairs, -1.0,
+                    c0 + dim, (int)dim, 1.0, t, (int)dim);
+        for (size_t i = 0; i < dim; i++)
+            t[i * dim + i] = diag[i];
+    } else {
+        memcpy(a->last, z + (q - 1) * dim, dim * sizeof *z);
+    }
+    a->have_prev = fitted;
+    fe__discover_advance(a, q);
+    a->n += q;
+}
+
+int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
+                         const double *r, size_t nrows, size_t *done)
+{
+    size_t i = 0;
+    int rc = FE_OK;
+
+    if (done != NULL)
+        *done = 0;
+    if (a == NULL || (nrows > 0 && (phi == NULL || r == NULL))
+        || (nrows > 1 && ldphi < a->m))
+        return FE_EINVAL;
+    while (i < nrows && rc == FE_OK) {
+        /* A panel: at most FE__DISCOVER_PANEL rows, all in one block. */
+        uint64_t left = a->next_cut - (a->row0 + a->n);
+        size_t q = nrows - i < FE__DISCOVER_PANEL ? nrows - i : FE__DISCOVER_PANEL, got;
+        if (left < q)
+            q = (size_t)left;
+        got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
+        if (got < q)
+            rc = FE_ENONFINITE;
+        if (got > 0)
+            fe__discover_panel(a, got);
+        i += got;
+    }
+    if (done != NULL)
+        *done = i;
+    return rc;
+}
+/* Fold a panel of rows ends here */
 /* [[file:../literate/discover.org::Workspace layout][Workspace layout]] */
 typedef struct fe__ws {
     double *g;          /* M x M total Gram of fitted rows, full */

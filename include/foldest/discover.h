@@ -27,10 +27,16 @@ typedef struct fe_discover_acc {
     uint64_t n;                 /* rows folded into this part */
     int have_prev;              /* the last row can be followed (no break) */
     int first_linked;           /* the first row follows the previous part */
+    size_t block;               /* block of the next row (K: held out) */
+    uint64_t next_cut;          /* global index of the next block's first row */
     double *gram;               /* (K + 1) x M x M, upper triangles */
-    double *lag;                /* M x M, sum z_t z_{t-1}^T over fitted rows */
+    double *lag;                /* M x M, L = sum z_t z_{t-1}^T over fitted
+                                   rows, folded: L_ii on the diagonal,
+                                   L_ij + L_ji above it, zeros below, so
+                                   that w^T lag w = w^T L w */
     double *first, *last;       /* M each */
     double *counts;             /* K + 1 row counts */
+    double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
 /* fe_discover_acc_doubles: doubles of storage for m columns, K blocks. */
@@ -48,8 +54,20 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
 
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
-   value is not finite.  Cost O(M^2). */
+   value is not finite.  Cost about 1.5 M (M + 1) multiply-adds
+   (fe_discover_add_rows is the fast path for many rows). */
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
+
+/* fe_discover_add_rows: fold `nrows` rows at once: row i is the m term
+   values phi[i * ldphi .. i * ldphi + m - 1] and the residual r[i].  The
+   same accumulation as fe_discover_add row by row (up to rounding: sums
+   are grouped differently), at about half its arithmetic and with level-3
+   BLAS.  Stops at the first row with a value that is not finite
+   (FE_ENONFINITE): the rows before it are folded, the rest are not.
+   `*done` (if not NULL) receives how many rows were folded.  FE_EINVAL for
+   null pointers or ldphi < m when nrows > 1 (nothing folded). */
+int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
+                         const double *r, size_t nrows, size_t *done);
 
 /* fe_discover_break: the next row does not follow the last in time (a new
    recording begins): no lag product is formed across. */
