@@ -227,7 +227,7 @@ static void assert_same_sums(const fe_discover_acc *got, const fe_discover_acc *
 /* Fold rows [from, to) through the panel path in uneven pieces. */
 static void add_in_pieces(fe_discover_acc *a, size_t from, size_t to)
 {
-    static const size_t piece[] = {1, 37, 300, 128, 2, 129, 1000, 5};
+    static const size_t piece[] = {37, 1, 300, 128, 2, 129, 1000, 5};
     size_t i = from, p = 0, done = 0;
     while (i < to) {
         size_t q = piece[p++ % (sizeof piece / sizeof *piece)];
