@@ -5,9 +5,9 @@
        the base (the catalog's shapes: powers and products of the state,
        v|v|, tanh(v/c), T - T0, T^4 - Ta^4, time, a difference for the delay)
        folded into the same accumulation, then ranked (one selection step).
-   Both folds go through the fastest path a caller has: terms evaluated into
-   a panel of 256 rows, folded by fe_discover_add_rows.  The row-by-row
-   figures (fe_discover_add) are printed beside them.
+   Both folds are timed both ways a caller has: row by row (fe_discover_add)
+   and with the terms evaluated into a panel of 256 rows folded by
+   fe_discover_add_rows; the ratio takes each fold's faster way.
    Prints ns per record, the ratio (goal: ranking <= 3x the base fold), the
    multiply-adds per row and the rate they run at, and the accumulation's
    size, which does not depend on the number of records. */
@@ -208,8 +208,11 @@ int main(int argc, char **argv)
            " %.1f GFLOP/s beyond the terms)\n", CAND, 1e9 * t_rank / (double)n,
            (double)(M * (M + 1)), 2.0 * (double)(M * (M + 1)) * (double)n / (t_rank - t_terms) / 1e9);
     printf("  ranking the %d candidates from the fold         %8.3f ms in all\n", CAND, 1e3 * t_select);
-    printf("  ratio ranking / base fold, both by panels: %.1f   (goal <= 3)\n",
-           (t_rank + t_select) / t_base);
+    /* Each through its faster path: for 4 columns the panels' BLAS calls
+       cost as much as they save. */
+    printf("  ratio ranking / base fold, each by its faster path: %.1f   (goal <= 3)\n",
+           ((t_rank < t_rank_rows ? t_rank : t_rank_rows) + t_select)
+               / (t_base < t_base_rows ? t_base : t_base_rows));
     printf("  accumulation: %zu doubles = %.1f KiB with the candidates (%zu = %.1f KiB base),"
            " for any number of records\n", nst, (double)nst * 8.0 / 1024.0, nst0,
            (double)nst0 * 8.0 / 1024.0);

@@ -42,13 +42,6 @@ static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
     return (size_t)(row * a->blocks / a->fit_rows);
 }
 
-/* Point the block tracker at global row `row`. */
-static void fe__discover_seek(fe_discover_acc *a, uint64_t row)
-{
-    a->block = fe__discover_block(a, row);
-    a->next_cut = a->block < a->blocks ? fe__discover_cut(a, a->block + 1) : UINT64_MAX;
-}
-
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
                          uint64_t fit_rows, uint64_t row0, double *storage,
                          size_t storage_doubles)
@@ -78,7 +71,6 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     a->last = a->first + dim;
     a->counts = a->last + dim;
     a->work = a->counts + blocks + 1;
-    fe__discover_seek(a, row0);
     return FE_OK;
 }
 
@@ -91,16 +83,6 @@ static void fe__discover_lag_pair(double *t, size_t dim, const double *z, const 
         ti[i] += zi * pi;
         for (size_t j = i + 1; j < dim; j++)
             ti[j] += zi * p[j] + pi * z[j];
-    }
-}
-
-/* Move the block tracker past the next `rows` rows. */
-static void fe__discover_advance(fe_discover_acc *a, uint64_t rows)
-{
-    uint64_t next = a->row0 + a->n + rows;
-    while (next >= a->next_cut) {
-        a->block++;
-        a->next_cut = a->block < a->blocks ? fe__discover_cut(a, a->block + 1) : UINT64_MAX;
     }
 }
 
@@ -120,7 +102,7 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     if (!isfinite(r))
         return FE_ENONFINITE;
     z[a->m] = r;
-    k = a->block;
+    k = fe__discover_block(a, a->row0 + a->n);
     g = a->gram + k * dim * dim;
     /* Add z z^T to the block's upper triangle. */
     for (size_t i = 0; i < dim; i++) {
@@ -139,7 +121,6 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
     a->have_prev = k < a->blocks;
-    fe__discover_advance(a, 1);
     a->n++;
     return FE_OK;
 }
@@ -182,8 +163,6 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     }
     memcpy(a->last, b->last, dim * sizeof *a->last);
     a->have_prev = b->have_prev;
-    a->block = b->block;
-    a->next_cut = b->next_cut;
     a->n += b->n;
     return FE_OK;
 }
@@ -212,10 +191,10 @@ static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ld
     return q;
 }
 
-/* Fold the q loaded rows (all in block a->block). */
-static void fe__discover_panel(fe_discover_acc *a, size_t q)
+/* Fold the q loaded rows, all in block k. */
+static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
 {
-    size_t dim = a->m + 1, k = a->block;
+    size_t dim = a->m + 1;
     double *x = a->work, *c = x + dim * dim, *z = c + dim;
     double *g = a->gram + k * dim * dim, *t = a->lag;
     int fitted = k < a->blocks, linked = fitted && a->have_prev;
@@ -263,7 +242,6 @@ static void fe__discover_panel(fe_discover_acc *a, size_t q)
         memcpy(a->last, z + (q - 1) * dim, dim * sizeof *z);
     }
     a->have_prev = fitted;
-    fe__discover_advance(a, q);
     a->n += q;
 }
 
@@ -280,15 +258,16 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
         return FE_EINVAL;
     while (i < nrows && rc == FE_OK) {
         /* A panel: at most FE__DISCOVER_PANEL rows, all in one block. */
-        uint64_t left = a->next_cut - (a->row0 + a->n);
-        size_t q = nrows - i < FE__DISCOVER_PANEL ? nrows - i : FE__DISCOVER_PANEL, got;
-        if (left < q)
-            q = (size_t)left;
+        uint64_t row = a->row0 + a->n;
+        size_t k = fe__discover_block(a, row), got;
+        size_t q = nrows - i < FE__DISCOVER_PANEL ? nrows - i : FE__DISCOVER_PANEL;
+        if (k < a->blocks && fe__discover_cut(a, k + 1) - row < q)
+            q = (size_t)(fe__discover_cut(a, k + 1) - row);
         got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
         if (got < q)
             rc = FE_ENONFINITE;
         if (got > 0)
-            fe__discover_panel(a, got);
+            fe__discover_panel(a, k, got);
         i += got;
     }
     if (done != NULL)

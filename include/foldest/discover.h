@@ -27,8 +27,6 @@ typedef struct fe_discover_acc {
     uint64_t n;                 /* rows folded into this part */
     int have_prev;              /* the last row can be followed (no break) */
     int first_linked;           /* the first row follows the previous part */
-    size_t block;               /* block of the next row (K: held out) */
-    uint64_t next_cut;          /* global index of the next block's first row */
     double *gram;               /* (K + 1) x M x M, upper triangles */
     double *lag;                /* M x M, L = sum z_t z_{t-1}^T over fitted
                                    rows, folded: L_ii on the diagonal,
