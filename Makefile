@@ -51,7 +51,7 @@ export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
         check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
-        check-tsan check-mpi bench-mpi
+        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage
 
 all: lib cli examples
 
@@ -73,9 +73,14 @@ $(STATIC): $(LIB_OBJ)
 	@mkdir -p $(@D)
 	rm -f $@ && ar rcs $@ $^
 
+# The shared library exports the public fe_ names and nothing else (a
+# version script: no fe__ helper, no compiler-made symbol such as Clang's
+# ifunc resolvers, leaks into users' link namespace).
 $(SHARED): $(LIB_OBJ)
 	@mkdir -p $(@D)
-	$(CC) -shared -Wl,-soname,libfoldest.so.$(SOVERSION) -o $@ $^ $(EXT_LIBS)
+	@printf '{\n  global: fe_[a-z]*;\n  local: *;\n};\n' > $(B)/lib/libfoldest.map
+	$(CC) -shared -Wl,-soname,libfoldest.so.$(SOVERSION) -Wl,--version-script=$(B)/lib/libfoldest.map \
+	  -o $@ $(LIB_OBJ) $(EXT_LIBS)
 	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so.$(SOVERSION)
 	ln -sf libfoldest.so.$(VERSION) $(B)/lib/libfoldest.so
 
@@ -86,7 +91,7 @@ $(B)/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(CC) $(WARN) $(CFLAGS) -Iinclude -Isrc/cli -c $< -o $@
 $(CLI): $(CLI_OBJ) $(STATIC)
 	@mkdir -p $(@D)
-	$(if $(CLI_OBJ),$(CC) $(CFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
+	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
 
 # ---------------------------------------------------------------- examples, bench
 examples: $(EXAMPLES)
@@ -159,7 +164,7 @@ TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"'
 
 $(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
-	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS)
+	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS) $(LDFLAGS)
 
 $(B)/san/%.o: src/%.c $(HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
@@ -213,6 +218,81 @@ check-install: lib
 	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest)' _ "$$d" "$$e"; \
 	  echo "built $$e against $$d/usr/local"; \
 	done
+
+# ---------------------------------------------------------------- fuzzing
+# libFuzzer harnesses (tests/fuzz/fuzz_*.c), clang with ASan and UBSan; the
+# library and the command line are rebuilt instrumented ($(B)/fuzz), the
+# CLI with its main renamed fe_cli_main.  `make fuzz` runs each harness
+# FUZZ_TIME seconds from its seed corpus (tests/fuzz/corpus/NAME, kept in
+# git) into $(B)/fuzz/corpus/NAME; a crash leaves $(B)/fuzz/crash-* and
+# fails.  Replay one: $(B)/fuzz/fuzz_NAME /absolute/FILE (FE_FUZZ_VERBOSE=1
+# shows the command line's messages; fuzz_cli runs in a scratch directory).
+FUZZ_CC      ?= clang
+FUZZ_TIME    ?= 120
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_CFLAGS  := $(WARN) -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer-no-link
+FUZZERS      := $(patsubst tests/fuzz/%.c,$(B)/fuzz/%,$(wildcard tests/fuzz/fuzz_*.c))
+FUZZ_LIB_OBJ := $(patsubst src/%.c,$(B)/fuzz/obj/%.o,$(LIB_SRC))
+FUZZ_CLI_OBJ := $(patsubst src/cli/%.c,$(B)/fuzz/obj/cli/%.o,$(CLI_SRC))
+
+$(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(B)/.deps
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Iinclude $(EXT_CFLAGS) -c $< -o $@
+$(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
+	@mkdir -p $(@D)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -Iinclude -Isrc/cli -c $< -o $@
+$(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_common.h $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
+	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
+
+# Keep the instrumented objects (make would delete them as intermediates).
+.SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
+
+fuzz-build: $(FUZZERS)
+
+fuzz: $(FUZZERS)
+	@set -e; for f in $(FUZZERS); do n=$$(basename $$f); \
+	  mkdir -p $(B)/fuzz/corpus/$$n tests/fuzz/corpus/$$n; \
+	  echo "== $$n for $(FUZZ_TIME) s"; \
+	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  $$f -max_total_time=$(FUZZ_TIME) -timeout=20 -rss_limit_mb=2048 -max_len=4096 \
+	    -print_final_stats=1 -artifact_prefix=$(abspath $(B)/fuzz)/ \
+	    $(abspath $(B)/fuzz/corpus)/$$n $(abspath tests/fuzz/corpus)/$$n > $(B)/fuzz/$$n.log 2>&1 \
+	    || { tail -60 $(B)/fuzz/$$n.log; echo "fuzz: $$n failed; see $(B)/fuzz/$$n.log"; exit 1; }; \
+	  grep -E '^stat::(number_of_executed_units|new_units_added)' $(B)/fuzz/$$n.log | tr '\n' ' '; echo; \
+	done
+
+# ---------------------------------------------------------------- coverage
+# The library and the command line rebuilt with gcov instrumentation in
+# $(B)/cov, every suite run once (the CLI suites run the instrumented
+# foldest), and gcovr's line and branch coverage of src/: a summary on the
+# terminal, per file in $(B)/cov/coverage.txt and $(B)/cov/branches.txt,
+# HTML in $(B)/cov/html/.  What stays uncovered, and why: README.md.
+# FE_NO_CLONES: one instance of the moment kernel's text (the portable one),
+# not three of which this processor runs one.
+COV_B := $(B)/cov
+coverage: $(B)/.deps
+	@rm -rf $(COV_B)/obj $(COV_B)/html && find $(COV_B) -name '*.gcda' -delete 2>/dev/null || true
+	$(MAKE) -s B=$(COV_B) CFLAGS='-O0 -g --coverage -fprofile-update=atomic -DFE_NO_CLONES' LDFLAGS=--coverage $(COV_B)/tests/check_foldest examples
+	@mkdir -p $(COV_B)/html
+	FE_TEST_QUICK=1 $(COV_B)/tests/check_foldest
+	gcovr -r . --filter 'src/' --object-directory $(COV_B)/obj --txt $(COV_B)/coverage.txt \
+	  --html-details $(COV_B)/html/index.html --print-summary
+	@gcovr -r . --filter 'src/' --object-directory $(COV_B)/obj --branches --txt $(COV_B)/branches.txt
+	@echo "per file: $(COV_B)/coverage.txt (lines), $(COV_B)/branches.txt; open $(COV_B)/html/index.html"
+
+# ---------------------------------------------------------------- static analysis
+# cppcheck and clang-tidy (configuration: .clang-tidy) over src/ and
+# include/; any finding fails.  Headers are checked through the sources that
+# include them.
+LINT_FLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L -Iinclude -Isrc/cli $(EXT_CFLAGS)
+lint: $(B)/.deps
+	cppcheck -q --std=c11 --enable=warning,portability,performance --inline-suppr \
+	  --error-exitcode=1 --suppress=missingIncludeSystem -j2 -Iinclude -Isrc/cli src include
+	@echo "cppcheck: clean"
+	@status=0; for f in $(LIB_SRC) $(CLI_SRC); do \
+	  clang-tidy -quiet $$f -- $(LINT_FLAGS) 2>/dev/null || status=1; \
+	done; [ $$status = 0 ] && echo "clang-tidy: clean"; exit $$status
 
 # ---------------------------------------------------------------- literate
 # Tangle into a scratch copy, then copy only the files whose content changed,

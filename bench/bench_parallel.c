@@ -9,13 +9,13 @@
    It also times the single-source pipeline (fe_parallel_fold_source: one
    reader thread, batches folded by a worker) against fe_fold_source.
 
-   Usage: bench_parallel [n]   (n observations per accumulator; 10^8 by
-   default for the mean and variance, 8e8 bytes).
+   Usage: bench_parallel [n]   (n observations for the mean and variance,
+   10^8 by default, 8e8 bytes; n/5 three-axis samples for the calibration
+   moments, 4.8e8 bytes).
 
-   To add an accumulator (the calibration moment fold, the normal
-   equations, ...): write a `generate` and an `agree` function like the
-   meanvar ones and add a row to `rows` below.  The accumulation must be
-   flat and at most sizeof(slot) bytes. */
+   To add an accumulator (the normal equations, ...): write a `generate`
+   and an `agree` function like the meanvar ones and add a row to `rows`
+   below.  The accumulation must be flat and at most sizeof(slot) bytes. */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -36,6 +36,7 @@ typedef struct row {
     /* The largest relative difference between two accumulations. */
     double (*agree)(const void *a, const void *b);
     double goal;                /* speed-up wanted on 2 threads */
+    unsigned divide;            /* fold n / divide observations */
 } row;
 
 static void meanvar_generate(void *obs, size_t i, fe_rng *r)
@@ -53,12 +54,49 @@ static double meanvar_agree(const void *a, const void *b)
                 fabs(p->m2 - q->m2) / fabs(q->m2));
 }
 
+/* Calibration moments: magnetometer-like samples on an ellipsoid far from
+   the origin (24 bytes each). */
+static fe_accumulator quadric_make(void)
+{
+    return fe_quadric_accumulator(NULL);
+}
+
+static void quadric_generate(void *obs, size_t i, fe_rng *r)
+{
+    static const double c[3] = {120.0, -35.0, 410.0}, semi[3] = {48.0, 50.0, 55.0};
+    double u[3], *x = obs;
+    (void)i;
+    fe_rng_unit_vector(r, u);
+    for (int j = 0; j < 3; j++)
+        x[j] = c[j] + semi[j] * u[j] + 0.4 * fe_rng_normal(r);
+}
+
+/* Moments may cancel (sum u1 u2 is near zero on a sphere): each is
+   compared relative to N s^d, s bounding every |u_j| and d its degree,
+   the largest total magnitude its N terms can have; count, reference and
+   extremes must agree exactly. */
+static double quadric_agree(const void *a, const void *b)
+{
+    const fe_quadric *p = a, *q = b;
+    double s = 0.0, worst = 0.0;
+    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0
+        || memcmp(p->lo, q->lo, sizeof p->lo) != 0 || memcmp(p->hi, q->hi, sizeof p->hi) != 0)
+        return INFINITY;
+    for (int j = 0; j < 3; j++)
+        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
+    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
+        int e[3];
+        fe_quadric_exponents(k, e);
+        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
+    }
+    return worst;
+}
+
 static const row rows[] = {
     {"mean+variance (fe_meanvar)", fe_meanvar_accumulator, meanvar_generate,
-     meanvar_agree, 1.7},
-    /* Hook: the calibration moment fold goes here when it lands, e.g.
-       {"calibration moments", fe_calib_moments_accumulator,
-        calib_generate, calib_agree, 1.7}, */
+     meanvar_agree, 1.7, 1},
+    {"calibration moments (fe_quadric)", quadric_make, quadric_generate,
+     quadric_agree, 1.7, 5},
 };
 
 /* Time one parallel fold of z on T threads into `result`. */
@@ -117,7 +155,7 @@ static double run_source(const row *w, const void *z, size_t n, int workers,
 
 int main(int argc, char **argv)
 {
-    size_t n = argc > 1 ? (size_t)strtod(argv[1], NULL) : 100000000;
+    size_t n_all = argc > 1 ? (size_t)strtod(argv[1], NULL) : 100000000;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     double busy = fe_bench_busy_fraction();
     int ok = 1;
@@ -130,6 +168,7 @@ int main(int argc, char **argv)
     for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
         const row *w = &rows[k];
         fe_accumulator f = w->make();
+        size_t n = n_all / w->divide;
         unsigned char *z = malloc(n * f.obs_size);
         fe_rng r = fe_rng_seed(2026);
         slot one, two, four;

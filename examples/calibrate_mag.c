@@ -67,9 +67,10 @@ static void print_fit(const char *name, int rc, const fe_sphere_fit *f)
         return;
     }
     printf("  %-9s offset (%.1f, %.1f, %.1f) +- (%.2f, %.2f, %.2f), field %.1f,"
-           " semi-axes %.1f %.1f %.1f, rms %.2f%%, %d iterations\n",
+           " semi-axes %.1f %.1f %.1f, rms %.2f%%, %d iterations%s\n",
            name, f->offset[0], f->offset[1], f->offset[2], f->se[0], f->se[1], f->se[2],
-           f->radius, f->axes[0], f->axes[1], f->axes[2], f->rms_percent, f->iterations);
+           f->radius, f->axes[0], f->axes[1], f->axes[2], f->rms_percent, f->iterations,
+           f->algebraic ? " (ran away: the algebraic sphere)" : "");
 }
 
 static void plot(const double *x, size_t n, const fe_sphere_fit *f)

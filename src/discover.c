@@ -42,11 +42,22 @@ static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
     return (size_t)(row * a->blocks / a->fit_rows);
 }
 
+static void fe__discover_layout(fe_discover_acc *a, double *storage)
+{
+    size_t dim = a->m + 1;
+    a->gram = storage;
+    a->lag = a->gram + (a->blocks + 1) * dim * dim;
+    a->first = a->lag + dim * dim;
+    a->last = a->first + dim;
+    a->counts = a->last + dim;
+    a->work = a->counts + a->blocks + 1;
+}
+
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
                          uint64_t fit_rows, uint64_t row0, double *storage,
                          size_t storage_doubles)
 {
-    size_t dim = m + 1, need;
+    size_t need;
     if (a == NULL || storage == NULL)
         return FE_EINVAL;
     if (m == 0 || m > FE_DISCOVER_MAX_COLUMNS || blocks < 2
@@ -65,12 +76,7 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     a->n = 0;
     a->have_prev = 0;
     a->first_linked = 1;
-    a->gram = storage;
-    a->lag = a->gram + (blocks + 1) * dim * dim;
-    a->first = a->lag + dim * dim;
-    a->last = a->first + dim;
-    a->counts = a->last + dim;
-    a->work = a->counts + blocks + 1;
+    fe__discover_layout(a, storage);
     return FE_OK;
 }
 
@@ -86,9 +92,19 @@ static void fe__discover_lag_pair(double *t, size_t dim, const double *z, const 
     }
 }
 
+/* Some value above 1e100 in magnitude: products may overflow. */
+static int fe__discover_large(const double *z, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (fabs(z[i]) > 1e100)
+            return 1;
+    return 0;
+}
+
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
 {
     size_t dim, k;
+    uint64_t row;
     double z[FE_DISCOVER_MAX_COLUMNS + 1], *g;
 
     if (a == NULL || phi == NULL)
@@ -102,8 +118,27 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     if (!isfinite(r))
         return FE_ENONFINITE;
     z[a->m] = r;
-    k = fe__discover_block(a, a->row0 + a->n);
+    if (a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        return FE_EINVAL;       /* a part that does not know its place */
+    row = a->row0 + a->n;
+    k = fe__discover_block(a, row);
     g = a->gram + k * dim * dim;
+    if (fe__discover_large(z, dim) || (a->have_prev && k < a->blocks
+                                       && fe__discover_large(a->last, dim))) {
+        /* The slow path: every new sum must be finite before any is written. */
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = i; j < dim; j++)
+                if (!isfinite(g[i * dim + j] + z[i] * z[j]))
+                    return FE_ENONFINITE;
+        if (a->have_prev && k < a->blocks)
+            for (size_t i = 0; i < dim; i++)
+                for (size_t j = i; j < dim; j++) {
+                    const double *p = a->last;
+                    double add = j == i ? z[i] * p[i] : z[i] * p[j] + p[i] * z[j];
+                    if (!isfinite(a->lag[i * dim + j] + add))
+                        return FE_ENONFINITE;
+                }
+    }
     /* Add z z^T to the block's upper triangle. */
     for (size_t i = 0; i < dim; i++) {
         double zi = z[i];
@@ -140,11 +175,17 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     size_t dim, total;
     if (a == NULL || b == NULL)
         return FE_EINVAL;
-    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
-        || b->row0 != a->row0 + a->n)
+    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows)
         return FE_EMISMATCH;
-    if (b->n == 0)
+    if (b->n == 0) {            /* the identity, carrying b's break if any */
+        if (!b->first_linked)
+            fe_discover_break(a);
         return FE_OK;
+    }
+    if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        a->row0 = b->row0;      /* an empty part adopts b's place */
+    else if (b->row0 != a->row0 + a->n)
+        return FE_EMISMATCH;
     dim = a->m + 1;
     total = (a->blocks + 1) * dim * dim;
     for (size_t i = 0; i < total; i++)
@@ -170,7 +211,8 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
 /* [[file:../literate/discover.org::Fold a panel of rows][Fold a panel of rows]] */
 /* Copy up to q rows into the panel Z (scratch rows 1..q; row 0 is kept for
    the row before the panel), checking every value; the count of rows
-   before the first that is not finite. */
+   before the first with a value that is not finite or above 1e100 in
+   magnitude. */
 static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ldphi,
                                 const double *r, size_t q)
 {
@@ -178,14 +220,14 @@ static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ld
     double *z = a->work + dim * dim + dim;
     for (size_t t = 0; t < q; t++) {
         const double *pt = phi + t * ldphi;
-        double *zt = z + t * dim, bad = 0.0;
+        double *zt = z + t * dim;
+        int ok = fabs(r[t]) <= 1e100;           /* false for NaN too */
         for (size_t i = 0; i < m; i++) {
             zt[i] = pt[i];
-            bad += pt[i] - pt[i];               /* NaN unless finite */
+            ok &= fabs(pt[i]) <= 1e100;
         }
         zt[m] = r[t];
-        bad += r[t] - r[t];
-        if (bad != 0.0)
+        if (!ok)
             return t;
     }
     return q;
@@ -254,27 +296,141 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
     if (done != NULL)
         *done = 0;
     if (a == NULL || (nrows > 0 && (phi == NULL || r == NULL))
-        || (nrows > 1 && ldphi < a->m))
+        || (nrows > 1 && ldphi < a->m)
+        || (nrows > 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN))
         return FE_EINVAL;
-    while (i < nrows && rc == FE_OK) {
+    while (i < nrows) {
         /* A panel: at most FE__DISCOVER_PANEL rows, all in one block. */
         uint64_t row = a->row0 + a->n;
-        size_t k = fe__discover_block(a, row), got;
+        size_t k = fe__discover_block(a, row), got = 0;
         size_t q = nrows - i < FE__DISCOVER_PANEL ? nrows - i : FE__DISCOVER_PANEL;
         if (k < a->blocks && fe__discover_cut(a, k + 1) - row < q)
             q = (size_t)(fe__discover_cut(a, k + 1) - row);
-        got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
-        if (got < q)
-            rc = FE_ENONFINITE;
-        if (got > 0)
+        if (!(a->have_prev && fe__discover_large(a->last, a->m + 1)))
+            got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
+        if (got > 0) {
             fe__discover_panel(a, k, got);
-        i += got;
+            i += got;
+            continue;
+        }
+        /* A row that is not finite, has a value above 1e100, or follows
+           one: the row step decides, with its guard against overflow. */
+        rc = fe_discover_add(a, phi + i * ldphi, r[i]);
+        if (rc != FE_OK)
+            break;
+        i++;
     }
     if (done != NULL)
         *done = i;
     return rc;
 }
 /* Fold a panel of rows ends here */
+/* [[file:../literate/discover.org::Fold rows that carry their index][Fold rows that carry their index]] */
+int fe_discover_rebind(fe_discover_acc *a, double *storage)
+{
+    if (a == NULL || storage == NULL)
+        return FE_EINVAL;
+    if (a->m == 0 || a->m > FE_DISCOVER_MAX_COLUMNS || a->blocks < 2
+        || a->blocks > FE_DISCOVER_MAX_BLOCKS)
+        return FE_ESIZE;
+    fe__discover_layout(a, storage);
+    return FE_OK;
+}
+
+int fe_discover_reset(fe_discover_acc *a)
+{
+    if (a == NULL || a->gram == NULL)
+        return FE_EINVAL;
+    memset(a->gram, 0, fe_discover_acc_doubles(a->m, a->blocks) * sizeof *a->gram);
+    a->row0 = FE_DISCOVER_ROW_UNKNOWN;
+    a->n = 0;
+    a->have_prev = 0;
+    a->first_linked = 1;
+    return FE_OK;
+}
+
+int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row)
+{
+    uint64_t row0;
+    int have_prev, first_linked, rc;
+    if (a == NULL || row == NULL || row->index == FE_DISCOVER_ROW_UNKNOWN)
+        return FE_EINVAL;
+    row0 = a->row0;
+    have_prev = a->have_prev;
+    first_linked = a->first_linked;
+    if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
+        a->row0 = row->index;
+    else if (row->index != a->row0 + a->n)
+        return FE_EINVAL;
+    if (row->starts_recording)
+        fe_discover_break(a);
+    rc = fe_discover_add(a, row->phi, row->r);
+    if (rc != FE_OK) {          /* undo the place and the break */
+        a->row0 = row0;
+        a->have_prev = have_prev;
+        a->first_linked = first_linked;
+    }
+    return rc;
+}
+
+int fe_discover_copy(fe_discover_acc *dst, const fe_discover_acc *src)
+{
+    double *storage;
+    if (dst == NULL || src == NULL || dst->gram == NULL || src->gram == NULL)
+        return FE_EINVAL;
+    if (dst->m != src->m || dst->blocks != src->blocks
+        || dst->fit_rows != src->fit_rows)
+        return FE_EMISMATCH;
+    if (dst == src)
+        return FE_OK;
+    storage = dst->gram;
+    memcpy(storage, src->gram,
+           fe_discover_acc_doubles(src->m, src->blocks) * sizeof *storage);
+    *dst = *src;
+    fe__discover_layout(dst, storage);
+    return FE_OK;
+}
+
+static int fe__discover_init_fn(void *acc, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_reset(acc);
+}
+
+static int fe__discover_step_fn(void *acc, const void *obs, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_add_row(acc, obs);
+}
+
+static int fe__discover_merge_fn(void *acc, const void *other, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_merge(acc, other);
+}
+
+static int fe__discover_copy_fn(void *dst, const void *src, void *ctx)
+{
+    (void)ctx;
+    return fe_discover_copy(dst, src);
+}
+
+fe_accumulator fe_discover_accumulator(void)
+{
+    fe_accumulator f = {
+        .name = "discover",
+        .acc_size = sizeof(fe_discover_acc),
+        .obs_size = sizeof(fe_discover_row),
+        .init = fe__discover_init_fn,
+        .step = fe__discover_step_fn,
+        .step_many = NULL,
+        .merge = fe__discover_merge_fn,
+        .copy = fe__discover_copy_fn,
+        .ctx = NULL,
+    };
+    return f;
+}
+/* Fold rows that carry their index ends here */
 /* [[file:../literate/discover.org::Workspace layout][Workspace layout]] */
 typedef struct fe__ws {
     double *g;          /* M x M total Gram of fitted rows, full */
@@ -371,7 +527,7 @@ static void fe__solve(const fe__model *mo, double *x, size_t nrhs)
         return;
     for (size_t i = 0; i < mo->n; i++)
         for (size_t r = 0; r < nrhs; r++)
-            x[i * nrhs + r] *= mo->scale[i];
+            x[i * nrhs + r] *= mo->scale[i]; /* NOLINT(clang-analyzer-core.uninitialized.Assign): callers fill x[0 .. n*nrhs) */
     LAPACKE_dpotrs(LAPACK_ROW_MAJOR, 'U', (lapack_int)mo->n, (lapack_int)nrhs,
                    mo->chol, (lapack_int)mo->n, x, (lapack_int)nrhs);
     for (size_t i = 0; i < mo->n; i++)

@@ -83,6 +83,14 @@ static inline int fe__finite(const double *v, size_t len)
     return s0 + s1 == 0.0;
 }
 
+/* The report's scalars are results too: an innovation covariance that
+   overflows (A = 1e200) can leave x and P finite, since the gain goes to
+   zero, while log det D is infinite.  Such a step is refused. */
+static inline int fe__report_finite(const fe_kalman_report *r)
+{
+    return r == NULL || (isfinite(r->nis) && isfinite(r->log_det_D));
+}
+
 static void fe__symmetrise(double *M, size_t n)
 {
     for (size_t i = 0; i < n; i++)
@@ -442,7 +450,8 @@ static int fe__kalman_rows_any(size_t n, double *x, double *P, double *g,
         memcpy(xo, x, sizeof xo);                                            \
         memcpy(Po, P, sizeof Po);                                            \
         rc = fe__kalman_rows(N, x, P, x, P, g, p, r);                        \
-        if (rc == FE_OK && (!fe__finite(x, N) || !fe__finite(P, N * N)))     \
+        if (rc == FE_OK && (!fe__finite(x, N) || !fe__finite(P, N * N)     \
+                            || !fe__report_finite(r)))                       \
             rc = FE_ENONFINITE;                                              \
         if (rc != FE_OK) {                                                   \
             memcpy(x, xo, sizeof xo);                                        \
@@ -548,7 +557,8 @@ static int fe__kalman_step(fe_kalman *k, const fe_kalman_model *m,
     if (o != NULL)
         rc = fast ? fe__kalman_seq_update(n, o, w.x, w.P, &w, r)
                   : fe__kalman_solve_update(n, o, w.x, w.P, &w, r);
-    if (rc == FE_OK && (!fe__finite(w.x, n) || !fe__finite(w.P, n * n)))
+    if (rc == FE_OK && (!fe__finite(w.x, n) || !fe__finite(w.P, n * n)
+                        || (o != NULL && !fe__report_finite(r))))
         rc = FE_ENONFINITE;
     if (rc != FE_OK)
         return rc;

@@ -60,7 +60,8 @@ static int fe__lm_emit_dense(fe_lm_sink *s, double f, double w,
                 }
         return fe_lsq_add_sparse(s->dense, idx, val, nnz, -f, w);
     }
-    memcpy(s->row, jg, p->ng * sizeof *jg);
+    if (p->ng > 0)              /* memcpy from NULL is undefined even for 0 bytes */
+        memcpy(s->row, jg, p->ng * sizeof *jg);
     if (block != FE_SCHUR_NONE)
         memcpy(s->row + base, jl, p->nl * sizeof *jl);
     rc = fe_lsq_add(s->dense, s->row, -f, w);
@@ -219,7 +220,7 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
     fe_lm_sink s;
     fe_lsq dense;
     fe_schur schur;
-    double *solve_work, *xt, *h, cost, lambda, nu = 2.0;
+    double *solve_work, *xt, *h, cost = 0.0, lambda, nu = 2.0;
     size_t p, k;
     int rc, it;
 

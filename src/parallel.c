@@ -43,7 +43,7 @@ static void fe__job_run(struct fe__job *j)
 {
     j->done = 0;
     j->ready = 0;
-    j->rc = j->needs_init ? fe_init(j->f, j->acc) : FE_OK;
+    j->rc = j->needs_init ? fe_init(j->f, j->acc) : FE_OK; /* NOLINT(clang-analyzer-core.uninitialized.Branch): every job is filled before it runs */
     if (j->rc != FE_OK)
         return;
     j->ready = 1;

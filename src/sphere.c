@@ -1,5 +1,6 @@
 /* Tangled from literate/sphere.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/sphere.org::Sphere Fit Includes][Sphere Fit Includes]] */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -243,7 +244,7 @@ static int fe__sphere_build_stored(const fe__sphere_problem *pr,
                                    const double *beta, double *cost,
                                    double *H, double *g)
 {
-    double d[3], a[6], P[9 * FE__P], J[FE__P], s = 0.0;
+    double d[3], a[6], P[9 * FE__P], J[FE__P] = {0}, s = 0.0;
     int p = pr->p;
 
     fe__sphere_unpack(pr->model, beta, d, a, P);
@@ -308,6 +309,21 @@ static int fe__sphere_posv(int n, int nrhs, double *A, double *b)
 }
 /* Solve a symmetric positive definite system ends here */
 /* [[file:../literate/sphere.org::Iterate Gauss-Newton with Levenberg-Marquardt damping][Iterate Gauss-Newton with Levenberg-Marquardt damping]] */
+/* The decrease of S the linear model predicts for `step`:
+   -2 g.step - step' H step (H: upper triangle used). */
+static double fe__sphere_predicted(int p, const double *g, const double *H,
+                                   const double *step)
+{
+    double gs = 0.0, hs = 0.0;
+    for (int k = 0; k < p; k++) {
+        gs += g[k] * step[k];
+        hs += H[k * p + k] * step[k] * step[k];
+        for (int l = k + 1; l < p; l++)
+            hs += 2.0 * H[k * p + l] * step[k] * step[l];
+    }
+    return -2.0 * gs - hs;
+}
+
 static int fe__sphere_iterate(const fe__sphere_problem *pr,
                               const fe_sphere_options *opt, double *beta,
                               double *cost, double *H, int *iterations,
@@ -346,7 +362,10 @@ static int fe__sphere_iterate(const fe__sphere_problem *pr,
         if (rc != FE_OK)
             return rc;
         accepted = isfinite(St) && St <= *cost * (1.0 + 1e-10);
-        converged = lambda == 0.0 && smax <= opt->xtol * (1.0 + bmax);
+        converged = lambda <= 1e-2
+                    && (smax <= opt->xtol * (1.0 + bmax)
+                        || fe__sphere_predicted(p, g, H, step)
+                           <= 16.0 * DBL_EPSILON * fmax((double)pr->n, 1.0));
         if (accepted) {
             memcpy(beta, trial, (size_t)p * sizeof *beta);
             memcpy(H, Ht, (size_t)(p * p) * sizeof *H);
@@ -436,6 +455,13 @@ static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
     fit->frame_scale = pr->sigma;
     if (!(h[0] > 0.0 && h[1] > 0.0 && h[2] > 0.0)) {
         fit->refusal = FE_SPHERE_PLANAR;
+        return FE_EUNDETERMINED;
+    }
+    /* The frame divides moments of degree 4 by sigma^4: a spread so small
+       (below about 1e-77) that sigma^4 is not a normal double cannot be
+       represented there. */
+    if (!(pow(pr->sigma, 4) >= DBL_MIN)) {
+        fit->refusal = FE_SPHERE_DEGENERATE;
         return FE_EUNDETERMINED;
     }
     moved = *q;
@@ -579,6 +605,99 @@ static int fe__sphere_finish(const fe__sphere_problem *pr, const fe_quadric *q,
     return FE_OK;
 }
 /* Express the fit in the sensor's units ends here */
+/* [[file:../literate/sphere.org::Fit the algebraic sphere][Fit the algebraic sphere]] */
+static int fe__sphere_algebraic(const fe__sphere_problem *pr,
+                                const fe_quadric *q,
+                                const fe_sphere_options *opt,
+                                fe_sphere_fit *fit)
+{
+    static const int sq[3] = {4, 7, 9};
+    double N[16], Ni[16], gam[4], h[4], tt = 0.0, rss, s2, d[3], ss;
+    double beta[FE__P], H[FE__P * FE__P], g[FE__P], cost, D[2][4];
+    double sigma = pr->sigma, n = q->m[0];
+    fe_sphere_options loose = *opt;     /* extents checked below */
+    int rc;
+
+    loose.min_extent = 0.0;
+    for (int k = 0; k < 4; k++) {
+        h[k] = 0.0;
+        for (int l = 0; l < 4; l++)
+            N[k * 4 + l] = pr->phi[k * 10 + l];
+        for (int c = 0; c < 3; c++)
+            h[k] += pr->phi[k * 10 + sq[c]];
+        gam[k] = h[k];
+    }
+    for (int c = 0; c < 3; c++)
+        for (int e = 0; e < 3; e++)
+            tt += pr->phi[sq[c] * 10 + sq[e]];
+    memcpy(Ni, N, sizeof Ni);
+    rc = fe__sphere_posv(4, 1, Ni, gam);
+    if (rc != FE_OK) {
+        fit->refusal = rc == FE_ENOTPD ? FE_SPHERE_SINGULAR : fit->refusal;
+        return rc;
+    }
+    for (int j = 0; j < 3; j++)
+        d[j] = 0.5 * gam[1 + j];
+    ss = gam[0] + d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if (!(ss > 0.0)) {
+        fit->refusal = FE_SPHERE_DEGENERATE;
+        return FE_ENOTPD;
+    }
+    memset(beta, 0, sizeof beta);
+    memcpy(beta, d, sizeof d);
+    beta[3] = sqrt(ss);
+    rc = pr->build(pr, beta, &cost, H, g);
+    if (rc != FE_OK)
+        return rc;
+    fit->refusal = FE_SPHERE_ACCEPTED;
+    fit->algebraic = 1;
+    rc = fe__sphere_finish(pr, q, &loose, beta, cost, H, fit);
+    if (rc != FE_OK)
+        return rc;
+    /* One-sided data: along some axis the samples do not reach both sides
+       of the centre by min_extent of the box's half-width. */
+    for (int j = 0; j < 3; j++) {
+        double hb = 0.5 * (q->hi[j] - q->lo[j]);
+        if (fmin(q->hi[j] - fit->offset[j], fit->offset[j] - q->lo[j])
+            < opt->min_extent * hb) {
+            fit->refusal = FE_SPHERE_HEMISPHERE;
+            rc = FE_EUNDETERMINED;
+        }
+    }
+    /* The linear estimator's covariance, carried to (b, s) in the sensor's
+       units: b_j = c_j + sigma gam_j / 2, s = sigma sqrt(gam_0 + |d|^2). */
+    rss = fmax(tt - (gam[0] * h[0] + gam[1] * h[1] + gam[2] * h[2] + gam[3] * h[3]), 0.0);
+    s2 = rss / (n - 4.0);
+    memcpy(Ni, N, sizeof Ni);
+    {
+        double inv[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        int rc2 = fe__sphere_posv(4, 4, Ni, inv);
+        if (rc2 != FE_OK)
+            return rc2;
+        for (int k = 0; k < 4; k++)
+            for (int l = 0; l < 4; l++)
+                Ni[k * 4 + l] = s2 * inv[k * 4 + l];
+    }
+    memset(fit->cov, 0, sizeof fit->cov);
+    for (int a = 0; a < 4; a++)         /* D[0], D[1]: derivatives of */
+        for (int b = 0; b < 4; b++) {   /* parameters a, b by gam */
+            double ca = 0.0;
+            for (int k = 0; k < 4; k++) {
+                D[0][k] = a < 3 ? (k == a + 1 ? 0.5 * sigma : 0.0)
+                                : sigma * (k == 0 ? 0.5 : 0.5 * d[k - 1]) / beta[3];
+                D[1][k] = b < 3 ? (k == b + 1 ? 0.5 * sigma : 0.0)
+                                : sigma * (k == 0 ? 0.5 : 0.5 * d[k - 1]) / beta[3];
+            }
+            for (int k = 0; k < 4; k++)
+                for (int l = 0; l < 4; l++)
+                    ca += D[0][k] * Ni[k * 4 + l] * D[1][l];
+            fit->cov[a * 4 + b] = ca;
+        }
+    for (int a = 0; a < 4; a++)
+        fit->se[a] = sqrt(fit->cov[a * 4 + a]);
+    return rc;
+}
+/* Fit the algebraic sphere ends here */
 /* [[file:../literate/sphere.org::Fit from moments or from stored samples][Fit from moments or from stored samples]] */
 static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
                           const fe_sphere_options *opt, fe__sphere_problem *pr,
@@ -619,17 +738,20 @@ static int fe__sphere_run(const fe_quadric *q, fe_sphere_model model,
     if (rc != FE_OK)
         return rc;
     if (stored) {               /* keep the samples, take the frame */
-        memcpy(setup.phi, pr->phi, sizeof setup.phi);
         setup.xyz = pr->xyz;
         setup.n = pr->n;
         setup.work = pr->work;
         setup.build = pr->build;
     } else {
+        setup.n = (size_t)fe_quadric_count(q);  /* for the convergence test only */
         setup.build = fe__sphere_build_moments;
     }
     *pr = setup;
     rc = fe__sphere_iterate(pr, opt, beta, &cost, H, &fit->iterations,
                             &fit->refusal);
+    if (rc == FE_EUNDETERMINED && model == FE_FIT_SPHERE
+        && fit->refusal == FE_SPHERE_UNBOUNDED)
+        return fe__sphere_algebraic(pr, q, opt, fit);
     if (rc == FE_ENOCONV || rc == FE_EUNDETERMINED || rc == FE_ENOTPD)
         return fe__sphere_diagnose(q, model, opt, fit, rc);
     if (rc != FE_OK)

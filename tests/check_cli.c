@@ -92,6 +92,95 @@ START_TEST(binary_and_long_lines)
 }
 END_TEST
 
+/* The dispatcher, each command's --help, and argument errors: the status
+   and a message that names the problem. */
+struct usage_case {
+    const char *args;
+    int status;
+    const char *expect;
+};
+
+static const struct usage_case usage_cases[] = {
+    {"", 2, "usage: foldest COMMAND"},
+    {"help", 0, "commands:"},
+    {"--help", 0, "'foldest COMMAND --help' documents each command."},
+    {"--version", 0, "foldest 0."},
+    {"frobnicate", 2, "unknown command 'frobnicate'"},
+    {"stats --help", 0, "usage: foldest stats"},
+    {"stats", 2, "usage: foldest stats"},
+    {"stats a.csv b.csv", 2, "one input file, please"},
+    {"stats --skip x a.csv", 2, "--skip: 'x' is not a whole number"},
+    {"stats --skip -3 a.csv", 2, "--skip: negative"},
+    {"stats /nonexistent/a.csv", 4, "/nonexistent/a.csv: cannot open"},
+    {"calibrate --help", 0, "usage: foldest calibrate"},
+    {"calibrate", 2, "usage: foldest calibrate"},
+    {"calibrate --model cube a.csv", 2, "--model: 'cube' is not sphere, axial or ellipsoid"},
+    {"calibrate --skip x a.csv", 2, "--skip: 'x' is not a whole number"},
+    {"calibrate --skip -1 a.csv", 2, "--skip: negative"},
+    {"calibrate --bogus a.csv", 2, "unknown option or missing value '--bogus'"},
+    {"calibrate a.csv b.csv", 2, "one input file, please"},
+    {"calibrate --apply out.csv -", 2, "--apply reads the input twice"},
+    {"calibrate /nonexistent/a.csv", 4, "cannot open"},
+    {"discover --help", 0, "usage: foldest discover"},
+    {"discover --sphere", 2, "--sphere needs a value"},
+    {"discover --sphere a.csv --role t=velocity", 2, "--role with --sphere: COLUMN=temperature"},
+    {"discover --sphere a.csv --holdout 0.95", 2, "--holdout: 0.95 is not in [0, 0.9)"},
+    {"discover --sphere a.csv --blocks 2", 2, "--blocks: 2 is not in [4, 64]"},
+    {"discover --sphere a.csv --alpha x", 2, "--alpha: 'x' is not a number"},
+    {"discover --sphere a.csv --wobble 1", 2, "unknown option '--wobble' with --sphere"},
+    {"discover --sphere /nonexistent/a.csv", 4, "cannot open"},
+    {"synth --help", 0, "usage: foldest synth"},
+    {"synth --effect quadratic_drag --seed x --real r --sim s", 2, "--seed"},
+};
+
+START_TEST(usage_and_help)
+{
+    const struct usage_case *c = &usage_cases[_i];
+    char cmd[512], out[8192];
+    FILE *p;
+    size_t got;
+    int status;
+    snprintf(cmd, sizeof cmd, "cd /tmp && %s %s 2>&1 < /dev/null", FE_TEST_CLI, c->args);
+    p = popen(cmd, "r");
+    ck_assert_ptr_nonnull(p);
+    got = fread(out, 1, sizeof out - 1, p);
+    out[got] = '\0';
+    status = pclose(p);
+    status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    ck_assert_msg(status == c->status, "foldest %s: status %d, want %d:\n%s", c->args, status,
+                  c->status, out);
+    ck_assert_msg(strstr(out, c->expect) != NULL, "foldest %s: output lacks \"%s\":\n%s", c->args,
+                  c->expect, out);
+}
+END_TEST
+
+/* discover --sphere's text report, with a time column and a temperature. */
+START_TEST(discover_sphere_in_words)
+{
+    static char content[1 << 17], out[4096];
+    char path[64];
+    size_t n = 0;
+    fe_rng g = fe_rng_seed(4);
+    int status;
+    n += (size_t)snprintf(content + n, sizeof content - n, "time,mx,my,mz,temp\n");
+    for (int i = 0; i < 2000; i++) {
+        double v[3];
+        fe_rng_unit_vector(&g, v);
+        n += (size_t)snprintf(content + n, sizeof content - n, "%.2f,%.4f,%.4f,%.4f,%.2f\n",
+                              0.02 * i, 30 + 410 * v[0] + fe_rng_normal(&g),
+                              -20 + 380 * v[1] + fe_rng_normal(&g), 10 + 400 * v[2] + fe_rng_normal(&g),
+                              25 + 0.001 * i);
+    }
+    status = run_on("discover --columns mx,my,mz --time time --role temp=temperature --blocks 8 "
+                    "--holdout 0.2 --alpha 0.01 --sphere", content, n, out, sizeof out, path,
+                    sizeof path);
+    ck_assert_msg(status == 0, "status %d:\n%s", status, out);
+    ck_assert_msg(strstr(out, "the sphere: centre (") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "baseline (sphere: radius and centre): radial RMS") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "axis_gain") != NULL, "%s", out);
+}
+END_TEST
+
 Suite *fe_cli_suite(void)
 {
     Suite *s = suite_create("cli");
@@ -99,6 +188,8 @@ Suite *fe_cli_suite(void)
     tcase_set_timeout(t, 60);
     tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
     tcase_add_test(t, binary_and_long_lines);
+    tcase_add_loop_test(t, usage_and_help, 0, (int)(sizeof usage_cases / sizeof usage_cases[0]));
+    tcase_add_test(t, discover_sphere_in_words);
     suite_add_tcase(s, t);
     return s;
 }

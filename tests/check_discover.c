@@ -345,6 +345,32 @@ START_TEST(panels_stop_at_the_first_refused_row)
     pr[7] = keep;
     ck_assert_uint_eq(done, 7);
     ck_assert_uint_eq(panels.n, 157);
+    /* A finite row whose square overflows is refused like a NaN; one of
+       1e150 (squares 1e300) goes through the guarded row step and the
+       panel resumes after it, as row by row. */
+    for (size_t i = 0; i < 7; i++)      /* what the second call folded */
+        ck_assert_int_eq(fe_discover_add(&rows, pphi[i], pr[i]), FE_OK);
+    keep = pphi[170][0];
+    pphi[170][0] = 1e200;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[157], PM, pr + 157, 100, &done),
+                     FE_ENONFINITE);
+    ck_assert_uint_eq(done, 13);
+    pphi[170][0] = 1e150;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[170], PM, pr + 170, 100, &done), FE_OK);
+    ck_assert_uint_eq(done, 100);
+    pphi[170][0] = keep;
+    for (size_t i = 157; i < 270; i++) {
+        double save = pphi[i][0];
+        if (i == 170)
+            pphi[i][0] = 1e150;
+        ck_assert_int_eq(fe_discover_add(&rows, pphi[i], pr[i]), FE_OK);
+        pphi[i][0] = save;
+    }
+    assert_same_sums(&panels, &rows);
+    /* A part that does not know its place folds nothing. */
+    panels.row0 = FE_DISCOVER_ROW_UNKNOWN;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM, pr, 3, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
     free(s1);
     free(s2);
 }

@@ -120,15 +120,69 @@ static double hash_distance(const void *a, const void *b)
     return memcmp(a, b, sizeof(hash_acc)) == 0 ? 0.0 : INFINITY;
 }
 
+/* Calibration moments: samples on an ellipsoid far from the origin.  The
+   reference of both folds is the stream's first sample (chunk 0 folds into
+   the caller's accumulation), or the supplied centre; partials start from
+   their own first samples and are moved to it by the merge.  The extremes
+   and the count must agree exactly.  A moment sum of u^alpha may cancel
+   (sum u1 u2 is near zero for a sphere), so its difference is measured
+   against N s^d, where s bounds every |u_j| (the box seen from the
+   reference) and d is the degree: no sum of N terms of degree d can have
+   terms of larger total magnitude, and rounding is relative to that.  The
+   coverage estimate (regions dated by the box size at the visit) is not
+   compared: each chunk dates its visits by its own box. */
+static const double quadric_centre[3] = {100.0, -200.0, 300.0};
+
+static fe_accumulator quadric_first_sample(void)
+{
+    return fe_quadric_accumulator(NULL);
+}
+
+static fe_accumulator quadric_fixed_centre(void)
+{
+    return fe_quadric_accumulator(quadric_centre);
+}
+
+static void quadric_generate(void *obs, fe_rng *r)
+{
+    static const double semi[3] = {40.0, 45.0, 52.0};
+    double u[3], *x = obs;
+    fe_rng_unit_vector(r, u);
+    for (int j = 0; j < 3; j++)
+        x[j] = quadric_centre[j] + 3.0 + semi[j] * u[j] + 0.5 * fe_rng_normal(r);
+}
+
+static double quadric_distance(const void *a, const void *b)
+{
+    const fe_quadric *p = a, *q = b;
+    double s = 0.0, worst = 0.0;
+    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0
+        || memcmp(p->lo, q->lo, sizeof p->lo) != 0
+        || memcmp(p->hi, q->hi, sizeof p->hi) != 0 || p->flags != q->flags)
+        return INFINITY;
+    if (q->m[0] == 0.0)
+        return 0.0;
+    for (int j = 0; j < 3; j++)
+        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
+    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
+        int e[3];
+        fe_quadric_exponents(k, e);
+        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
+    }
+    return worst;
+}
+
 static const pcase cases[] = {
     {"meanvar", fe_meanvar_accumulator, meanvar_generate, meanvar_distance},
     {"hash (exact, non-commutative)", hash_accumulator, hash_generate, hash_distance},
+    {"quadric (first sample)", quadric_first_sample, quadric_generate, quadric_distance},
+    {"quadric (fixed centre)", quadric_fixed_centre, quadric_generate, quadric_distance},
     /* Add a row here for each new mergeable accumulator. */
 };
 enum { NCASES = sizeof cases / sizeof cases[0] };
 
 /* Storage for one accumulation of any flat accumulator under test. */
-typedef union { max_align_t align; unsigned char bytes[512]; } slot;
+typedef union { max_align_t align; unsigned char bytes[1024]; } slot;
 
 /* Fill n observations of case c. */
 static unsigned char *generate(const pcase *c, const fe_accumulator *f,
@@ -192,6 +246,362 @@ START_TEST(flat_accumulators_equal_serial)
     ck_assert_msg(worst <= 1e-12, "relative difference %.3g at %s", worst, where);
     if (getenv("FE_TEST_VERBOSE"))
         fprintf(stderr, "parallel vs serial: worst relative difference %.3g at %s\n", worst, where);
+}
+END_TEST
+
+/* ------------------------------------------------------------------------
+   Accumulations that point into caller storage (normal equations, the
+   arrow-shaped normal equations, the information filter, discovery's block
+   Gram matrices): every partial is bound to storage of its own, as the
+   parallel folds require.  Their sums are of products of regressors with
+   nonzero means, so no entry cancels and each is compared relative to
+   itself. */
+typedef struct bcase {
+    const char *name;
+    fe_accumulator (*make)(void);
+    size_t doubles;             /* storage of one accumulation */
+    size_t arena;               /* doubles behind one observation */
+    /* Bind `acc` to `storage` for a stream of n observations, empty. */
+    int (*bind)(void *acc, double *storage, size_t n);
+    /* Observation i, its numbers in `mine` (arena doubles). */
+    void (*generate)(void *obs, size_t i, double *mine, fe_rng *r);
+    double (*distance)(const void *a, const void *b);
+} bcase;
+
+/* Largest relative difference of n doubles. */
+static double rel_array(const double *a, const double *b, size_t n)
+{
+    double worst = 0.0;
+    for (size_t i = 0; i < n; i++)
+        worst = fmax(worst, rel(a[i], b[i]));
+    return worst;
+}
+
+enum { LSQ_P = 6 };
+
+static int lsq_bind(void *acc, double *storage, size_t n)
+{
+    (void)n;
+    return fe_lsq_init(acc, LSQ_P, storage);
+}
+
+static void lsq_generate(void *obs, size_t i, double *mine, fe_rng *r)
+{
+    fe_lsq_row *row = obs;
+    double y = 0.5;
+    for (int k = 0; k < LSQ_P; k++) {
+        mine[k] = 1.0 + 0.5 * k + 0.3 * fe_rng_normal(r);
+        y += (k + 1) * mine[k];
+    }
+    row->j = mine;
+    row->r = y + 0.1 * fe_rng_normal(r);
+    row->w = 1.0 + 0.5 * (double)(i % 3);
+}
+
+static double lsq_distance(const void *a, const void *b)
+{
+    const fe_lsq *p = a, *q = b;
+    if (p->p != q->p || p->n != q->n)
+        return INFINITY;
+    return fmax(rel(p->wsum, q->wsum), rel_array(p->g, q->g, fe_lsq_storage(q->p)));
+}
+
+enum { SCHUR_NG = 3, SCHUR_NL = 2, SCHUR_NB = 5 };
+
+static int schur_bind(void *acc, double *storage, size_t n)
+{
+    (void)n;
+    return fe_schur_init(acc, SCHUR_NG, SCHUR_NL, SCHUR_NB, storage);
+}
+
+static void schur_generate(void *obs, size_t i, double *mine, fe_rng *r)
+{
+    fe_schur_row *row = obs;
+    double y = 1.0;
+    for (int k = 0; k < SCHUR_NG + SCHUR_NL; k++) {
+        mine[k] = 2.0 + 0.2 * k + 0.3 * fe_rng_normal(r);
+        y += mine[k];
+    }
+    row->jg = mine;
+    row->block = i % (SCHUR_NB + 1) == SCHUR_NB ? FE_SCHUR_NONE : i % (SCHUR_NB + 1);
+    row->jl = mine + SCHUR_NG;
+    row->r = y + 0.1 * fe_rng_normal(r);
+    row->w = 1.0;
+}
+
+static double schur_distance(const void *a, const void *b)
+{
+    const fe_schur *p = a, *q = b;
+    if (p->ng != q->ng || p->nl != q->nl || p->nb != q->nb)
+        return INFINITY;
+    return fmax(lsq_distance(&p->global, &q->global),
+                rel_array(p->blk, q->blk, q->nb * fe_schur_block_size(q->ng, q->nl)));
+}
+
+enum { INFO_N = 4, INFO_B = 2 };
+
+static int info_bind(void *acc, double *storage, size_t n)
+{
+    (void)n;
+    return fe_kalman_info_init(acc, INFO_N, INFO_B, storage,
+                               fe_kalman_info_doubles(INFO_N, INFO_B));
+}
+
+/* A packet of two correlated measurements of a 4-state. */
+static void info_generate(void *obs, size_t i, double *mine, fe_rng *r)
+{
+    fe_kalman_obs *o = obs;
+    double *A = mine, *z = A + INFO_B * INFO_N, *Z = z + INFO_B;
+    (void)i;
+    for (int m = 0; m < INFO_B; m++) {
+        z[m] = 0.3 * fe_rng_normal(r);
+        for (int k = 0; k < INFO_N; k++) {
+            A[m * INFO_N + k] = 1.0 + 0.25 * (k + m) + 0.2 * fe_rng_normal(r);
+            z[m] += (k + 1.0) * A[m * INFO_N + k];
+        }
+    }
+    Z[0] = 0.09;
+    Z[1] = Z[2] = 0.01;
+    Z[3] = 0.16;
+    o->b = INFO_B;
+    o->A = A;
+    o->z = z;
+    o->Z = Z;
+}
+
+static double info_distance(const void *a, const void *b)
+{
+    const fe_kalman_info *p = a, *q = b;
+    if (p->n != q->n || p->count != q->count)
+        return INFINITY;
+    return fmax(rel_array(p->eta, q->eta, q->n), rel_array(p->Lambda, q->Lambda, q->n * q->n));
+}
+
+enum { DISC_M = 5, DISC_K = 8 };
+
+/* Four fifths of the rows are fitted, the rest held out. */
+static int disc_bind(void *acc, double *storage, size_t n)
+{
+    uint64_t fit = n * 4 / 5 < 2 * DISC_K ? 2 * DISC_K : n * 4 / 5;
+    return fe_discover_acc_init(acc, DISC_M, DISC_K, fit, 0, storage,
+                                fe_discover_acc_doubles(DISC_M, DISC_K));
+}
+
+/* Rows of a smooth signal (so that the lag products do not cancel); a new
+   recording starts every 997 rows. */
+static void disc_generate(void *obs, size_t i, double *mine, fe_rng *r)
+{
+    fe_discover_row *row = obs;
+    double t = 1e-3 * (double)i;
+    for (int k = 0; k < DISC_M; k++)
+        mine[k] = 1.5 + sin(t * (k + 1)) + 0.1 * fe_rng_normal(r);
+    row->index = i;
+    row->phi = mine;
+    row->r = 2.0 + 0.5 * mine[0] + 0.1 * fe_rng_normal(r);
+    row->starts_recording = i % 997 == 500;
+}
+
+static double disc_distance(const void *a, const void *b)
+{
+    const fe_discover_acc *p = a, *q = b;
+    if (p->m != q->m || p->blocks != q->blocks || p->fit_rows != q->fit_rows
+        || p->n != q->n || (q->n > 0 && p->row0 != q->row0)
+        || p->have_prev != q->have_prev || p->first_linked != q->first_linked)
+        return INFINITY;
+    return rel_array(p->gram, q->gram, fe_discover_acc_doubles(q->m, q->blocks));
+}
+
+static fe_accumulator lsq_make(void) { return fe_lsq_accumulator(); }
+static fe_accumulator schur_make(void) { return fe_schur_accumulator(); }
+static fe_accumulator info_make(void) { return fe_kalman_info_accumulator(); }
+static fe_accumulator disc_make(void) { return fe_discover_accumulator(); }
+
+static const bcase bcases[] = {
+    {"lsq (normal equations)", lsq_make, (LSQ_P + 1) * (LSQ_P + 1), LSQ_P, lsq_bind,
+     lsq_generate, lsq_distance},
+    {"schur (arrow-shaped normal equations)", schur_make,
+     (SCHUR_NG + 1) * (SCHUR_NG + 1)
+         + SCHUR_NB * (SCHUR_NL * SCHUR_NL + SCHUR_NL + SCHUR_NL * SCHUR_NG),
+     SCHUR_NG + SCHUR_NL, schur_bind, schur_generate, schur_distance},
+    {"kalman information form", info_make, 0, INFO_B * INFO_N + INFO_B + INFO_B * INFO_B,
+     info_bind, info_generate, info_distance},
+    {"discover (block Gram matrices)", disc_make, 0, DISC_M, disc_bind, disc_generate,
+     disc_distance},
+    /* Add a row here for each new accumulator that points into storage. */
+};
+enum { NBCASES = sizeof bcases / sizeof bcases[0] };
+
+static size_t bcase_doubles(const bcase *c)
+{
+    if (c->doubles > 0)
+        return c->doubles;
+    if (c->bind == info_bind)
+        return fe_kalman_info_doubles(INFO_N, INFO_B);
+    return fe_discover_acc_doubles(DISC_M, DISC_K);
+}
+
+static const size_t bsizes[] = {0, 1, 2, 3, 7, 9, 64, 1000, 4099, 20011};
+
+START_TEST(bound_accumulators_equal_serial)
+{
+    /* As flat_accumulators_equal_serial, for every accumulator whose
+       accumulation points into storage: 1 to 8 threads, each partial bound
+       to its own storage; equal to the serial fold to 1e-12 relative,
+       bit-identical on a second run, and exactly fe_fold on one thread. */
+    double worst = 0.0;
+    int bad_rc = 0, not_all = 0, not_repeatable = 0, not_fe_fold = 0;
+    char where[256] = "";
+    for (int ci = 0; ci < NBCASES; ci++) {
+        const bcase *c = &bcases[ci];
+        fe_accumulator f = c->make();
+        size_t nd = bcase_doubles(c);
+        double *store = malloc((MAX_T + 3) * nd * sizeof *store);
+        ck_assert_ptr_nonnull(store);
+        for (size_t si = 0; si < sizeof bsizes / sizeof bsizes[0]; si++) {
+            size_t n = bsizes[si] == 20011 && fe_test_quick() ? 2003 : bsizes[si];
+            unsigned char *z = malloc(n * f.obs_size + 1);
+            double *arena = malloc((n * c->arena + 1) * sizeof *arena);
+            fe_rng r = fe_rng_seed(700 + si);
+            slot serial, par, again, parts[MAX_T];
+            void *pp[MAX_T];
+            ck_assert_uint_le(f.acc_size, sizeof(slot));
+            for (size_t i = 0; i < n; i++)
+                c->generate(z + i * f.obs_size, i, arena + i * c->arena, &r);
+            bad_rc |= c->bind(&serial, store, n);
+            bad_rc |= fe_fold(&f, &serial, z, n, NULL);
+            for (int t = 0; t < MAX_T; t++) {
+                bad_rc |= c->bind(&parts[t], store + (size_t)(t + 3) * nd, n);
+                pp[t] = &parts[t];
+            }
+            for (unsigned T = 1; T <= MAX_T; T++) {
+                double d;
+                size_t done = 0;
+                bad_rc |= c->bind(&par, store + nd, n);
+                bad_rc |= fe_parallel_fold(&f, &par, z, n, T, pp, &done);
+                not_all |= done != n;
+                d = c->distance(&par, &serial);
+                if (T == 1)
+                    not_fe_fold |= d != 0.0;
+                if (!(d <= worst)) {
+                    worst = d;
+                    snprintf(where, sizeof where, "%s, n = %zu, %u threads", c->name, n, T);
+                }
+                /* Again, into storage of its own: the same bits (the
+                   distance is 0 only for equal values). */
+                bad_rc |= c->bind(&again, store + 2 * nd, n);
+                bad_rc |= fe_parallel_fold(&f, &again, z, n, T, pp, NULL);
+                not_repeatable |= c->distance(&again, &par) != 0.0;
+            }
+            free(arena);
+            free(z);
+        }
+        free(store);
+    }
+    ck_assert_int_eq(bad_rc, FE_OK);
+    ck_assert_msg(!not_all, "a parallel fold did not fold every observation");
+    ck_assert_msg(!not_repeatable, "a parallel fold is not deterministic");
+    ck_assert_msg(!not_fe_fold, "one thread is not exactly fe_fold");
+    ck_assert_msg(worst <= 1e-12, "relative difference %.3g at %s", worst, where);
+    if (getenv("FE_TEST_VERBOSE"))
+        fprintf(stderr, "bound accumulators, parallel vs serial: worst relative difference %.3g at %s\n",
+                worst, where);
+}
+END_TEST
+
+START_TEST(discover_rows_out_of_order_are_refused)
+{
+    /* A part anchors at its first row's index; a row that is not the next
+       is refused and changes nothing, nor does a non-finite one after a
+       break. */
+    size_t nd = fe_discover_acc_doubles(DISC_M, DISC_K);
+    double *st = malloc(nd * sizeof *st), *copy = malloc(nd * sizeof *st);
+    double phi[DISC_M] = {1, 2, 3, 4, 5}, bad[DISC_M] = {1, 2, NAN, 4, 5};
+    fe_discover_acc a, before;
+    fe_discover_row row = {40, phi, 0.5, 0};
+    fe_accumulator f = fe_discover_accumulator();
+    ck_assert_int_eq(disc_bind(&a, st, 100), FE_OK);
+    ck_assert_int_eq(fe_init(&f, &a), FE_OK);
+    ck_assert(a.row0 == FE_DISCOVER_ROW_UNKNOWN);
+    ck_assert_int_eq(fe_discover_add(&a, phi, 0.5), FE_EINVAL);
+    ck_assert_int_eq(fe_step(&f, &a, &row), FE_OK);
+    ck_assert_uint_eq(a.row0, 40);
+    before = a;
+    memcpy(copy, st, nd * sizeof *st);
+    row.index = 42;
+    ck_assert_int_eq(fe_step(&f, &a, &row), FE_EINVAL);
+    row.index = 41;
+    row.phi = bad;
+    row.starts_recording = 1;
+    ck_assert_int_eq(fe_step(&f, &a, &row), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nd * sizeof *st);
+    row.phi = phi;
+    ck_assert_int_eq(fe_step(&f, &a, &row), FE_OK);
+    ck_assert_uint_eq(a.n, 2);
+    ck_assert_int_eq(a.first_linked, 1);    /* the break was after row 40 */
+    free(st);
+    free(copy);
+}
+END_TEST
+
+START_TEST(discover_empty_parts_copy_and_rebind)
+{
+    /* An empty part that carries a break, merged between two parts, cuts
+       the lag chain as the serial break does; a copy is deep; a struct and
+       storage copied as bytes and rebound read the same. */
+    enum { N = 60 };
+    size_t nd = fe_discover_acc_doubles(DISC_M, DISC_K);
+    double *s1 = malloc(nd * sizeof *s1), *s2 = malloc(nd * sizeof *s1),
+           *s3 = malloc(nd * sizeof *s1), *sw = malloc(nd * sizeof *s1),
+           *moved = malloc(nd * sizeof *s1);
+    double phi[N][DISC_M], r[N];
+    fe_discover_acc a, b, c, whole, copy;
+    fe_rng g = fe_rng_seed(5);
+    for (int i = 0; i < N; i++) {
+        for (int k = 0; k < DISC_M; k++)
+            phi[i][k] = 1.0 + fe_rng_normal(&g);
+        r[i] = fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(disc_bind(&whole, sw, N), FE_OK);
+    ck_assert_int_eq(disc_bind(&a, s1, N), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, DISC_M, DISC_K, whole.fit_rows, 30, s2, nd), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&c, DISC_M, DISC_K, whole.fit_rows, 30, s3, nd), FE_OK);
+    for (int i = 0; i < N; i++) {
+        if (i == 30)
+            fe_discover_break(&whole);
+        ck_assert_int_eq(fe_discover_add(&whole, phi[i], r[i]), FE_OK);
+        ck_assert_int_eq(fe_discover_add(i < 30 ? &a : &c, phi[i], r[i]), FE_OK);
+    }
+    fe_discover_break(&b);                      /* empty, but a break */
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &c), FE_OK);
+    ck_assert_uint_eq(a.n, N);
+    /* Linking rows 29 and 30 would add a lag product of relative size
+       about 1/30, far above rounding. */
+    ck_assert_double_le(rel_array(s1, sw, nd), 1e-12);
+    ck_assert_int_eq(disc_bind(&b, s2, N), FE_OK);
+    ck_assert_int_eq(fe_discover_copy(&b, &a), FE_OK);
+    ck_assert_ptr_eq(b.gram, s2);
+    ck_assert_mem_eq(s2, s1, nd * sizeof *s1);
+    s2[0] += 1.0;
+    ck_assert_double_ne(s1[0], s2[0]);
+    ck_assert_int_eq(disc_bind(&c, s3, 2 * N), FE_OK);
+    ck_assert_int_eq(fe_discover_copy(&c, &a), FE_EMISMATCH);   /* other fit_rows */
+    /* Bytes and rebind. */
+    memcpy(&copy, &a, sizeof copy);
+    memcpy(moved, s1, nd * sizeof *moved);
+    ck_assert_int_eq(fe_discover_rebind(&copy, moved), FE_OK);
+    ck_assert_ptr_eq(copy.gram, moved);
+    ck_assert(copy.lag - copy.gram == a.lag - a.gram && copy.first - copy.gram == a.first - a.gram
+              && copy.last - copy.gram == a.last - a.gram
+              && copy.counts - copy.gram == a.counts - a.gram);
+    copy.m = 0;
+    ck_assert_int_eq(fe_discover_rebind(&copy, moved), FE_ESIZE);
+    free(s1);
+    free(s2);
+    free(s3);
+    free(sw);
+    free(moved);
 }
 END_TEST
 
@@ -921,6 +1331,9 @@ Suite *fe_parallel_suite(void)
     TCase *t = tcase_create("core");
     tcase_set_timeout(t, 120);
     tcase_add_test(t, flat_accumulators_equal_serial);
+    tcase_add_test(t, bound_accumulators_equal_serial);
+    tcase_add_test(t, discover_rows_out_of_order_are_refused);
+    tcase_add_test(t, discover_empty_parts_copy_and_rebind);
     tcase_add_test(t, folds_onto_a_nonempty_accumulation);
     tcase_add_test(t, precision_at_large_offset);
     tcase_add_test(t, product_equals_serial);

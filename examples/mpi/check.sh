@@ -20,3 +20,17 @@ $MPIRUN "$B/mpi/meanvar_mpi" -n 1
 echo "-- a file, each rank reading its own slice"
 $MPIRUN "$B/mpi/meanvar_mpi" -write "$tmp/x.f64" 300007
 $MPIRUN "$B/mpi/meanvar_mpi" "$tmp/x.f64"
+echo "-- calibration: moments merged, the root fits the ellipsoid"
+$MPIRUN "$B/mpi/calibrate_mpi"
+echo "-- calibration: a NaN in the last rank's shard"
+$MPIRUN "$B/mpi/calibrate_mpi" -nan 150000
+echo "-- calibration: fewer samples than ranks (the fit refuses, as serially)"
+$MPIRUN "$B/mpi/calibrate_mpi" -n 1
+echo "-- least squares: normal equations travel with their storage, the root solves"
+$MPIRUN "$B/mpi/lsq_mpi"
+$MPIRUN "$B/mpi/lsq_mpi" -nan 300000
+echo "-- discovery: block Gram matrices merged in rank order, the root ranks and selects"
+$MPIRUN "$B/mpi/discover_mpi"
+$MPIRUN "$B/mpi/discover_mpi" -nan 150000
+echo "-- discovery: the second recording begins exactly at the cut between ranks"
+$MPIRUN "$B/mpi/discover_mpi" -n 100001

@@ -52,7 +52,8 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
 
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
-   value is not finite.  Cost about 1.5 M (M + 1) multiply-adds
+   value is not finite; FE_EINVAL when row0 is FE_DISCOVER_ROW_UNKNOWN (use
+   fe_discover_add_row).  Cost about 1.5 M (M + 1) multiply-adds
    (fe_discover_add_rows is the fast path for many rows). */
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
 
@@ -61,10 +62,13 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
    same accumulation as fe_discover_add row by row (up to rounding: sums
    are grouped differently), with two thirds of its arithmetic, M (M + 1)
    multiply-adds a row, all in level-3 BLAS: measured twice as fast at
-   M = 16, five times at M = 54, no faster for a handful of columns.  Stops at the first row with a value that is not finite
-   (FE_ENONFINITE): the rows before it are folded, the rest are not.
-   `*done` (if not NULL) receives how many rows were folded.  FE_EINVAL for
-   null pointers or ldphi < m when nrows > 1 (nothing folded). */
+   M = 16, five times at M = 54, no faster for a handful of columns.
+   Stops at the first row with a value that is not finite (FE_ENONFINITE):
+   the rows before it are folded, the rest are not.
+   Rows whose sums would overflow are refused the same way (FE_ENONFINITE),
+   as by fe_discover_add.  `*done` (if not NULL) receives how many rows
+   were folded.  FE_EINVAL for null pointers, ldphi < m when nrows > 1, or
+   row0 FE_DISCOVER_ROW_UNKNOWN (nothing folded). */
 int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
                          const double *r, size_t nrows, size_t *done);
 
@@ -73,10 +77,57 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
 void fe_discover_break(fe_discover_acc *a);
 
 /* fe_discover_merge: a <- a (+) b, where b holds the rows right after a's
-   (b->row0 == a->row0 + a->n).  FE_EMISMATCH otherwise or when the shapes
-   differ; a is then unchanged. */
+   (b->row0 == a->row0 + a->n).  An empty b is the identity (its break, if
+   any, is kept); an empty a whose row0 is FE_DISCOVER_ROW_UNKNOWN takes
+   b's.  FE_EMISMATCH otherwise or when the shapes differ; a is then
+   unchanged. */
 int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b);
 /* Discovery Accumulation Declarations ends here */
+/* [[file:../../literate/discover.org::Discovery Accumulator Declarations][Discovery Accumulator Declarations]] */
+/* The row0 of a part that does not know where it starts: it takes the
+   index of its first row (fe_discover_add_row) or of the part merged into
+   it.  fe_init and fe_discover_reset leave this. */
+#define FE_DISCOVER_ROW_UNKNOWN UINT64_MAX
+
+/* One row for the generic fold: its index in the whole stream, the m term
+   values, the residual, and whether it begins a new recording (then no
+   lag product is formed with the row before it). */
+typedef struct fe_discover_row {
+    uint64_t index;
+    const double *phi;
+    double r;
+    int starts_recording;
+} fe_discover_row;
+
+/* fe_discover_reset: make a bound accumulation empty again, keeping its
+   shape and storage; row0 <- FE_DISCOVER_ROW_UNKNOWN.  FE_EINVAL for NULL. */
+int fe_discover_reset(fe_discover_acc *a);
+
+/* fe_discover_add_row: fold one row that must be the part's next:
+   row->index == row0 + n, or, while the part is empty and row0 is
+   FE_DISCOVER_ROW_UNKNOWN, any index (row0 becomes it).  A row that
+   starts a recording is folded as fe_discover_break then fe_discover_add.
+   Errors: FE_EINVAL (NULL, a row out of order), FE_ENONFINITE; `a` is
+   then unchanged. */
+int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row);
+
+/* fe_discover_copy: dst's contents <- src's; dst is bound to its own
+   storage with the same m, blocks and fit_rows (FE_EMISMATCH otherwise). */
+int fe_discover_copy(fe_discover_acc *dst, const fe_discover_acc *src);
+
+/* fe_discover_rebind: point a's arrays into `storage` (at least
+   fe_discover_acc_doubles(a->m, a->blocks) doubles) laid out as
+   fe_discover_acc_init lays them out, without touching any value: for an
+   accumulation whose struct and storage were copied as bytes (a message,
+   a file).  FE_EINVAL for NULL, FE_ESIZE for a shape out of range. */
+int fe_discover_rebind(fe_discover_acc *a, double *storage);
+
+/* fe_discover_accumulator: the accumulator for fe_fold and the parallel
+   folds, over fe_discover_row observations and fe_discover_acc
+   accumulations (bound first by fe_discover_acc_init; fe_init resets with
+   row0 unknown).  Merges consecutive parts; copies deeply. */
+fe_accumulator fe_discover_accumulator(void);
+/* Discovery Accumulator Declarations ends here */
 /* [[file:../../literate/discover.org::Discovery Selection Declarations][Discovery Selection Declarations]] */
 /* A candidate term: a name and the columns it occupies. */
 typedef struct fe_discover_group {

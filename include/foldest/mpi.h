@@ -135,6 +135,101 @@ static inline void fe_mpi_reduction_free(fe_mpi_reduction *r)
     }                                                                        \
     typedef int name##_defined_ /* swallow the caller's semicolon */
 /* Define a reduction for one accumulation type ends here */
+/* [[file:../../literate/mpi.org::Define a reduction for accumulations bound to storage][Define a reduction for accumulations bound to storage]] */
+#define FE_MPI_DEFINE_BOUND_REDUCTION(name, type, accumulator, capacity,     \
+                                      rebind)                                \
+    typedef struct name##_cell {                                             \
+        type acc;           /* points into storage[] once rebound */         \
+        double storage[capacity];                                            \
+        uint64_t done;      /* observations folded into acc */               \
+        int status;         /* FE_OK, or the first refusal's code */         \
+        int rank;           /* rank of that refusal; -1 when none */         \
+        int first;          /* first rank this cell covers */                \
+    } name##_cell;                                                           \
+                                                                             \
+    static inline int name##_cell_rebind(name##_cell *c)                     \
+    {                                                                        \
+        return rebind(&c->acc, c->storage);                                  \
+    }                                                                        \
+                                                                             \
+    static void name##_op(void *in, void *inout, int *len,                   \
+                          MPI_Datatype *datatype)                            \
+    {                                                                        \
+        const fe_accumulator fe_f_ = (accumulator);                          \
+        unsigned char *fe_in_ = in, *fe_io_ = inout;                         \
+        (void)datatype;                                                      \
+        for (int fe_i_ = 0; fe_i_ < *len; fe_i_++) {                         \
+            name##_cell fe_l_, fe_r_;                                        \
+            int fe_rc_;                                                      \
+            memcpy(&fe_l_, fe_in_ + (size_t)fe_i_ * sizeof fe_l_,            \
+                   sizeof fe_l_);                                            \
+            memcpy(&fe_r_, fe_io_ + (size_t)fe_i_ * sizeof fe_r_,            \
+                   sizeof fe_r_);                                            \
+            if (fe_l_.status == FE_OK) {                                     \
+                fe_rc_ = name##_cell_rebind(&fe_l_);                         \
+                if (fe_rc_ == FE_OK)                                         \
+                    fe_rc_ = name##_cell_rebind(&fe_r_);                     \
+                if (fe_rc_ == FE_OK)                                         \
+                    fe__mpi_combine(&fe_f_, &fe_l_.acc, &fe_l_.done,         \
+                                    &fe_l_.status, &fe_l_.rank, &fe_r_.acc,  \
+                                    fe_r_.done, fe_r_.status, fe_r_.rank,    \
+                                    fe_r_.first);                            \
+                else if (fe_r_.status != FE_OK) {                            \
+                    fe_l_.status = fe_r_.status;  /* never bound: its */     \
+                    fe_l_.rank = fe_r_.rank;      /* own refusal */          \
+                } else {                                                     \
+                    fe_l_.status = fe_rc_;        /* cannot be read */       \
+                    fe_l_.rank = fe_r_.first;                                \
+                }                                                            \
+            }                                                                \
+            memcpy(fe_io_ + (size_t)fe_i_ * sizeof fe_l_, &fe_l_,            \
+                   sizeof fe_l_);                                            \
+        }                                                                    \
+    }                                                                        \
+                                                                             \
+    static inline int name##_reduction(fe_mpi_reduction *r)                  \
+    {                                                                        \
+        const fe_accumulator fe_f_ = (accumulator);                          \
+        if (fe_f_.acc_size != sizeof(type) || fe_f_.merge == NULL)           \
+            return FE_ENOTSUP;                                               \
+        return fe_mpi_reduction_create(r, sizeof(name##_cell), name##_op);   \
+    }                                                                        \
+                                                                             \
+    static inline void name##_cell_init(name##_cell *c, int rank)            \
+    {                                                                        \
+        memset(c, 0, sizeof *c);                                             \
+        c->rank = -1;                                                        \
+        c->first = rank;                                                     \
+        c->status = FE_OK;                                                   \
+    }                                                                        \
+                                                                             \
+    static inline void name##_cell_record(name##_cell *c, int rc,            \
+                                          size_t done)                       \
+    {                                                                        \
+        if (c->status != FE_OK)                                              \
+            return;                                                          \
+        c->done = (uint64_t)done;                                            \
+        c->status = rc;                                                      \
+        c->rank = rc != FE_OK ? c->first : -1;                               \
+    }                                                                        \
+    typedef int name##_defined_ /* swallow the caller's semicolon */
+/* Define a reduction for accumulations bound to storage ends here */
+/* [[file:../../literate/mpi.org::Rebind the accumulations that travel in cells][Rebind the accumulations that travel in cells]] */
+/* fe_mpi_rebind_lsq: a->g <- storage (the whole layout of fe_lsq_init). */
+static inline int fe_mpi_rebind_lsq(fe_lsq *a, double *storage)
+{
+    if (a == NULL || storage == NULL)
+        return FE_EINVAL;
+    a->g = storage;
+    return FE_OK;
+}
+
+/* fe_mpi_rebind_discover: fe_discover_rebind. */
+static inline int fe_mpi_rebind_discover(fe_discover_acc *a, double *storage)
+{
+    return fe_discover_rebind(a, storage);
+}
+/* Rebind the accumulations that travel in cells ends here */
 /* [[file:../../literate/mpi.org::Reduce cells across ranks][Reduce cells across ranks]] */
 /* fe_mpi_reduce: result (on `root` only) <- cell of rank 0 o cell of rank 1
    o ... (rank order).  `cell` and `result` are name_cell objects of the

@@ -81,6 +81,9 @@ typedef struct fe_sphere_fit {
     double extent_lo[3], extent_hi[3]; /* per axis, in half-widths */
     double planarity;           /* smallest/largest covariance eigenvalue */
     int iterations;
+    int algebraic;              /* 1: sphere model only, Schmidt's cost has
+                                   no finite minimum on these data and this
+                                   is the algebraic least-squares sphere */
     double frame_centre[3];     /* c and sigma of the solve's frame */
     double frame_scale;
 } fe_sphere_fit;

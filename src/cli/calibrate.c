@@ -26,7 +26,7 @@ static const char fe__calibrate_help[] =
     "                  matrix (3x3, to the unit sphere), radius, axes, params,\n"
     "                  params_se, rms_percent, rms_radial_percent, coverage,\n"
     "                  coverage_fold, planarity, extent_lo, extent_hi,\n"
-    "                  iterations, refusal\n"
+    "                  iterations, algebraic, refusal\n"
     "  --trace         print the Gauss-Newton iterations on standard error\n"
     "  --apply OUT.csv write the calibrated samples R M (x - b) (R: the fitted\n"
     "                  field) to OUT.csv; needs a file, not standard input\n"
@@ -35,7 +35,9 @@ static const char fe__calibrate_help[] =
     "From a file a second pass counts the coverage exactly from the fitted centre\n"
     "(100 equal-area regions), measures the radial RMS error, and writes --apply.\n"
     "rms_percent is 50 sqrt(S/n), S the sum of (1 - |y|^2)^2: the RMS radial\n"
-    "error to first order.\n"
+    "error to first order.  When the data are so far from a sphere that the\n"
+    "sphere model's Gauss-Newton fit runs off to infinity, the sphere is the\n"
+    "algebraic least-squares sphere, and the output says so (algebraic: true).\n"
     "\n"
     "The fit is refused (exit status 1, with the reason) when the samples are\n"
     "too few, lie near a plane, cover one side of the sphere only, or give a\n"
@@ -80,9 +82,9 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
         } else if (strcmp(argv[i], "--apply") == 0 && i + 1 < argc) {
             a->apply = argv[++i];
         } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
-            if (fe_cli_parse_long("--skip", argv[++i], &a->skip, err, sizeof err) != FE_CLI_OK
-                || a->skip < 0) {
-                fprintf(stderr, "foldest calibrate: %s\n", a->skip < 0 ? "--skip: negative" : err);
+            int bad = fe_cli_parse_long("--skip", argv[++i], &a->skip, err, sizeof err) != FE_CLI_OK;
+            if (bad || a->skip < 0) {
+                fprintf(stderr, "foldest calibrate: %s\n", bad ? err : "--skip: negative");
                 return FE_CLI_USAGE;
             }
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
@@ -290,7 +292,8 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         printf(", \"extent_hi\": ");
         fe__calibrate_json_array(f->extent_hi, 3);
     }
-    printf(", \"iterations\": %d, \"refusal\": ", f->iterations);
+    printf(", \"iterations\": %d, \"algebraic\": %s, \"refusal\": ", f->iterations,
+           f->algebraic ? "true" : "false");
     if (rc == FE_OK)
         printf("null");
     else
@@ -321,6 +324,10 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
             printf("  %.6g +- %.2g", f->params[k], f->se[k]);
         printf("\n");
     }
+    if (f->algebraic)
+        printf("  method           the algebraic least-squares sphere: Schmidt's residual\n"
+               "                   has no finite minimum on these data, which are far from\n"
+               "                   a sphere (try --model ellipsoid)\n");
     printf("  rms residual     %.3f %% of the field", f->rms_percent);
     if (p2->done)
         printf(" (radial, exact: %.3f %%)", p2->rms_radial_percent);

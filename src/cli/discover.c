@@ -12,6 +12,20 @@ enum { FE__MAX_PAIRS = 64, FE__ROLES = 5, FE__PLOT_POINTS = 4000 };
 
 static const char *const fe__role_names[FE__ROLES] = {
     "position", "velocity", "temperature", "ambient", "input"};
+
+/* The sample's field for role r, in the order of fe__role_names.  A switch,
+   not pointer arithmetic from &s->position: C does not let a pointer to
+   one member walk to the next. */
+static double *fe__role(fe_sample *s, int r)
+{
+    switch (r) {
+    case 0: return &s->position;
+    case 1: return &s->velocity;
+    case 2: return &s->temperature;
+    case 3: return &s->ambient;
+    default: return &s->input;
+    }
+}
 /* Discover Command Includes ends here */
 /* [[file:../../literate/cli_discover.org::Align a recording with its simulation][Align a recording with its simulation]] */
 /* One simulation row: time, channel and the role columns. */
@@ -122,13 +136,13 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
             out->sim = p->w[1].s;
             out->dsim = fe__dsim(p, 1);
             for (int r = 0; r < FE__ROLES; r++)
-                (&out->position)[r] = p->w[1].role[r];
+                *fe__role(out, r) = p->w[1].role[r];
         } else {
             lambda = (t - p->w[1].t) / (p->w[2].t - p->w[1].t);
             out->sim = p->w[1].s + lambda * (p->w[2].s - p->w[1].s);
             out->dsim = fe__dsim(p, 1) + lambda * (fe__dsim(p, 2) - fe__dsim(p, 1));
             for (int r = 0; r < FE__ROLES; r++)
-                (&out->position)[r] = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
+                *fe__role(out, r) = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
         }
         return FE_OK;
     }
@@ -830,7 +844,7 @@ int fe_cli_discover(int argc, char **argv)
     while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
         fe_catalog_scale_add(&scale, &s);
         for (int r = 0; r < FE__ROLES; r++) {
-            double v = (&s.position)[r];
+            double v = *fe__role(&s, r);
             rmin[r] = v < rmin[r] ? v : rmin[r];
             rmax[r] = v > rmax[r] ? v : rmax[r];
         }
@@ -838,6 +852,17 @@ int fe_cli_discover(int argc, char **argv)
     }
     if (rc != FE_END)
         goto fail;
+    /* A file with a header and no rows is malformed input (status 3), not
+       a comparison with too few rows (a refusal). */
+    for (size_t i = 0; i < a.npairs; i++) {
+        const fe_cli_table *empty = a.pairs[i].real.rows == 0 ? &a.pairs[i].real
+                                  : a.pairs[i].sim.rows == 0 ? &a.pairs[i].sim : NULL;
+        if (empty != NULL) {
+            fprintf(stderr, "foldest discover: %s: no data rows\n", empty->name);
+            rc = FE_CLI_INPUT;
+            goto cleanup;
+        }
+    }
     out.skipped = st.skipped;
     scale.temperature_kelvin = kelvin[2];
     scale.ambient_kelvin = kelvin[3];
@@ -1023,7 +1048,7 @@ int fe_cli_discover(int argc, char **argv)
             }
             for (int v = 0; v < 3; v++) {       /* position, velocity, temperature */
                 int r = v == 2 ? 2 : v;
-                double x = (&s.position)[r], w = rmax[r] - rmin[r];
+                double x = *fe__role(&s, r), w = rmax[r] - rmin[r];
                 int b = w > 0 ? (int)((x - rmin[r]) / w * FE__BINS) : 0;
                 b = b < 0 ? 0 : b >= FE__BINS ? FE__BINS - 1 : b;
                 if (roles & (1u << r))
@@ -1057,7 +1082,7 @@ int fe_cli_discover(int argc, char **argv)
 
     /* Locate: time blocks, then regions. */
     {
-        double ms[FE_DISCOVER_MAX_BLOCKS], med, rho = res->baseline.lag1, all_n = 0, all_sq = 0;
+        double ms[FE_DISCOVER_MAX_BLOCKS] = {0}, med, rho = res->baseline.lag1, all_n = 0, all_sq = 0;
         double infl;
         size_t K = (size_t)a.blocks;
         rho = rho < 0 ? 0 : rho > 0.99 ? 0.99 : rho;
@@ -1337,7 +1362,14 @@ static int fe__discover_sphere(fe__sphere_args *a)
     }
     if (rc != FE_END)
         goto fail;
-    rc = fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &fit);
+    if (rows == 0) {            /* malformed input, not a refusal */
+        snprintf(err, sizeof err, "%s: no data rows", t.name);
+        rc = FE_CLI_INPUT;
+        goto fail;
+    }
+    /* The refusal, not the status, decides here: a fit that fails still
+       names its refusal. */
+    (void)fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &fit);
     if (fit.refusal == FE_SPHERE_TOO_FEW || fit.refusal == FE_SPHERE_PLANAR
         || fit.refusal == FE_SPHERE_HEMISPHERE || fit.refusal == FE_SPHERE_COVERAGE) {
         if (a->json) {
@@ -1356,7 +1388,7 @@ static int fe__discover_sphere(fe__sphere_args *a)
        when the data are not planar, unlike the geometric fit, which can run
        off to a plane when the data are a strong ellipsoid). */
     {
-        double g[25], w[25], coef[4], rss, ref[3];
+        double g[25], w[25], coef[4], rss, ref[3] = {0, 0, 0};
         fe_lsq ls;
         fe_lsq_init(&ls, 4, g);
         if ((rc = fe_cli_table_rewind(&t, err, sizeof err)) != FE_CLI_OK)

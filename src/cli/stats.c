@@ -34,9 +34,9 @@ int fe_cli_stats(int argc, char **argv)
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
             columns = argv[++i];
         } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
-            if (fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK
-                || skip < 0) {
-                fprintf(stderr, "foldest stats: %s\n", skip < 0 ? "--skip: negative" : err);
+            int bad = fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK;
+            if (bad || skip < 0) {
+                fprintf(stderr, "foldest stats: %s\n", bad ? err : "--skip: negative");
                 return FE_CLI_USAGE;
             }
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
@@ -58,12 +58,19 @@ int fe_cli_stats(int argc, char **argv)
         fprintf(stderr, "foldest stats: %s\n", err);
         return rc;
     }
-    cols = calloc(t.ncols, sizeof *cols);
+    /* Room for every name --columns may list (a column may be named twice),
+       not just for the table's columns. */
+    cols = calloc(FE_CLI_FIELDS_MAX, sizeof *cols);
     if (cols == NULL)
         goto out_of_memory;
     if (columns != NULL) {
         char *names[FE_CLI_FIELDS_MAX];
         int n = fe_cli_split_list(columns, names, FE_CLI_FIELDS_MAX);
+        if (n < 0) {
+            fprintf(stderr, "foldest stats: --columns: more than %d names\n", FE_CLI_FIELDS_MAX);
+            rc = FE_CLI_USAGE;
+            goto done;
+        }
         for (int i = 0; i < n; i++) {
             rc = fe_cli_table_column(&t, names[i], &cols[k++], err, sizeof err);
             if (rc != FE_CLI_OK) {
@@ -75,10 +82,10 @@ int fe_cli_stats(int argc, char **argv)
         for (k = 0; k < t.ncols; k++)
             cols[k] = k;
     }
-    row = calloc(k, sizeof *row);
-    lo = calloc(k, sizeof *lo);
-    hi = calloc(k, sizeof *hi);
-    mv = calloc(k, sizeof *mv);
+    row = calloc(k + 1, sizeof *row);          /* + 1: never calloc(0) */
+    lo = calloc(k + 1, sizeof *lo);
+    hi = calloc(k + 1, sizeof *hi);
+    mv = calloc(k + 1, sizeof *mv);
     if (row == NULL || lo == NULL || hi == NULL || mv == NULL)
         goto out_of_memory;
     while ((rc = fe_cli_table_next(&t, cols, k, row, err, sizeof err)) == FE_OK) {

@@ -231,6 +231,12 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 
     for (size_t j = 0; j < t->ncols; j++)
         if (strcmp(t->names[j], spec) == 0) {
+            for (size_t l = j + 1; l < t->ncols; l++)
+                if (strcmp(t->names[l], spec) == 0) {
+                    snprintf(err, errlen, "%s: columns %zu and %zu are both named '%s': "
+                             "name the one you mean by its number", t->name, j + 1, l + 1, spec);
+                    return FE_CLI_USAGE;
+                }
             *col = j;
             return FE_CLI_OK;
         }

@@ -1,0 +1,136 @@
+/* The catalog: every built-in term evaluated against its documented
+   formula, the scale's first pass, user terms, and every coefficient read in
+   words (the sign conventions of catalog.org). */
+#include "foldest.h"
+#include "testutil.h"
+
+static double user_term(const fe_sample *s, const fe_catalog_scale *c, void *u)
+{
+    (void)c;
+    return *(const double *)u * s->t;
+}
+
+START_TEST(every_builtin_term_is_its_formula)
+{
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_sample first = {2.0, 0, 0, 0, 0.5, 1.0, 20.0, 15.0, 0.25};
+    fe_sample s = {5.0, 1.0, 3.0, -0.5, 2.0, -4.0, 30.0, 10.0, 7.0};
+    double phi[FE_DISCOVER_MAX_GROUPS];
+    size_t n;
+    const fe_term *b = fe_catalog_builtin_terms(&n);
+    ck_assert_uint_eq(n, 13);
+    ck_assert_int_eq(fe_catalog_scale_add(&scale, &first), FE_OK);
+    ck_assert_int_eq(fe_catalog_scale_add(&scale, &s), FE_OK);
+    ck_assert_int_eq(fe_catalog_scale_add(NULL, &s), FE_EINVAL);
+    ck_assert_uint_eq(scale.n, 2);
+    ck_assert(scale.t_first == 2.0 && scale.temperature_first == 20.0 && scale.vmax == 4.0);
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE
+                                         | FE_ROLE_AMBIENT | FE_ROLE_INPUT, &scale), FE_OK);
+    ck_assert_uint_eq(c.count, n);
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_OK);
+    {
+        const double tk = 30.0 + 273.15, ak = 10.0 + 273.15;
+        const struct { const char *name; double want; } w[] = {
+            {"bias", 1.0}, {"drift", 3.0}, {"gain", 3.0}, {"delay", -0.5},
+            {"viscous_friction", -4.0}, {"quadratic_drag", -16.0},
+            {"coulomb_friction", tanh(-4.0 / (0.002 * 4.0))}, {"linear_stiffness", 2.0},
+            {"cubic_stiffness", 8.0}, {"thermal_sensitivity", 10.0}, {"newton_cooling", 20.0},
+            {"radiative_cooling", tk * tk * tk * tk - ak * ak * ak * ak}, {"input_gain", 7.0},
+        };
+        for (size_t i = 0; i < sizeof w / sizeof w[0]; i++) {
+            long j = fe_catalog_find(&c, w[i].name);
+            ck_assert_msg(j >= 0, "%s missing", w[i].name);
+            ck_assert_str_eq(b[j].name, w[i].name);
+            FE_ASSERT_REL(phi[j], w[i].want, 1e-12);
+        }
+    }
+    /* Temperatures already in kelvin are not shifted. */
+    scale.temperature_kelvin = scale.ambient_kelvin = 1;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT, &scale), FE_OK);
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_OK);
+    FE_ASSERT_REL(phi[fe_catalog_find(&c, "radiative_cooling")], 30.0 * 30 * 30 * 30 - 1e4, 1e-12);
+    /* Only the terms whose roles are present. */
+    ck_assert_int_eq(fe_catalog_init(&c, 0, &scale), FE_OK);
+    ck_assert_int_eq(fe_catalog_find(&c, "quadratic_drag"), -1);
+    ck_assert_int_ge(fe_catalog_find(&c, "bias"), 0);
+    ck_assert_int_eq(fe_catalog_init(NULL, 0, &scale), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval(NULL, &s, phi), FE_EINVAL);
+}
+END_TEST
+
+START_TEST(user_terms_and_a_full_catalog)
+{
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    double k = 3.0, phi[FE_DISCOVER_MAX_GROUPS];
+    fe_sample s = {2.0, 0, 0, 0, 0, 0, 0, 0, 0};
+    fe_discover_group g[FE_DISCOVER_MAX_GROUPS];
+    char name[FE_DISCOVER_MAX_GROUPS][16];
+    ck_assert_int_eq(fe_catalog_init(&c, 0, &scale), FE_OK);
+    ck_assert_int_eq(fe_catalog_add(&c, "bias", "again", user_term, &k), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add(&c, "u", "user", NULL, &k), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add(&c, "u", "user", user_term, &k), FE_OK);
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_OK);
+    ck_assert(phi[fe_catalog_find(&c, "u")] == 6.0);
+    k = NAN;
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_ENONFINITE);
+    k = 1.0;
+    for (size_t i = c.count; i < FE_DISCOVER_MAX_GROUPS; i++) {
+        snprintf(name[i], sizeof name[i], "t%zu", i);
+        ck_assert_int_eq(fe_catalog_add(&c, name[i], "", user_term, &k), FE_OK);
+    }
+    ck_assert_int_eq(fe_catalog_add(&c, "one_more", "", user_term, &k), FE_ESIZE);
+    fe_catalog_groups(&c, g);
+    ck_assert_str_eq(g[FE_DISCOVER_MAX_GROUPS - 1].name, name[FE_DISCOVER_MAX_GROUPS - 1]);
+    ck_assert_uint_eq(g[5].first, 5);
+    ck_assert_uint_eq(g[5].count, 1);
+}
+END_TEST
+
+START_TEST(every_coefficient_in_words)
+{
+    const struct { const char *name; double coef; const char *words; } w[] = {
+        {"bias", 0.5, "constant offset of 0.5"},
+        {"drift", -0.01, "drifting by -0.01"},
+        {"gain", 0.02, "(1 +0.02) x simulation"},
+        {"delay", -0.03, "lags the simulation by 0.03"},
+        {"viscous_friction", -0.2, "b = 0.2"},
+        {"quadratic_drag", -0.02, "terminal speed sqrt(g/k) = 22.1 m/s"},
+        {"coulomb_friction", -0.3, "mu = 0.3"},
+        {"linear_stiffness", -4, "kappa = 4"},
+        {"cubic_stiffness", -2, "hardening"},
+        {"cubic_stiffness", 2, "softening"},
+        {"thermal_sensitivity", 0.7, "0.7 +/- 0.1 channel units per degree"},
+        {"newton_cooling", -0.05, "convective loss: -0.05"},
+        {"radiative_cooling", -1e-9, "per K^4"},
+        {"input_gain", 0.1, "per input unit"},
+        {"someone_elses", 1.5, "coefficient 1.5 +/- 0.1"},
+        {NULL, 1.5, "coefficient 1.5"},
+    };
+    char buf[256];
+    for (size_t i = 0; i < sizeof w / sizeof w[0]; i++) {
+        ck_assert_int_eq(fe_catalog_explain(w[i].name, w[i].coef, 0.1, buf, sizeof buf), FE_OK);
+        ck_assert_msg(strstr(buf, w[i].words) != NULL, "%s: \"%s\" lacks \"%s\"",
+                      w[i].name ? w[i].name : "(null)", buf, w[i].words);
+    }
+    ck_assert_int_eq(fe_catalog_explain("bias", 1, 0.1, NULL, 10), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_explain("bias", 1, 0.1, buf, 0), FE_EINVAL);
+    /* A short buffer is truncated, never overrun. */
+    buf[8] = 'X';
+    ck_assert_int_eq(fe_catalog_explain("quadratic_drag", -0.02, 0.01, buf, 8), FE_OK);
+    ck_assert_uint_eq(strlen(buf), 7);
+    ck_assert(buf[8] == 'X');
+}
+END_TEST
+
+Suite *fe_catalog_suite(void)
+{
+    Suite *s = suite_create("catalog");
+    TCase *t = tcase_create("terms");
+    tcase_add_test(t, every_builtin_term_is_its_formula);
+    tcase_add_test(t, user_terms_and_a_full_catalog);
+    tcase_add_test(t, every_coefficient_in_words);
+    suite_add_tcase(s, t);
+    return s;
+}
