@@ -17,14 +17,9 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
 }
 /* Discovery Includes ends here */
 /* [[file:../literate/discover.org::Fold a row into its block][Fold a row into its block]] */
-/* Rows per panel in fe_discover_add_rows (the scratch holds one more). */
-enum { FE__DISCOVER_PANEL = 128 };
-
 size_t fe_discover_acc_doubles(size_t m, size_t blocks)
 {
-    size_t dim = m + 1;
-    return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1
-           + dim * dim + (FE__DISCOVER_PANEL + 1) * dim;
+    return FE_DISCOVER_ACC_DOUBLES(m, blocks);
 }
 
 /* The first global row of block k (k = K: the first held-out row). */
@@ -300,10 +295,10 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
         || (nrows > 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN))
         return FE_EINVAL;
     while (i < nrows) {
-        /* A panel: at most FE__DISCOVER_PANEL rows, all in one block. */
+        /* A panel: at most FE_DISCOVER_PANEL_ROWS rows, all in one block. */
         uint64_t row = a->row0 + a->n;
         size_t k = fe__discover_block(a, row), got = 0;
-        size_t q = nrows - i < FE__DISCOVER_PANEL ? nrows - i : FE__DISCOVER_PANEL;
+        size_t q = nrows - i < FE_DISCOVER_PANEL_ROWS ? nrows - i : FE_DISCOVER_PANEL_ROWS;
         if (k < a->blocks && fe__discover_cut(a, k + 1) - row < q)
             q = (size_t)(fe__discover_cut(a, k + 1) - row);
         if (!(a->have_prev && fe__discover_large(a->last, a->m + 1)))

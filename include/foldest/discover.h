@@ -16,6 +16,21 @@ enum {
     FE_DISCOVER_MAX_STEPS = 12      /* forward-selection steps */
 };
 
+/* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
+   triangle and FE_DISCOVER_PANEL_ROWS + 1 rows) is part of the
+   accumulation's storage. */
+enum { FE_DISCOVER_PANEL_ROWS = 128 };
+
+/* FE_DISCOVER_ACC_DOUBLES: fe_discover_acc_doubles(m, blocks) as a
+   constant expression, for storage sized at compile time.  The values
+   (blocks, T, first, last, counts) come first, the scratch last, at
+   FE_DISCOVER_ACC_VALUES(m, blocks). */
+#define FE_DISCOVER_ACC_VALUES(m, blocks)                                   \
+    (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1)
+#define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
+    (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
+     + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
+
 /* The accumulation: K block Gram matrices of the rows (phi, r), one for
    held-out rows, the lag-one cross product, and the first and last rows.
    Memory is the caller's: fe_discover_acc_doubles() doubles. */
