@@ -78,11 +78,10 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
    are grouped differently), with two thirds of its arithmetic, M (M + 1)
    multiply-adds a row, all in level-3 BLAS: measured twice as fast at
    M = 16, five times at M = 54, no faster for a handful of columns.
-   Stops at the first row with a value that is not finite (FE_ENONFINITE):
-   the rows before it are folded, the rest are not.
-   Rows whose sums would overflow are refused the same way (FE_ENONFINITE),
-   as by fe_discover_add.  `*done` (if not NULL) receives how many rows
-   were folded.  FE_EINVAL for null pointers, ldphi < m when nrows > 1, or
+   Stops at the first row that fe_discover_add would refuse (a value not
+   finite, or sums that would overflow: FE_ENONFINITE): the rows before it
+   are folded, the rest are not.  `*done` (if not NULL) receives how many
+   rows were folded.  FE_EINVAL for null pointers, ldphi < m when nrows > 1, or
    row0 FE_DISCOVER_ROW_UNKNOWN (nothing folded). */
 int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
                          const double *r, size_t nrows, size_t *done);
