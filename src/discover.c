@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include <cblas.h>
 #include <lapacke.h>
 
 #include "foldest/discover.h"
@@ -18,8 +19,22 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
 /* [[file:../literate/discover.org::Fold a row into its block][Fold a row into its block]] */
 size_t fe_discover_acc_doubles(size_t m, size_t blocks)
 {
-    size_t dim = m + 1;
-    return (blocks + 1) * dim * dim + dim * dim + 2 * dim + blocks + 1;
+    return FE_DISCOVER_ACC_DOUBLES(m, blocks);
+}
+
+/* The first global row of block k (k = K: the first held-out row). */
+static uint64_t fe__discover_cut(const fe_discover_acc *a, size_t k)
+{
+    if (k >= a->blocks)
+        return a->fit_rows;
+    return ((uint64_t)k * a->fit_rows + a->blocks - 1) / a->blocks;
+}
+
+static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
+{
+    if (row >= a->fit_rows)
+        return a->blocks;                       /* held out */
+    return (size_t)(row * a->blocks / a->fit_rows);
 }
 
 static void fe__discover_layout(fe_discover_acc *a, double *storage)
@@ -30,6 +45,7 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->first = a->lag + dim * dim;
     a->last = a->first + dim;
     a->counts = a->last + dim;
+    a->work = a->counts + a->blocks + 1;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -59,11 +75,16 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     return FE_OK;
 }
 
-static size_t fe__discover_block(const fe_discover_acc *a, uint64_t row)
+/* Add the folded z p^T to T: z_i p_i on the diagonal, z_i p_j + p_i z_j above. */
+static void fe__discover_lag_pair(double *t, size_t dim, const double *z, const double *p)
 {
-    if (row >= a->fit_rows)
-        return a->blocks;                       /* held out */
-    return (size_t)(row * a->blocks / a->fit_rows);
+    for (size_t i = 0; i < dim; i++) {
+        double zi = z[i], pi = p[i];
+        double *ti = t + i * dim;
+        ti[i] += zi * pi;
+        for (size_t j = i + 1; j < dim; j++)
+            ti[j] += zi * p[j] + pi * z[j];
+    }
 }
 
 /* Some value above 1e100 in magnitude: products may overflow. */
@@ -106,9 +127,12 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
                     return FE_ENONFINITE;
         if (a->have_prev && k < a->blocks)
             for (size_t i = 0; i < dim; i++)
-                for (size_t j = 0; j < dim; j++)
-                    if (!isfinite(a->lag[i * dim + j] + z[i] * a->last[j]))
+                for (size_t j = i; j < dim; j++) {
+                    const double *p = a->last;
+                    double add = j == i ? z[i] * p[i] : z[i] * p[j] + p[i] * z[j];
+                    if (!isfinite(a->lag[i * dim + j] + add))
                         return FE_ENONFINITE;
+                }
     }
     /* Add z z^T to the block's upper triangle. */
     for (size_t i = 0; i < dim; i++) {
@@ -120,11 +144,9 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
             gi[j] += zi * z[j];
     }
     a->counts[k] += 1.0;
-    /* Add z_t z_{t-1}^T when the previous row is a fitted neighbour. */
+    /* Add z_t z_{t-1}^T, folded, when the previous row is a fitted neighbour. */
     if (a->have_prev && k < a->blocks)
-        for (size_t i = 0; i < dim; i++)
-            for (size_t j = 0; j < dim; j++)
-                a->lag[i * dim + j] += z[i] * a->last[j];
+        fe__discover_lag_pair(a->lag, dim, z, a->last);
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
@@ -170,9 +192,7 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     /* The lag product across the cut. */
     if (a->n > 0 && a->have_prev && b->first_linked
         && fe__discover_block(a, b->row0) < a->blocks)
-        for (size_t i = 0; i < dim; i++)
-            for (size_t j = 0; j < dim; j++)
-                a->lag[i * dim + j] += b->first[i] * a->last[j];
+        fe__discover_lag_pair(a->lag, dim, b->first, a->last);
     if (a->n == 0) {
         memcpy(a->first, b->first, dim * sizeof *a->first);
         a->first_linked = b->first_linked;
@@ -183,6 +203,123 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     return FE_OK;
 }
 /* Merge consecutive accumulations ends here */
+/* [[file:../literate/discover.org::Fold a panel of rows][Fold a panel of rows]] */
+/* Copy up to q rows into the panel Z (scratch rows 1..q; row 0 is kept for
+   the row before the panel), checking every value; the count of rows
+   before the first with a value that is not finite or above 1e100 in
+   magnitude. */
+static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ldphi,
+                                const double *r, size_t q)
+{
+    size_t dim = a->m + 1, m = a->m;
+    double *z = a->work + dim * dim + dim;
+    for (size_t t = 0; t < q; t++) {
+        const double *pt = phi + t * ldphi;
+        double *zt = z + t * dim;
+        int ok = fabs(r[t]) <= 1e100;           /* false for NaN too */
+        for (size_t i = 0; i < m; i++) {
+            zt[i] = pt[i];
+            ok &= fabs(pt[i]) <= 1e100;
+        }
+        zt[m] = r[t];
+        if (!ok)
+            return t;
+    }
+    return q;
+}
+
+/* Fold the q loaded rows, all in block k. */
+static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
+{
+    size_t dim = a->m + 1;
+    double *x = a->work, *c = x + dim * dim, *z = c + dim;
+    double *g = a->gram + k * dim * dim, *t = a->lag;
+    int fitted = k < a->blocks, linked = fitted && a->have_prev;
+    size_t pairs = linked ? q : q - 1;
+
+    /* X = Z^T Z, into the block. */
+    cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)q, 1.0, z,
+                (int)dim, 0.0, x, (int)dim);
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = i; j < dim; j++)
+            g[i * dim + j] += x[i * dim + j];
+    a->counts[k] += (double)q;
+    if (a->n == 0)
+        memcpy(a->first, z, dim * sizeof *z);
+    if (fitted && pairs > 0) {
+        double diag[FE_DISCOVER_MAX_COLUMNS + 1], sign = linked ? 1.0 : -1.0;
+        double *c0 = linked ? c : z, *cp = z + (q - 1) * dim;
+        if (linked)
+            memcpy(c, a->last, dim * sizeof *c);
+        /* The diagonal directly: T_ii += sum_s c_{s,i} c_{s-1,i}. */
+        for (size_t i = 0; i < dim; i++)
+            diag[i] = t[i * dim + i];
+        for (size_t s = 1; s <= pairs; s++) {
+            const double *cs = c0 + s * dim, *cr = cs - dim;
+            for (size_t i = 0; i < dim; i++)
+                diag[i] += cs[i] * cr[i];
+        }
+        /* Above it: 2X +- c_0 c_0^T - c_p c_p^T, ... */
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = i + 1; j < dim; j++)
+                t[i * dim + j] += 2.0 * x[i * dim + j] + sign * c0[i] * c0[j] - cp[i] * cp[j];
+        memcpy(a->last, cp, dim * sizeof *cp);
+        /* ... - D, from the differences made in place, last row first. */
+        for (size_t s = pairs; s > 0; s--) {
+            double *cs = c0 + s * dim;
+            const double *cr = cs - dim;
+            for (size_t i = 0; i < dim; i++)
+                cs[i] -= cr[i];
+        }
+        cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)pairs, -1.0,
+                    c0 + dim, (int)dim, 1.0, t, (int)dim);
+        for (size_t i = 0; i < dim; i++)
+            t[i * dim + i] = diag[i];
+    } else {
+        memcpy(a->last, z + (q - 1) * dim, dim * sizeof *z);
+    }
+    a->have_prev = fitted;
+    a->n += q;
+}
+
+int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
+                         const double *r, size_t nrows, size_t *done)
+{
+    size_t i = 0;
+    int rc = FE_OK;
+
+    if (done != NULL)
+        *done = 0;
+    if (a == NULL || (nrows > 0 && (phi == NULL || r == NULL))
+        || (nrows > 1 && ldphi < a->m)
+        || (nrows > 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN))
+        return FE_EINVAL;
+    while (i < nrows) {
+        /* A panel: at most FE_DISCOVER_PANEL_ROWS rows, all in one block. */
+        uint64_t row = a->row0 + a->n;
+        size_t k = fe__discover_block(a, row), got = 0;
+        size_t q = nrows - i < FE_DISCOVER_PANEL_ROWS ? nrows - i : FE_DISCOVER_PANEL_ROWS;
+        if (k < a->blocks && fe__discover_cut(a, k + 1) - row < q)
+            q = (size_t)(fe__discover_cut(a, k + 1) - row);
+        if (!(a->have_prev && fe__discover_large(a->last, a->m + 1)))
+            got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
+        if (got > 0) {
+            fe__discover_panel(a, k, got);
+            i += got;
+            continue;
+        }
+        /* A row that is not finite, has a value above 1e100, or follows
+           one: the row step decides, with its guard against overflow. */
+        rc = fe_discover_add(a, phi + i * ldphi, r[i]);
+        if (rc != FE_OK)
+            break;
+        i++;
+    }
+    if (done != NULL)
+        *done = i;
+    return rc;
+}
+/* Fold a panel of rows ends here */
 /* [[file:../literate/discover.org::Fold rows that carry their index][Fold rows that carry their index]] */
 int fe_discover_rebind(fe_discover_acc *a, double *storage)
 {

@@ -166,6 +166,216 @@ START_TEST(merge_of_consecutive_parts_equals_whole)
 }
 END_TEST
 
+/* Rows for the panel tests: smooth columns (a constant, slow sines, a
+   ramp), a white one, and an AR(1) residual, so that the lag products have
+   both large and cancelling parts. */
+enum { PN = 5000, PM = 6, PK = 10, PFIT = 4000 };
+static double pphi[PN][PM], pr[PN];
+
+static void panel_rows(void)
+{
+    fe_rng g = fe_rng_seed(21);
+    double e = 0.0;
+    for (int i = 0; i < PN; i++) {
+        double t = 0.01 * i;
+        e = 0.8 * e + fe_rng_normal(&g);
+        pphi[i][0] = 1.0;
+        pphi[i][1] = sin(0.7 * t);
+        pphi[i][2] = 3.0 * cos(0.2 * t) + 0.01 * fe_rng_normal(&g);
+        pphi[i][3] = t;
+        pphi[i][4] = fe_rng_normal(&g);
+        pphi[i][5] = tanh(2.0 * pphi[i][1]) * 1e3;
+        pr[i] = 0.3 * pphi[i][1] + e;
+    }
+}
+
+/* Every stored sum of `got` equals that of `want` to 1e-12 of its
+   Cauchy-Schwarz scale sqrt(G_ii G_jj) (G summed over all blocks). */
+static void assert_same_sums(const fe_discover_acc *got, const fe_discover_acc *want)
+{
+    size_t dim = want->m + 1, K = want->blocks;
+    double diag[PM + 1] = {0};
+    ck_assert_uint_eq(got->n, want->n);
+    ck_assert_int_eq(got->have_prev, want->have_prev);
+    ck_assert_int_eq(got->first_linked, want->first_linked);
+    for (size_t k = 0; k <= K; k++) {
+        ck_assert_double_eq(got->counts[k], want->counts[k]);
+        for (size_t i = 0; i < dim; i++)
+            diag[i] += want->gram[k * dim * dim + i * dim + i];
+    }
+    for (size_t i = 0; i < dim; i++) {
+        ck_assert_double_eq(got->first[i], want->first[i]);
+        ck_assert_double_eq(got->last[i], want->last[i]);
+    }
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = 0; j < dim; j++) {
+            double scale = sqrt(diag[i] * diag[j]);
+            for (size_t k = 0; k <= K; k++) {
+                size_t at = k * dim * dim + i * dim + j;
+                ck_assert_msg(fabs(got->gram[at] - want->gram[at]) <= 1e-12 * scale,
+                              "block %zu G[%zu][%zu] = %.17g, want %.17g", k, i, j,
+                              got->gram[at], want->gram[at]);
+            }
+            ck_assert_msg(fabs(got->lag[i * dim + j] - want->lag[i * dim + j]) <= 1e-12 * scale,
+                          "T[%zu][%zu] = %.17g, want %.17g (scale %g)", i, j,
+                          got->lag[i * dim + j], want->lag[i * dim + j], scale);
+        }
+}
+
+/* Fold rows [from, to) through the panel path in uneven pieces. */
+static void add_in_pieces(fe_discover_acc *a, size_t from, size_t to)
+{
+    static const size_t piece[] = {37, 1, 300, 128, 2, 129, 1000, 5};
+    size_t i = from, p = 0, done = 0;
+    while (i < to) {
+        size_t q = piece[p++ % (sizeof piece / sizeof *piece)];
+        if (q > to - i)
+            q = to - i;
+        ck_assert_int_eq(fe_discover_add_rows(a, pphi[i], PM, pr + i, q, &done), FE_OK);
+        ck_assert_uint_eq(done, q);
+        i += q;
+    }
+}
+
+START_TEST(panel_path_equals_row_path)
+{
+    /* Row by row and by panels, with a break at row 1777 (a new recording):
+       the same blocks, counts, ends and lag products; and the lag product
+       against its definition, summed directly. */
+    size_t nst = fe_discover_acc_doubles(PM, PK), dim = PM + 1;
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+    double L[PM + 1][PM + 1] = {{0}};
+    fe_discover_acc rows, panels;
+    int rc = FE_OK;
+    panel_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&rows, PM, PK, PFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&panels, PM, PK, PFIT, 0, s2, nst), FE_OK);
+    for (size_t i = 0; i < PN; i++) {
+        if (i == 1777)
+            fe_discover_break(&rows);
+        rc |= fe_discover_add(&rows, pphi[i], pr[i]);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    add_in_pieces(&panels, 0, 1777);
+    fe_discover_break(&panels);
+    add_in_pieces(&panels, 1777, PN);
+    assert_same_sums(&panels, &rows);
+    /* T_ii = L_ii, T_ij = L_ij + L_ji over fitted neighbours, none across the break. */
+    for (size_t t = 1; t < PFIT; t++) {
+        double z[PM + 1], p[PM + 1];
+        if (t == 1777)
+            continue;
+        for (size_t i = 0; i < dim; i++) {
+            z[i] = i < PM ? pphi[t][i] : pr[t];
+            p[i] = i < PM ? pphi[t - 1][i] : pr[t - 1];
+        }
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = 0; j < dim; j++)
+                L[i][j] += z[i] * p[j];
+    }
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = 0; j < dim; j++) {
+            double want = j < i ? 0.0 : j == i ? L[i][i] : L[i][j] + L[j][i];
+            double scale = sqrt(fabs(L[i][i]) * fabs(L[j][j])) + 1.0;
+            ck_assert_msg(fabs(panels.lag[i * dim + j] - want) <= 1e-10 * scale,
+                          "T[%zu][%zu] = %.17g, want %.17g", i, j, panels.lag[i * dim + j], want);
+        }
+    free(s1);
+    free(s2);
+}
+END_TEST
+
+START_TEST(panels_of_split_parts_merge_to_the_whole)
+{
+    /* Parts cut mid-block and in the held-out rows, each folded by panels,
+       merge into the row-by-row fold of the whole stream. */
+    size_t nst = fe_discover_acc_doubles(PM, PK);
+    double *w = malloc(nst * sizeof *w), *p1 = malloc(nst * sizeof *w),
+           *p2 = malloc(nst * sizeof *w), *p3 = malloc(nst * sizeof *w);
+    fe_discover_acc whole, a, b, c;
+    const size_t cut1 = 1234, cut2 = 4001;
+    int rc = FE_OK;
+    panel_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&whole, PM, PK, PFIT, 0, w, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&a, PM, PK, PFIT, 0, p1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, PM, PK, PFIT, cut1, p2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&c, PM, PK, PFIT, cut2, p3, nst), FE_OK);
+    for (size_t i = 0; i < PN; i++)
+        rc |= fe_discover_add(&whole, pphi[i], pr[i]);
+    ck_assert_int_eq(rc, FE_OK);
+    add_in_pieces(&a, 0, cut1);
+    add_in_pieces(&b, cut1, cut2);
+    add_in_pieces(&c, cut2, PN);
+    ck_assert_int_eq(fe_discover_merge(&b, &c), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);
+    assert_same_sums(&a, &whole);
+    free(w);
+    free(p1);
+    free(p2);
+    free(p3);
+}
+END_TEST
+
+START_TEST(panels_stop_at_the_first_refused_row)
+{
+    /* A NaN at row 150 (in the second panel): rows 0..149 are folded, as
+       row by row, and nothing after; bad arguments fold nothing. */
+    size_t nst = fe_discover_acc_doubles(PM, PK), done = 99;
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+    double keep;
+    fe_discover_acc rows, panels;
+    panel_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&rows, PM, PK, PFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&panels, PM, PK, PFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM - 1, pr, 2, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM, NULL, 2, &done), FE_EINVAL);
+    ck_assert_uint_eq(panels.n, 0);
+    for (size_t i = 0; i < 150; i++)
+        ck_assert_int_eq(fe_discover_add(&rows, pphi[i], pr[i]), FE_OK);
+    keep = pphi[150][3];
+    pphi[150][3] = NAN;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM, pr, 400, &done), FE_ENONFINITE);
+    pphi[150][3] = keep;
+    ck_assert_uint_eq(done, 150);
+    assert_same_sums(&panels, &rows);
+    keep = pr[7];
+    pr[7] = INFINITY;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM, pr, 10, &done), FE_ENONFINITE);
+    pr[7] = keep;
+    ck_assert_uint_eq(done, 7);
+    ck_assert_uint_eq(panels.n, 157);
+    /* A finite row whose square overflows is refused like a NaN; one of
+       1e150 (squares 1e300) goes through the guarded row step and the
+       panel resumes after it, as row by row. */
+    for (size_t i = 0; i < 7; i++)      /* what the second call folded */
+        ck_assert_int_eq(fe_discover_add(&rows, pphi[i], pr[i]), FE_OK);
+    keep = pphi[170][0];
+    pphi[170][0] = 1e200;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[157], PM, pr + 157, 100, &done),
+                     FE_ENONFINITE);
+    ck_assert_uint_eq(done, 13);
+    pphi[170][0] = 1e150;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[170], PM, pr + 170, 100, &done), FE_OK);
+    ck_assert_uint_eq(done, 100);
+    pphi[170][0] = keep;
+    for (size_t i = 157; i < 270; i++) {
+        double save = pphi[i][0];
+        if (i == 170)
+            pphi[i][0] = 1e150;
+        ck_assert_int_eq(fe_discover_add(&rows, pphi[i], pr[i]), FE_OK);
+        pphi[i][0] = save;
+    }
+    assert_same_sums(&panels, &rows);
+    /* A part that does not know its place folds nothing. */
+    panels.row0 = FE_DISCOVER_ROW_UNKNOWN;
+    ck_assert_int_eq(fe_discover_add_rows(&panels, pphi[0], PM, pr, 3, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    free(s1);
+    free(s2);
+}
+END_TEST
+
 START_TEST(refusals_leave_the_accumulation_unchanged)
 {
     enum { M = 3, K = 4 };
@@ -287,6 +497,9 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, score_is_the_drop_in_rss);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, panel_path_equals_row_path);
+    tcase_add_test(t, panels_of_split_parts_merge_to_the_whole);
+    tcase_add_test(t, panels_stop_at_the_first_refused_row);
     tcase_add_test(t, selection_refuses_empty_blocks_and_collinear_base);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);

@@ -30,7 +30,8 @@ enum {
     M = 5,                      /* candidate columns */
     K = 10,                     /* time blocks */
     DIM = M + 1,
-    CAPACITY = (K + 2) * DIM * DIM + 2 * DIM + K + 1   /* fe_discover_acc_doubles(M, K) */
+    CAPACITY = FE_DISCOVER_ACC_DOUBLES(M, K),   /* fe_discover_acc_doubles(M, K) */
+    VALUES = FE_DISCOVER_ACC_VALUES(M, K)       /* then fe_discover_add_rows' scratch */
 };
 
 FE_MPI_DEFINE_BOUND_REDUCTION(dc, fe_discover_acc, fe_discover_accumulator(), CAPACITY,
@@ -78,7 +79,7 @@ static int fold_range(fe_discover_acc *a, size_t begin, size_t end, size_t n, si
     return rc;
 }
 
-/* Every entry of the storage (block Gram matrices, lag products, first and
+/* Every value in the storage (block Gram matrices, lag products, first and
    last rows, counts) relative to the scale of its terms: entry (i, j) of a
    Gram or lag matrix against sqrt(G_ii G_jj) of the whole fold's Gram
    (Cauchy-Schwarz), rows and counts against themselves. */
@@ -98,7 +99,7 @@ static double gram_apart(const fe_discover_acc *a, const fe_discover_acc *b)
                 if (s > 0.0)
                     worst = fmax(worst, fabs(a->gram[e] - b->gram[e]) / s);
             }
-    for (size_t e = (K + 2) * DIM * DIM; e < CAPACITY; e++)
+    for (size_t e = (K + 2) * DIM * DIM; e < VALUES; e++)
         worst = fmax(worst, fabs(a->gram[e] - b->gram[e])
                                 / fmax(fabs(b->gram[e]), 1e-300));
     return worst;

@@ -16,6 +16,21 @@ enum {
     FE_DISCOVER_MAX_STEPS = 12      /* forward-selection steps */
 };
 
+/* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
+   triangle and FE_DISCOVER_PANEL_ROWS + 1 rows) is part of the
+   accumulation's storage. */
+enum { FE_DISCOVER_PANEL_ROWS = 128 };
+
+/* FE_DISCOVER_ACC_DOUBLES: fe_discover_acc_doubles(m, blocks) as a
+   constant expression, for storage sized at compile time.  The values
+   (blocks, T, first, last, counts) come first, the scratch last, at
+   FE_DISCOVER_ACC_VALUES(m, blocks). */
+#define FE_DISCOVER_ACC_VALUES(m, blocks)                                   \
+    (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1)
+#define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
+    (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
+     + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
+
 /* The accumulation: K block Gram matrices of the rows (phi, r), one for
    held-out rows, the lag-one cross product, and the first and last rows.
    Memory is the caller's: fe_discover_acc_doubles() doubles. */
@@ -28,9 +43,13 @@ typedef struct fe_discover_acc {
     int have_prev;              /* the last row can be followed (no break) */
     int first_linked;           /* the first row follows the previous part */
     double *gram;               /* (K + 1) x M x M, upper triangles */
-    double *lag;                /* M x M, sum z_t z_{t-1}^T over fitted rows */
+    double *lag;                /* M x M, L = sum z_t z_{t-1}^T over fitted
+                                   rows, folded: L_ii on the diagonal,
+                                   L_ij + L_ji above it, zeros below, so
+                                   that w^T lag w = w^T L w */
     double *first, *last;       /* M each */
     double *counts;             /* K + 1 row counts */
+    double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
 /* fe_discover_acc_doubles: doubles of storage for m columns, K blocks. */
@@ -49,8 +68,23 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
    value is not finite; FE_EINVAL when row0 is FE_DISCOVER_ROW_UNKNOWN (use
-   fe_discover_add_row).  Cost O(M^2). */
+   fe_discover_add_row).  Cost about 1.5 M (M + 1) multiply-adds
+   (fe_discover_add_rows is the fast path for many rows). */
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
+
+/* fe_discover_add_rows: fold `nrows` rows at once: row i is the m term
+   values phi[i * ldphi .. i * ldphi + m - 1] and the residual r[i].  The
+   same accumulation as fe_discover_add row by row (up to rounding: sums
+   are grouped differently), with two thirds of its arithmetic, M (M + 1)
+   multiply-adds a row, all in level-3 BLAS: measured twice as fast at
+   M = 16, five times at M = 54, no faster for a handful of columns.
+   Stops at the first row that fe_discover_add would refuse (a value not
+   finite, or sums that would overflow: FE_ENONFINITE): the rows before it
+   are folded, the rest are not.  `*done` (if not NULL) receives how many
+   rows were folded.  FE_EINVAL for null pointers, ldphi < m when nrows > 1, or
+   row0 FE_DISCOVER_ROW_UNKNOWN (nothing folded). */
+int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
+                         const double *r, size_t nrows, size_t *done);
 
 /* fe_discover_break: the next row does not follow the last in time (a new
    recording begins): no lag product is formed across. */
