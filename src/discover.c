@@ -247,7 +247,8 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     if (fitted && pairs > 0) {
-        double diag[FE_DISCOVER_MAX_COLUMNS + 1], sign = linked ? 1.0 : -1.0;
+        double diag[FE_DISCOVER_MAX_COLUMNS + 1] = {0}; /* dim entries set below */
+        double sign = linked ? 1.0 : -1.0;
         double *c0 = linked ? c : z, *cp = z + (q - 1) * dim;
         if (linked)
             memcpy(c, a->last, dim * sizeof *c);
