@@ -71,25 +71,12 @@ static void quadric_generate(void *obs, size_t i, fe_rng *r)
         x[j] = c[j] + semi[j] * u[j] + 0.4 * fe_rng_normal(r);
 }
 
-/* Moments may cancel (sum u1 u2 is near zero on a sphere): each is
-   compared relative to N s^d, s bounding every |u_j| and d its degree,
-   the largest total magnitude its N terms can have; count, reference and
-   extremes must agree exactly. */
+/* Moments relative to the size their terms can reach; count, reference
+   and extremes exactly (fe_quadric_compare). */
 static double quadric_agree(const void *a, const void *b)
 {
-    const fe_quadric *p = a, *q = b;
-    double s = 0.0, worst = 0.0;
-    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0
-        || memcmp(p->lo, q->lo, sizeof p->lo) != 0 || memcmp(p->hi, q->hi, sizeof p->hi) != 0)
-        return INFINITY;
-    for (int j = 0; j < 3; j++)
-        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
-    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
-        int e[3];
-        fe_quadric_exponents(k, e);
-        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
-    }
-    return worst;
+    double apart;
+    return fe_quadric_compare(a, b, &apart) == FE_OK ? apart : INFINITY;
 }
 
 static const row rows[] = {

@@ -634,6 +634,36 @@ int fe_quadric_merge(fe_quadric *a, const fe_quadric *b)
     return FE_OK;
 }
 /* Merge two accumulations ends here */
+/* [[file:../literate/quadric.org::Compare two accumulations][Compare two accumulations]] */
+int fe_quadric_compare(const fe_quadric *a, const fe_quadric *b, double *apart)
+{
+    double s = 0.0, worst = 0.0;
+    if (a == NULL || b == NULL || apart == NULL)
+        return FE_EINVAL;
+    if (a->m[0] != b->m[0])
+        return FE_EMISMATCH;
+    for (int j = 0; j < 3; j++) {
+        double up = b->hi[j] - b->ref[j], down = b->ref[j] - b->lo[j];
+        if (a->ref[j] != b->ref[j] || a->lo[j] != b->lo[j] || a->hi[j] != b->hi[j])
+            return FE_EMISMATCH;
+        s = up > s ? up : s;
+        s = down > s ? down : s;
+    }
+    for (int k = 1; k < FE_QUADRIC_MOMENTS && b->m[0] > 0.0; k++) {
+        double size = b->m[0], d = a->m[k] - b->m[k];
+        for (int e = 0; e < fe__quadric_exp[k][0] + fe__quadric_exp[k][1]
+                            + fe__quadric_exp[k][2]; e++)
+            size *= s;
+        d = d < 0.0 ? -d : d;
+        if (size > 0.0 && d / size > worst)
+            worst = d / size;
+        else if (!(size > 0.0) && d > 0.0)
+            worst = d;                  /* a box of one point: absolute */
+    }
+    *apart = worst;
+    return FE_OK;
+}
+/* Compare two accumulations ends here */
 /* [[file:../literate/quadric.org::Read out the count and the coverage][Read out the count and the coverage]] */
 int fe_quadric_init(fe_quadric *q, const double *centre)
 {

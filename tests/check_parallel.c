@@ -155,21 +155,10 @@ static void quadric_generate(void *obs, fe_rng *r)
 static double quadric_distance(const void *a, const void *b)
 {
     const fe_quadric *p = a, *q = b;
-    double s = 0.0, worst = 0.0;
-    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0
-        || memcmp(p->lo, q->lo, sizeof p->lo) != 0
-        || memcmp(p->hi, q->hi, sizeof p->hi) != 0 || p->flags != q->flags)
+    double apart;
+    if (p->flags != q->flags || fe_quadric_compare(p, q, &apart) != FE_OK)
         return INFINITY;
-    if (q->m[0] == 0.0)
-        return 0.0;
-    for (int j = 0; j < 3; j++)
-        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
-    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
-        int e[3];
-        fe_quadric_exponents(k, e);
-        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
-    }
-    return worst;
+    return apart;
 }
 
 static const pcase cases[] = {

@@ -103,6 +103,29 @@ START_TEST(two_shards_equal_one)
     ck_assert_double_le(moment_diff(&a, &whole, 400.0), 1e-12);
     ck_assert_mem_eq(a.lo, whole.lo, sizeof a.lo);
     ck_assert_mem_eq(a.hi, whole.hi, sizeof a.hi);
+    /* fe_quadric_compare: the merged shards against the whole; a known
+       perturbation of a fourth moment; exact parts that differ. */
+    {
+        double apart = -1.0, s = 0.0;
+        fe_quadric c = a;
+        ck_assert_int_eq(fe_quadric_compare(&a, &whole, &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+        ck_assert_double_ge(apart, 0.0);
+        for (int j = 0; j < 3; j++)
+            s = fmax(s, fmax(whole.hi[j] - whole.ref[j], whole.ref[j] - whole.lo[j]));
+        c.m[fe_quadric_index(2, 1, 1)] += 1e-6 * N * s * s * s * s;
+        ck_assert_int_eq(fe_quadric_compare(&c, &whole, &apart), FE_OK);
+        FE_ASSERT_REL(apart, 1e-6, 1e-6);
+        c = a;
+        c.m[0] += 1.0;
+        ck_assert_int_eq(fe_quadric_compare(&c, &whole, &apart), FE_EMISMATCH);
+        c = a;
+        c.hi[2] += 1.0;
+        ck_assert_int_eq(fe_quadric_compare(&c, &whole, &apart), FE_EMISMATCH);
+        ck_assert_int_eq(fe_quadric_compare(&b, &whole, &apart), FE_EMISMATCH);
+        ck_assert_int_eq(fe_quadric_compare(NULL, &whole, &apart), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_compare(&a, &whole, NULL), FE_EINVAL);
+    }
 }
 END_TEST
 

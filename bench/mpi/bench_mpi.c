@@ -63,21 +63,11 @@ static void qm_generate(double *x, fe_rng *r)
         x[j] = c[j] + semi[j] * u[j] + 0.4 * fe_rng_normal(r);
 }
 
-/* Each moment relative to N s^d (s bounds every |u_j|, d its degree). */
+/* Each moment relative to the size its terms can reach (fe_quadric_compare). */
 static double qm_agree(const void *a, const void *b)
 {
-    const fe_quadric *p = a, *q = b;
-    double s = 0.0, worst = 0.0;
-    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0)
-        return INFINITY;
-    for (int j = 0; j < 3; j++)
-        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
-    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
-        int e[3];
-        fe_quadric_exponents(k, e);
-        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
-    }
-    return worst;
+    double apart;
+    return fe_quadric_compare(a, b, &apart) == FE_OK ? apart : INFINITY;
 }
 
 static const kind kinds[] = {

@@ -57,23 +57,13 @@ static int fold_range(fe_quadric *q, size_t begin, size_t end, size_t nan_at, si
     return rc;
 }
 
-/* The largest difference of two moment sets, each moment relative to N s^d
-   (s bounds every |u_j|, d is its degree): the size its terms can reach. */
+/* How far apart two moment sets are: each moment relative to the size its
+   terms can reach (fe_quadric_compare); infinite when the exact parts
+   (count, reference, extremes) differ. */
 static double moments_apart(const fe_quadric *p, const fe_quadric *q)
 {
-    double s = 0.0, worst = 0.0;
-    if (p->m[0] != q->m[0] || memcmp(p->ref, q->ref, sizeof p->ref) != 0)
-        return INFINITY;
-    if (q->m[0] == 0.0)
-        return 0.0;
-    for (int j = 0; j < 3; j++)
-        s = fmax(s, fmax(fabs(q->hi[j] - q->ref[j]), fabs(q->lo[j] - q->ref[j])));
-    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
-        int e[3];
-        fe_quadric_exponents(k, e);
-        worst = fmax(worst, fabs(p->m[k] - q->m[k]) / (q->m[0] * pow(s, e[0] + e[1] + e[2])));
-    }
-    return worst;
+    double apart;
+    return fe_quadric_compare(p, q, &apart) == FE_OK ? apart : INFINITY;
 }
 
 /* The largest difference of two calibrations: offsets relative to the

@@ -66,6 +66,15 @@ int fe_quadric_merge(fe_quadric *a, const fe_quadric *b);
    about 400 multiplications.  FE_ENONFINITE on overflow (q unchanged). */
 int fe_quadric_recentre(fe_quadric *q, const double ref[3]);
 
+/* fe_quadric_compare: how far apart two accumulations of the same samples
+   are (a fold against a split, threaded or distributed fold of it):
+   *apart receives the largest moment difference, each relative to the
+   size N s^d its N terms can reach (d its degree, s the largest extent of
+   b's box about the reference).  The exact parts must agree: FE_EMISMATCH
+   when the counts, references or boxes differ; FE_EINVAL for NULL.  Both
+   must hold the same reference (recentre one first).  No allocation. */
+int fe_quadric_compare(const fe_quadric *a, const fe_quadric *b, double *apart);
+
 /* fe_quadric_count: N.  fe_quadric_regions: the number of regions
    visited while the box was at least half its final size (its largest
    half-width).  fe_quadric_coverage: their fraction of 100, in [0, 1]. */
