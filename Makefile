@@ -115,7 +115,7 @@ MPI_NP       ?= 2
 MPIRUN        = mpirun -np $(MPI_NP) --oversubscribe $(if $(filter 0,$(shell id -u)),--allow-run-as-root)
 MPI_PROGS    := $(patsubst examples/mpi/%.c,$(B)/mpi/%,$(wildcard examples/mpi/*.c))
 
-$(B)/mpi/%: examples/mpi/%.c include/foldest/mpi.h $(STATIC)
+$(B)/mpi/%: examples/mpi/%.c $(wildcard examples/mpi/*.h) include/foldest/mpi.h $(STATIC)
 	@mkdir -p $(@D)
 	$(MPICC) $(WARN) $(CFLAGS) -Iinclude -o $@ $< $(STATIC) $(EXT_LIBS)
 

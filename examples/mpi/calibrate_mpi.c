@@ -19,6 +19,8 @@
 
 #include <foldest/mpi.h>
 
+#include "options.h"
+
 FE_MPI_DEFINE_REDUCTION(qm, fe_quadric, fe_quadric_accumulator(NULL));
 
 enum { PIECE = 4096 };
@@ -90,12 +92,7 @@ int main(int argc, char **argv)
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    for (int i = 1; i + 1 < argc; i++) {
-        if (strcmp(argv[i], "-n") == 0)
-            n = (size_t)strtod(argv[++i], NULL);
-        else if (strcmp(argv[i], "-nan") == 0)
-            nan_at = (size_t)strtod(argv[++i], NULL);
-    }
+    example_options(argc, argv, &n, &nan_at);
 
     /* 1. Each rank folds its shard: the cut of the threads. */
     fe_parallel_chunk(n, (unsigned)size, (unsigned)rank, &begin, &end);

@@ -26,6 +26,8 @@
 
 #include <foldest/mpi.h>
 
+#include "options.h"
+
 enum {
     M = 5,                      /* candidate columns */
     K = 10,                     /* time blocks */
@@ -140,12 +142,7 @@ int main(int argc, char **argv)
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    for (int i = 1; i + 1 < argc; i++) {
-        if (strcmp(argv[i], "-n") == 0)
-            n = (size_t)strtod(argv[++i], NULL);
-        else if (strcmp(argv[i], "-nan") == 0)
-            nan_at = (size_t)strtod(argv[++i], NULL);
-    }
+    example_options(argc, argv, &n, &nan_at);
 
     /* 1. Each rank's part knows where it starts (row0 = its first row), so
        its rows land in the same blocks as in one fold. */

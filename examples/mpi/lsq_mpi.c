@@ -19,6 +19,8 @@
 
 #include <foldest/mpi.h>
 
+#include "options.h"
+
 /* The model: y = b0 + b1 t + b2 sin(2 pi t) + b3 cos(2 pi t) + b4 t^2. */
 enum { P = 5, CAPACITY = (P + 1) * (P + 1), PIECE = 4096 };
 
@@ -90,12 +92,7 @@ int main(int argc, char **argv)
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    for (int i = 1; i + 1 < argc; i++) {
-        if (strcmp(argv[i], "-n") == 0)
-            n = (size_t)strtod(argv[++i], NULL);
-        else if (strcmp(argv[i], "-nan") == 0)
-            nan_at = (size_t)strtod(argv[++i], NULL);
-    }
+    example_options(argc, argv, &n, &nan_at);
 
     /* 1. Each rank binds its normal equations to its cell's storage and
        folds its shard into them. */

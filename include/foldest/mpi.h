@@ -72,6 +72,21 @@ static inline void fe_mpi_reduction_free(fe_mpi_reduction *r)
     MPI_Type_free(&r->type);
 }
 /* Create and free the MPI handles ends here */
+/* [[file:../../literate/mpi.org::Record a rank's outcome in its cell][Record a rank's outcome in its cell]] */
+/* name##_cell_record(c, rc, done): the outcome of the rank's fold; the
+   first refusal is kept.  Ends the definitions (swallows the semicolon). */
+#define FE__MPI_DEFINE_CELL_RECORD(name)                                     \
+    static inline void name##_cell_record(name##_cell *c, int rc,            \
+                                          size_t done)                       \
+    {                                                                        \
+        if (c->status != FE_OK)                                              \
+            return;                                                          \
+        c->done = (uint64_t)done;                                            \
+        c->status = rc;                                                      \
+        c->rank = rc != FE_OK ? c->first : -1;                               \
+    }                                                                        \
+    typedef int name##_defined_ /* swallow the caller's semicolon */
+/* Record a rank's outcome in its cell ends here */
 /* [[file:../../literate/mpi.org::Define a reduction for one accumulation type][Define a reduction for one accumulation type]] */
 #define FE_MPI_DEFINE_REDUCTION(name, type, accumulator)                     \
     typedef struct name##_cell {                                             \
@@ -124,16 +139,7 @@ static inline void fe_mpi_reduction_free(fe_mpi_reduction *r)
         return c->status;                                                    \
     }                                                                        \
                                                                              \
-    static inline void name##_cell_record(name##_cell *c, int rc,            \
-                                          size_t done)                       \
-    {                                                                        \
-        if (c->status != FE_OK)                                              \
-            return;                                                          \
-        c->done = (uint64_t)done;                                            \
-        c->status = rc;                                                      \
-        c->rank = rc != FE_OK ? c->first : -1;                               \
-    }                                                                        \
-    typedef int name##_defined_ /* swallow the caller's semicolon */
+    FE__MPI_DEFINE_CELL_RECORD(name)
 /* Define a reduction for one accumulation type ends here */
 /* [[file:../../literate/mpi.org::Define a reduction for accumulations bound to storage][Define a reduction for accumulations bound to storage]] */
 #define FE_MPI_DEFINE_BOUND_REDUCTION(name, type, accumulator, capacity,     \
@@ -203,16 +209,7 @@ static inline void fe_mpi_reduction_free(fe_mpi_reduction *r)
         c->status = FE_OK;                                                   \
     }                                                                        \
                                                                              \
-    static inline void name##_cell_record(name##_cell *c, int rc,            \
-                                          size_t done)                       \
-    {                                                                        \
-        if (c->status != FE_OK)                                              \
-            return;                                                          \
-        c->done = (uint64_t)done;                                            \
-        c->status = rc;                                                      \
-        c->rank = rc != FE_OK ? c->first : -1;                               \
-    }                                                                        \
-    typedef int name##_defined_ /* swallow the caller's semicolon */
+    FE__MPI_DEFINE_CELL_RECORD(name)
 /* Define a reduction for accumulations bound to storage ends here */
 /* [[file:../../literate/mpi.org::Rebind the accumulations that travel in cells][Rebind the accumulations that travel in cells]] */
 /* fe_mpi_rebind_lsq: a->g <- storage (the whole layout of fe_lsq_init). */
