@@ -67,7 +67,8 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
 
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
-   value is not finite; FE_EINVAL when row0 is FE_DISCOVER_ROW_UNKNOWN (use
+   value is not finite or the sums would overflow (values above 1e100 are
+   checked); FE_EINVAL when row0 is FE_DISCOVER_ROW_UNKNOWN (use
    fe_discover_add_row).  Cost about 1.5 M (M + 1) multiply-adds
    (fe_discover_add_rows is the fast path for many rows). */
 int fe_discover_add(fe_discover_acc *a, const double *phi, double r);

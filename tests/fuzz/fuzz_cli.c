@@ -19,8 +19,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    snprintf(dir, sizeof dir, "/tmp/foldest-fuzz-cli-XXXXXX");
-    REQUIRE(mkdtemp(dir) != NULL);
+    fe_fuzz_scratch("foldest-fuzz-cli", dir, sizeof dir);
     REQUIRE(chdir(dir) == 0);
     return 0;
 }

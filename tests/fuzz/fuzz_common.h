@@ -187,4 +187,27 @@ static int fe_json_valid(const char *s)
     return end != NULL && *fe_json_ws(end) == '\0';
 }
 
+/* A scratch directory /tmp/PREFIX-XXXXXX for the run, written into dir
+   (at least 64 bytes) and removed with what it holds when the process
+   exits normally (libFuzzer's time limit ends with exit). */
+static char fe_fuzz_scratch_dir[64];
+
+static void fe_fuzz_scratch_remove(void)
+{
+    char cmd[128];
+    if (fe_fuzz_scratch_dir[0] == '\0')
+        return;
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", fe_fuzz_scratch_dir);
+    if (system(cmd) != 0)
+        fprintf(stderr, "fuzz: could not remove %s\n", fe_fuzz_scratch_dir);
+}
+
+static void fe_fuzz_scratch(const char *prefix, char *dir, size_t len)
+{
+    snprintf(dir, len, "/tmp/%s-XXXXXX", prefix);
+    REQUIRE(mkdtemp(dir) != NULL);
+    snprintf(fe_fuzz_scratch_dir, sizeof fe_fuzz_scratch_dir, "%s", dir);
+    REQUIRE(atexit(fe_fuzz_scratch_remove) == 0);
+}
+
 #endif /* FE_FUZZ_COMMON_H */

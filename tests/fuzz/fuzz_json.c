@@ -15,8 +15,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    snprintf(dir, sizeof dir, "/tmp/foldest-fuzz-json-XXXXXX");
-    REQUIRE(mkdtemp(dir) != NULL);
+    fe_fuzz_scratch("foldest-fuzz-json", dir, sizeof dir);
     return 0;
 }
 

@@ -213,8 +213,6 @@ static void fuzz_kalman(in *s, unsigned shape)
                 REQUIRE(count == k.count);
             } else {
                 REQUIRE(finite_all(k.x, n) && finite_all(k.P, n * n));
-                if (!(isfinite(r.nis) && r.nis >= 0 && isfinite(r.log_det_D)))
-                    fprintf(stderr, "kalman n=%zu b=%zu fast=%d: nis %g log det D %g; A %g z %g Z %g\n", n, o.b, fast, r.nis, r.log_det_D, A[0], z[0], Z[0]);
                 REQUIRE(isfinite(r.nis) && r.nis >= 0 && isfinite(r.log_det_D));
                 memcpy(&msnap, &mon, sizeof mon);
                 rc = fe_kalman_monitor_add(&mon, &r);
