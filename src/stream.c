@@ -26,6 +26,62 @@ int fe_source_rewind(fe_source *src)
     return src->rewind(src->self);
 }
 
+static int fe__array_next(void *self, const void **obs);
+static int fe__fd_next(void *self, const void **obs);
+
+/* The observations of one of the library's own sources that are already
+   in memory, one after another: their number, *obs the first.  0 for any
+   other source, or when more must be read. */
+static size_t fe__source_in_memory(const fe_source *src, const void **obs)
+{
+    if (src->next == fe__array_next) {
+        const fe_array_source *s = src->self;
+        *obs = s->base + s->pos * s->obs_size;
+        return s->count - s->pos;
+    }
+    if (src->next == fe__fd_next) {
+        const fe_fd_source *s = src->self;
+        *obs = s->buf + s->pos;
+        return (s->len - s->pos) / s->obs_size;
+    }
+    return 0;
+}
+
+/* Consume n of those observations. */
+static void fe__source_consume(fe_source *src, size_t n)
+{
+    if (src->next == fe__array_next)
+        ((fe_array_source *)src->self)->pos += n;
+    else
+        ((fe_fd_source *)src->self)->pos += n * src->obs_size;
+}
+
+/* Fold a source with the accumulator's step_many, in batches of what the
+   source holds in memory. */
+static int fe__fold_source_many(const fe_accumulator *f, void *acc,
+                                fe_source *src, size_t *done)
+{
+    size_t total = 0;
+    int rc = FE_OK;
+    while (rc == FE_OK) {
+        const void *obs;
+        size_t n = fe__source_in_memory(src, &obs), k = 0;
+        if (n > 0) {
+            rc = f->step_many(acc, obs, n, &k, f->ctx);
+            fe__source_consume(src, rc == FE_OK ? n : k + 1);
+        } else {
+            rc = src->next(src->self, &obs);
+            if (rc == FE_OK) {
+                rc = f->step(acc, obs, f->ctx);
+                k = rc == FE_OK;
+            }
+        }
+        total += k;
+    }
+    *done = total;
+    return rc == FE_END ? FE_OK : rc;
+}
+
 int fe_scan_source(const fe_accumulator *f, void *acc, fe_source *src,
                    fe_visit_fn *visit, void *visit_ctx, size_t *done)
 {
@@ -37,6 +93,13 @@ int fe_scan_source(const fe_accumulator *f, void *acc, fe_source *src,
     if (f == NULL || f->step == NULL || acc == NULL || src == NULL
         || src->next == NULL || src->obs_size != f->obs_size)
         return FE_EINVAL;
+    if (visit == NULL && f->step_many != NULL) {
+        size_t k = 0;
+        rc = fe__fold_source_many(f, acc, src, &k);
+        if (done != NULL)
+            *done = k;
+        return rc;
+    }
     if (visit != NULL)
         rc = visit(acc, 0, visit_ctx);
     while (rc == FE_OK) {

@@ -105,6 +105,57 @@ START_TEST(fd_source_reads_records_through_a_small_buffer)
 }
 END_TEST
 
+START_TEST(batched_fold_stops_exactly_at_the_refused_observation)
+{
+    /* The library's own sources are folded in batches through step_many;
+       a refusal must look as it does one observation at a time: the fold
+       of those before it, *done their number, and the source just past the
+       refused one.  Array source, then a file read through 64 doubles. */
+    enum { N = 1000, BAD = 617 };
+    static double x[N];
+    double buf[64];
+    char path[] = "/tmp/foldest-test-XXXXXX";
+    fe_accumulator f = fe_meanvar_accumulator();
+    for (int how = 0; how < 2; how++) {
+        fe_array_source as;
+        fe_fd_source fs;
+        fe_source src;
+        fe_meanvar a = FE_MEANVAR_EMPTY, want = FE_MEANVAR_EMPTY;
+        const void *obs;
+        size_t done = 0, wdone = 0;
+        int fd = -1;
+        for (int i = 0; i < N; i++)
+            x[i] = 3.0 + 0.25 * i;
+        x[BAD] = NAN;
+        if (how == 0) {
+            ck_assert_int_eq(fe_source_from_array(&src, &as, x, N, sizeof(double)), FE_OK);
+        } else {
+            fd = mkstemp(path);
+            ck_assert_int_ge(fd, 0);
+            unlink(path);
+            ck_assert_int_eq(write(fd, x, sizeof x), (ssize_t)sizeof x);
+            ck_assert_int_eq(lseek(fd, 0, SEEK_SET), 0);
+            ck_assert_int_eq(fe_source_from_fd(&src, &fs, fd, sizeof(double), buf, sizeof buf),
+                             FE_OK);
+        }
+        ck_assert_int_eq(fe_fold_source(&f, &a, &src, &done), FE_ENONFINITE);
+        ck_assert_uint_eq(done, BAD);
+        ck_assert_int_eq(fe_meanvar_add_many(&want, x, N, &wdone), FE_ENONFINITE);
+        ck_assert_uint_eq(wdone, BAD);
+        ck_assert_uint_eq(a.n, BAD);
+        FE_ASSERT_REL(a.mean, want.mean, 1e-14);
+        FE_ASSERT_REL(a.m2, want.m2, 1e-12);
+        ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+        ck_assert_double_eq(*(const double *)obs, x[BAD + 1]);
+        ck_assert_int_eq(fe_fold_source(&f, &a, &src, &done), FE_OK);
+        ck_assert_uint_eq(done, N - BAD - 2);
+        ck_assert_uint_eq(a.n, N - 2);
+        if (fd >= 0)
+            close(fd);
+    }
+}
+END_TEST
+
 START_TEST(fd_source_on_a_pipe_cannot_rewind)
 {
     int p[2];
@@ -153,6 +204,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, generator_source_in_constant_memory);
     tcase_add_test(t, fd_source_reads_records_through_a_small_buffer);
     tcase_add_test(t, fd_source_on_a_pipe_cannot_rewind);
+    tcase_add_test(t, batched_fold_stops_exactly_at_the_refused_observation);
     tcase_add_test(t, bad_arguments_and_mismatched_sizes);
     suite_add_tcase(s, t);
     return s;
