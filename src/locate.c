@@ -239,7 +239,6 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
             cur.z = zn;
             cur.t = za;
             cur.p_value = 2.0;
-            cur.region[0] = '\0';
             dof = nis = acf = acf_terms = sq = sq_terms = 0;
             open = 1;
         }
@@ -280,20 +279,14 @@ int fe_located_json(const fe_located *l, char *buf, size_t len)
     if (l == NULL || buf == NULL || len == 0)
         return FE_EINVAL;
     buf[0] = '\0';
-    if (l->is_time)
-        n = snprintf(buf, len, "{\"kind\": \"time\", \"recording\": %d, \"end_recording\": %d",
-                     l->pair + 1, l->pair1 + 1);
-    else
-        n = snprintf(buf, len, "{\"kind\": \"state\", \"variable\": \"%s\", \"region\": \"%s\"",
-                     l->variable != NULL ? l->variable : "", l->region);
+    n = snprintf(buf, len, "{\"kind\": \"time\", \"recording\": %d, \"end_recording\": %d",
+                 l->pair + 1, l->pair1 + 1);
     if (n < 0 || (size_t)n >= len)
         return FE_ESIZE;
     at = (size_t)n;
-    if (l->is_time) {
-        rc = fe__json_num(buf, len, &at, "start", l->t0);
-        if (rc == FE_OK)
-            rc = fe__json_num(buf, len, &at, "end", l->t1);
-    }
+    rc = fe__json_num(buf, len, &at, "start", l->t0);
+    if (rc == FE_OK)
+        rc = fe__json_num(buf, len, &at, "end", l->t1);
     if (rc == FE_OK)
         rc = fe__json_num(buf, len, &at, "rows", l->n);
     if (rc == FE_OK)

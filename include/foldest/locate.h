@@ -9,15 +9,15 @@
 #include "foldest/discover.h"
 #include "foldest/kalman.h"
 
-/* One located place: a time window (or a region of the state).  The
-   statistic is on the standard normal scale. */
+/* One located time window.  The statistics are on the standard normal
+   scale. */
 typedef struct fe_located {
-    int is_time;                /* 1: a time window; 0: a region of the state */
+    int is_time;                /* 1: a time window (the only kind located
+                                   from innovations; the command's own list
+                                   also has regions of the state) */
     const char *test;           /* what located it: "nis", "innovation_acf" */
     double t0, t1;              /* time of its first and last row */
     int pair, pair1;            /* recordings (from 0) of those rows */
-    const char *variable;       /* a region's variable (NULL for time) */
-    char region[64];            /* a region's description ("" for time) */
     double n;                   /* rows (Kalman reports) in it */
     double z;                   /* largest NIS statistic of its blocks */
     double t;                   /* autocorrelation statistic largest in size */
