@@ -768,6 +768,24 @@ int fe_sphere_fit_moments(const fe_quadric *q, fe_sphere_model model,
     return fe__sphere_run(q, model, opt, &pr, fit, 0);
 }
 
+int fe_sphere_fit_algebraic(const fe_quadric *q, const fe_sphere_options *opt,
+                            fe_sphere_fit *fit)
+{
+    fe_sphere_options defaults = fe_sphere_default_options();
+    fe__sphere_problem pr;
+    double beta[FE__P];
+    int rc;
+    if (q == NULL || fit == NULL)
+        return FE_EINVAL;
+    if (opt == NULL)
+        opt = &defaults;
+    rc = fe__sphere_setup(q, FE_FIT_SPHERE, opt, &pr, fit, beta);
+    if (rc != FE_OK)
+        return rc;
+    pr.build = fe__sphere_build_moments;
+    return fe__sphere_algebraic(&pr, q, opt, fit);
+}
+
 static int fe__sphere_fit_samples(const double *xyz, size_t n,
                                   fe_sphere_model model,
                                   const fe_sphere_options *opt, double *work,

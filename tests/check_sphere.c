@@ -263,6 +263,36 @@ START_TEST(runaway_sphere_falls_back_to_the_algebraic_sphere)
 }
 END_TEST
 
+START_TEST(algebraic_sphere_on_its_own)
+{
+    /* Where Schmidt's sphere converges the algebraic one is still there on
+       request: the linear fit, equal to a direct solve, flagged, and
+       refused by the same checks (planar data). */
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f, schmidt;
+    double b[3], radius;
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 77);
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, NULL, &schmidt), FE_OK);
+    ck_assert_int_eq(schmidt.algebraic, 0);
+    ck_assert_int_eq(fe_sphere_fit_algebraic(&q, NULL, &f), FE_OK);
+    ck_assert_int_eq(f.algebraic, 1);
+    algebraic_sphere(x, N, b, &radius);
+    for (int j = 0; j < 3; j++)
+        ck_assert_double_le(fabs(f.offset[j] - b[j]) / radius, 1e-10);
+    FE_ASSERT_REL(f.radius, radius, 1e-10);
+    ck_assert_int_eq(fe_sphere_fit_algebraic(NULL, NULL, &f), FE_EINVAL);
+    for (size_t i = 0; i < N; i++)
+        x[3 * i + 2] = C0[2];                   /* flatten into a plane */
+    q = (fe_quadric)FE_QUADRIC_EMPTY;
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_algebraic(&q, NULL, &f), FE_EUNDETERMINED);
+    ck_assert_int_eq(f.refusal, FE_SPHERE_PLANAR);
+}
+END_TEST
+
 START_TEST(trace_and_stop)
 {
     enum { N = 3000 };
@@ -742,6 +772,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);
+    tcase_add_test(t, algebraic_sphere_on_its_own);
     tcase_add_test(t, trace_and_stop);
     tcase_add_test(t, damping_when_a_step_fails);
     tcase_add_test(t, refuse_too_few_and_bad_arguments);

@@ -98,6 +98,15 @@ typedef struct fe_sphere_fit {
 int fe_sphere_fit_moments(const fe_quadric *q, fe_sphere_model model,
                           const fe_sphere_options *opt, fe_sphere_fit *fit);
 
+/* fe_sphere_fit_algebraic: the algebraic least-squares sphere, fitted
+   linearly from the moments (what fe_sphere_fit_moments falls back to when
+   Schmidt's sphere runs away; always defined for samples that are not
+   coplanar); fit->algebraic is 1.  Refusals as fe_sphere_fit_moments (too
+   few, planar, one-sided judged in the box's half-widths); after a fit the
+   struct holds the sphere even when refused.  No allocation. */
+int fe_sphere_fit_algebraic(const fe_quadric *q, const fe_sphere_options *opt,
+                            fe_sphere_fit *fit);
+
 /* fe_sphere_fit_stored: (ii), the same fit by accumulating J^T J and
    J^T r over the n stored samples xyz[3i..3i+2] at every iteration.
    Same errors as fe_sphere_fit_moments. */

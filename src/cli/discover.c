@@ -1383,37 +1383,15 @@ static int fe__discover_sphere(fe__sphere_args *a)
         fe_cli_table_close(&t);
         return FE_CLI_REFUSED;
     }
-    /* The sphere itself: the algebraic least-squares sphere
-       |d|^2 = 2 b'.d + c, d = x - x_1, from a second fold (always defined
-       when the data are not planar, unlike the geometric fit, which can run
-       off to a plane when the data are a strong ellipsoid). */
-    {
-        double g[25], w[25], coef[4], rss, ref[3] = {0, 0, 0};
-        fe_lsq ls;
-        fe_lsq_init(&ls, 4, g);
-        if ((rc = fe_cli_table_rewind(&t, err, sizeof err)) != FE_CLI_OK)
-            goto fail;
-        for (size_t i = 0; (rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK; i++) {
-            double d[4];
-            if (i == 0)
-                memcpy(ref, v, sizeof ref);
-            d[0] = v[0] - ref[0];
-            d[1] = v[1] - ref[1];
-            d[2] = v[2] - ref[2];
-            d[3] = 1.0;
-            fe_lsq_add(&ls, d, d[0] * d[0] + d[1] * d[1] + d[2] * d[2], 1.0);
-        }
-        if (rc != FE_END)
-            goto fail;
-        if (fe_lsq_solve(&ls, NULL, 4, coef, &rss, NULL, w) != FE_OK) {
-            fprintf(stderr, "foldest discover: %s: no sphere fits these samples\n", t.name);
-            rc = FE_CLI_REFUSED;
-            goto done;
-        }
-        for (int i = 0; i < 3; i++)
-            fit.offset[i] = ref[i] + 0.5 * coef[i];
-        fit.radius = sqrt(coef[3] + 0.25 * (coef[0] * coef[0] + coef[1] * coef[1]
-                                            + coef[2] * coef[2]));
+    /* The sphere itself: the algebraic least-squares sphere, from the same
+       moments (always defined when the data are not planar, unlike the
+       geometric fit, which can run off to a plane when the data are a
+       strong ellipsoid).  One-sidedness was judged above. */
+    if (fe_sphere_fit_algebraic(&q, NULL, &fit) != FE_OK
+        && fit.refusal != FE_SPHERE_HEMISPHERE) {
+        fprintf(stderr, "foldest discover: %s: no sphere fits these samples\n", t.name);
+        rc = FE_CLI_REFUSED;
+        goto done;
     }
     held = (size_t)floor(a->holdout * (double)rows);
     fit_rows = rows - held;
