@@ -32,6 +32,7 @@ ORG          := $(wildcard literate/*.org)
 LIB_SRC      := $(wildcard src/*.c)
 CLI_SRC      := $(wildcard src/cli/*.c)
 HEADERS      := include/foldest.h $(wildcard include/foldest/*.h)
+PRIV_HEADERS := $(wildcard src/*.h)
 TEST_SRC     := $(wildcard tests/check_*.c)
 EXAMPLES     := $(patsubst examples/%.c,$(B)/examples/%,$(wildcard examples/*.c))
 BENCHES      := $(patsubst bench/%.c,$(B)/bench/%,$(wildcard bench/*.c))
@@ -65,7 +66,7 @@ $(B)/.deps: .ci/deps
 # ---------------------------------------------------------------- library
 lib: $(STATIC) $(SHARED)
 
-$(B)/obj/%.o: src/%.c $(HEADERS) $(B)/.deps
+$(B)/obj/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) $(CFLAGS) -fPIC -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
@@ -166,7 +167,7 @@ $(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/s
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS) $(LDFLAGS)
 
-$(B)/san/%.o: src/%.c $(HEADERS) $(B)/.deps
+$(B)/san/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
@@ -175,7 +176,7 @@ $(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tes
 	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
 # The parallel folds again, library and tests built with ThreadSanitizer.
-$(B)/tsan/%.o: src/%.c $(HEADERS) $(B)/.deps
+$(B)/tsan/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
@@ -235,7 +236,7 @@ FUZZERS      := $(patsubst tests/fuzz/%.c,$(B)/fuzz/%,$(wildcard tests/fuzz/fuzz
 FUZZ_LIB_OBJ := $(patsubst src/%.c,$(B)/fuzz/obj/%.o,$(LIB_SRC))
 FUZZ_CLI_OBJ := $(patsubst src/cli/%.c,$(B)/fuzz/obj/cli/%.o,$(CLI_SRC))
 
-$(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(B)/.deps
+$(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 $(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps

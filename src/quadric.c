@@ -2,6 +2,7 @@
 /* [[file:../literate/quadric.org::Quadric Includes][Quadric Includes]] */
 #include "foldest/error.h"
 #include "foldest/quadric.h"
+#include "lanes.h"
 
 enum { FE__QUADRIC_BLOCK = 512 };
 
@@ -139,48 +140,9 @@ int fe_quadric_add(fe_quadric *q, const double x[3])
 }
 /* Fold one sample into the moments ends here */
 /* [[file:../literate/quadric.org::Compile the kernel for four and eight lanes][Compile the kernel for four and eight lanes]] */
-/* No clones under ThreadSanitizer: the loader runs the clone's resolver
-   before the sanitizer's runtime is up, and the instrumented resolver
-   crashes. */
-#if defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define FE__QUADRIC_TSAN 1
-#endif
-#endif
-#if defined(__SANITIZE_THREAD__)
-#define FE__QUADRIC_TSAN 1
-#endif
-
-#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__) \
-    && !defined(FE_NO_CLONES)
-#define FE__QUADRIC_X86 1
-#endif
-
-#if defined(__GNUC__)
-#define FE__PREFETCH(p) __builtin_prefetch((p), 0, 3)
-#else
-#define FE__PREFETCH(p) ((void)(p))
-#endif
-
-/* Contract x * y + s into one fused multiply-add: GCC needs asking. */
-#if defined(__GNUC__) && !defined(__clang__)
-#define FE__QUADRIC_CONTRACT optimize("fp-contract=fast"),
-#define FE__QUADRIC_WIDE_TARGET target("avx512f,fma,prefer-vector-width=512")
-#else
-#define FE__QUADRIC_CONTRACT
-#define FE__QUADRIC_WIDE_TARGET target("avx512f,fma")
-#endif
-
-#if defined(FE__QUADRIC_X86) && !defined(FE__QUADRIC_TSAN)
-#define FE__QUADRIC_KERNEL \
-    __attribute__((FE__QUADRIC_CONTRACT target_clones("fma", "default")))
-#else
-#define FE__QUADRIC_KERNEL
-#endif
-
 #define FE__L 4
 #define FE__QUADRIC_BLOCK_FN fe__quadric_block4
-FE__QUADRIC_KERNEL
+FE__LANES_CLONES
 static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
                                  const double *next, int nnext,
                                  double out[35], double rlo[3], double rhi[3])
@@ -303,10 +265,10 @@ static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
 #undef FE__L
 #undef FE__QUADRIC_BLOCK_FN
 
-#if defined(FE__QUADRIC_X86)
+#if defined(FE__LANES_X86)
 #define FE__L 8
 #define FE__QUADRIC_BLOCK_FN fe__quadric_block8
-__attribute__((FE__QUADRIC_CONTRACT FE__QUADRIC_WIDE_TARGET))
+FE__LANES_WIDE
 static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
                                  const double *next, int nnext,
                                  double out[35], double rlo[3], double rhi[3])
@@ -436,8 +398,8 @@ static void fe__quadric_block(const double *b, int n, const double ref[3],
                               const double *next, int nnext, double out[35],
                               double rlo[3], double rhi[3])
 {
-#if defined(FE__QUADRIC_X86)
-    if (__builtin_cpu_supports("avx512f")) {
+#if defined(FE__LANES_X86)
+    if (FE__LANES_HAVE_WIDE()) {
         fe__quadric_block8(b, n, ref, next, nnext, out, rlo, rhi);
         return;
     }
