@@ -9,6 +9,7 @@
 #include "foldest/discover.h"
 #include "foldest/error.h"
 #include "foldest/special.h"
+#include "lanes.h"
 
 /* Element (i, j) of a symmetric matrix stored in its upper triangle. */
 static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
@@ -52,11 +53,19 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
                          uint64_t fit_rows, uint64_t row0, double *storage,
                          size_t storage_doubles)
 {
+    return fe_discover_screen_init(a, m, m, blocks, fit_rows, row0, storage,
+                                   storage_doubles);
+}
+
+int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
+                            size_t blocks, uint64_t fit_rows, uint64_t row0,
+                            double *storage, size_t storage_doubles)
+{
     size_t need;
     if (a == NULL || storage == NULL)
         return FE_EINVAL;
     if (m == 0 || m > FE_DISCOVER_MAX_COLUMNS || blocks < 2
-        || blocks > FE_DISCOVER_MAX_BLOCKS)
+        || blocks > FE_DISCOVER_MAX_BLOCKS || base_cols > m)
         return FE_ESIZE;
     need = fe_discover_acc_doubles(m, blocks);
     if (storage_doubles < need)
@@ -66,6 +75,7 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     memset(storage, 0, need * sizeof *storage);
     a->m = m;
     a->blocks = blocks;
+    a->base_cols = base_cols;
     a->fit_rows = fit_rows;
     a->row0 = row0;
     a->n = 0;
@@ -75,15 +85,44 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
     return FE_OK;
 }
 
-/* Add the folded z p^T to T: z_i p_i on the diagonal, z_i p_j + p_i z_j above. */
-static void fe__discover_lag_pair(double *t, size_t dim, const double *z, const double *p)
+/* The columns kept whole are the base columns and r: the u-th of them,
+   u <= base_cols. */
+static size_t fe__discover_whole(const fe_discover_acc *a, size_t u)
 {
-    for (size_t i = 0; i < dim; i++) {
+    return u < a->base_cols ? u : a->m;
+}
+
+/* Whether entry (i, j), i <= j, of a block's triangle is kept: always in
+   a full accumulation; in a screen, when i is kept whole, j is r, or j is
+   one of the next two columns after i. */
+static int fe__discover_kept(const fe_discover_acc *a, size_t i, size_t j)
+{
+    return i < a->base_cols || j == a->m || j - i < FE_DISCOVER_MAX_GROUP_SIZE;
+}
+
+/* Where the kept entries of row i of a triangle end: the band's end, or
+   the row's (r is then added on its own when the band stops short). */
+static size_t fe__discover_row_end(const fe_discover_acc *a, size_t i)
+{
+    size_t dim = a->m + 1, band = i + FE_DISCOVER_MAX_GROUP_SIZE;
+    return i < a->base_cols || band > dim ? dim : band;
+}
+
+/* Add the folded z p^T to T among the columns kept whole: z_i p_i on the
+   diagonal, z_i p_j + p_i z_j above. */
+static void fe__discover_lag_pair(const fe_discover_acc *a, const double *z,
+                                  const double *p)
+{
+    size_t dim = a->m + 1, nr = a->base_cols + 1;
+    for (size_t u = 0; u < nr; u++) {
+        size_t i = fe__discover_whole(a, u);
         double zi = z[i], pi = p[i];
-        double *ti = t + i * dim;
+        double *ti = a->lag + i * dim;
         ti[i] += zi * pi;
-        for (size_t j = i + 1; j < dim; j++)
+        for (size_t v = u + 1; v < nr; v++) {
+            size_t j = fe__discover_whole(a, v);
             ti[j] += zi * p[j] + pi * z[j];
+        }
     }
 }
 
@@ -120,33 +159,38 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     g = a->gram + k * dim * dim;
     if (fe__discover_large(z, dim) || (a->have_prev && k < a->blocks
                                        && fe__discover_large(a->last, dim))) {
-        /* The slow path: every new sum must be finite before any is written. */
+        /* The slow path: every new sum kept must be finite before any is
+           written. */
         for (size_t i = 0; i < dim; i++)
             for (size_t j = i; j < dim; j++)
-                if (!isfinite(g[i * dim + j] + z[i] * z[j]))
+                if (fe__discover_kept(a, i, j) && !isfinite(g[i * dim + j] + z[i] * z[j]))
                     return FE_ENONFINITE;
         if (a->have_prev && k < a->blocks)
-            for (size_t i = 0; i < dim; i++)
-                for (size_t j = i; j < dim; j++) {
+            for (size_t u = 0; u <= a->base_cols; u++)
+                for (size_t v = u; v <= a->base_cols; v++) {
                     const double *p = a->last;
+                    size_t i = fe__discover_whole(a, u), j = fe__discover_whole(a, v);
                     double add = j == i ? z[i] * p[i] : z[i] * p[j] + p[i] * z[j];
                     if (!isfinite(a->lag[i * dim + j] + add))
                         return FE_ENONFINITE;
                 }
     }
-    /* Add z z^T to the block's upper triangle. */
+    /* Add z z^T to the block's upper triangle, where it is kept. */
     for (size_t i = 0; i < dim; i++) {
         double zi = z[i];
         double *gi = g + i * dim;
+        size_t end = fe__discover_row_end(a, i);
         if (zi == 0.0)
             continue;
-        for (size_t j = i; j < dim; j++)
+        for (size_t j = i; j < end; j++)
             gi[j] += zi * z[j];
+        if (end < dim)
+            gi[a->m] += zi * z[a->m];
     }
     a->counts[k] += 1.0;
     /* Add z_t z_{t-1}^T, folded, when the previous row is a fitted neighbour. */
     if (a->have_prev && k < a->blocks)
-        fe__discover_lag_pair(a->lag, dim, z, a->last);
+        fe__discover_lag_pair(a, z, a->last);
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
@@ -170,7 +214,8 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     size_t dim, total;
     if (a == NULL || b == NULL)
         return FE_EINVAL;
-    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows)
+    if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
+        || a->base_cols != b->base_cols)
         return FE_EMISMATCH;
     if (b->n == 0) {            /* the identity, carrying b's break if any */
         if (!b->first_linked)
@@ -192,7 +237,7 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     /* The lag product across the cut. */
     if (a->n > 0 && a->have_prev && b->first_linked
         && fe__discover_block(a, b->row0) < a->blocks)
-        fe__discover_lag_pair(a->lag, dim, b->first, a->last);
+        fe__discover_lag_pair(a, b->first, a->last);
     if (a->n == 0) {
         memcpy(a->first, b->first, dim * sizeof *a->first);
         a->first_linked = b->first_linked;
@@ -282,7 +327,364 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
     a->have_prev = fitted;
     a->n += q;
 }
+/* Fold a panel of rows ends here */
+/* [[file:../literate/discover.org::Compile the discovery kernels][Compile the discovery kernels]] */
+#define FE__L 4
+#define FE__DISCOVER_DOTS_FN fe__discover_dots4
+#define FE__DISCOVER_BAND_FN fe__discover_band4
+#define FE__DISCOVER_TARGET FE__LANES_CLONES
+/* out[4 a + c] += sum_{t < q} x[a][t] y[c][t], a, c < 4. */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_DOTS_FN(const double *const *x, const double *const *y, size_t q,
+                                 double *out)
+{
+    const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *x3 = x[3];
+    const double *y0 = y[0], *y1 = y[1], *y2 = y[2], *y3 = y[3];
+    double s[16][FE__L] = {{0}};
+    size_t t;
+    for (t = 0; t + FE__L <= q; t += FE__L)
+        for (int l = 0; l < FE__L; l++) {
+            double a0 = x0[t + l], a1 = x1[t + l], a2 = x2[t + l], a3 = x3[t + l];
+            double b0 = y0[t + l], b1 = y1[t + l], b2 = y2[t + l], b3 = y3[t + l];
+            s[0][l] += a0 * b0;
+            s[1][l] += a0 * b1;
+            s[2][l] += a0 * b2;
+            s[3][l] += a0 * b3;
+            s[4][l] += a1 * b0;
+            s[5][l] += a1 * b1;
+            s[6][l] += a1 * b2;
+            s[7][l] += a1 * b3;
+            s[8][l] += a2 * b0;
+            s[9][l] += a2 * b1;
+            s[10][l] += a2 * b2;
+            s[11][l] += a2 * b3;
+            s[12][l] += a3 * b0;
+            s[13][l] += a3 * b1;
+            s[14][l] += a3 * b2;
+            s[15][l] += a3 * b3;
+        }
+    for (int c = 0; c < 16; c++) {
+        double v = 0.0;
+        for (int l = 0; l < FE__L; l++)
+            v += s[c][l];
+        for (size_t u = t; u < q; u++)
+            v += x[c / 4][u] * y[c % 4][u];
+        out[c] += v;
+    }
+}
 
+/* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
+   for d < 3 and j + d < n, four columns j at a time. */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out)
+{
+    for (size_t j = 0; j < n; j += 4) {
+        const double *p[6];
+        double s[12][FE__L] = {{0}}, v[12];
+        size_t t;
+        for (int c = 0; c < 6; c++)
+            p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
+        for (t = 0; t + FE__L <= q; t += FE__L)
+            for (int l = 0; l < FE__L; l++) {
+                double u0 = p[0][t + l], u1 = p[1][t + l], u2 = p[2][t + l],
+                       u3 = p[3][t + l], u4 = p[4][t + l], u5 = p[5][t + l];
+                s[0][l] += u0 * u0;
+                s[1][l] += u0 * u1;
+                s[2][l] += u0 * u2;
+                s[3][l] += u1 * u1;
+                s[4][l] += u1 * u2;
+                s[5][l] += u1 * u3;
+                s[6][l] += u2 * u2;
+                s[7][l] += u2 * u3;
+                s[8][l] += u2 * u4;
+                s[9][l] += u3 * u3;
+                s[10][l] += u3 * u4;
+                s[11][l] += u3 * u5;
+            }
+        for (int c = 0; c < 12; c++) {
+            v[c] = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                v[c] += s[c][l];
+            for (size_t u = t; u < q; u++)
+                v[c] += p[c / 3][u] * p[c / 3 + c % 3][u];
+        }
+        /* Keep the products that exist: (j + a, j + a + d) inside n. */
+        for (size_t a = 0; a < 4 && j + a < n; a++)
+            for (size_t d = 0; d < 3 && j + a + d < n; d++)
+                out[3 * (j + a) + d] += v[3 * a + d];
+    }
+}
+#undef FE__DISCOVER_TARGET
+#undef FE__L
+#undef FE__DISCOVER_DOTS_FN
+#undef FE__DISCOVER_BAND_FN
+
+#if defined(FE__LANES_X86)
+#define FE__L 8
+#define FE__DISCOVER_DOTS_FN fe__discover_dots8
+#define FE__DISCOVER_BAND_FN fe__discover_band8
+#define FE__DISCOVER_TARGET FE__LANES_WIDE
+/* out[4 a + c] += sum_{t < q} x[a][t] y[c][t], a, c < 4. */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_DOTS_FN(const double *const *x, const double *const *y, size_t q,
+                                 double *out)
+{
+    const double *x0 = x[0], *x1 = x[1], *x2 = x[2], *x3 = x[3];
+    const double *y0 = y[0], *y1 = y[1], *y2 = y[2], *y3 = y[3];
+    double s[16][FE__L] = {{0}};
+    size_t t;
+    for (t = 0; t + FE__L <= q; t += FE__L)
+        for (int l = 0; l < FE__L; l++) {
+            double a0 = x0[t + l], a1 = x1[t + l], a2 = x2[t + l], a3 = x3[t + l];
+            double b0 = y0[t + l], b1 = y1[t + l], b2 = y2[t + l], b3 = y3[t + l];
+            s[0][l] += a0 * b0;
+            s[1][l] += a0 * b1;
+            s[2][l] += a0 * b2;
+            s[3][l] += a0 * b3;
+            s[4][l] += a1 * b0;
+            s[5][l] += a1 * b1;
+            s[6][l] += a1 * b2;
+            s[7][l] += a1 * b3;
+            s[8][l] += a2 * b0;
+            s[9][l] += a2 * b1;
+            s[10][l] += a2 * b2;
+            s[11][l] += a2 * b3;
+            s[12][l] += a3 * b0;
+            s[13][l] += a3 * b1;
+            s[14][l] += a3 * b2;
+            s[15][l] += a3 * b3;
+        }
+    for (int c = 0; c < 16; c++) {
+        double v = 0.0;
+        for (int l = 0; l < FE__L; l++)
+            v += s[c][l];
+        for (size_t u = t; u < q; u++)
+            v += x[c / 4][u] * y[c % 4][u];
+        out[c] += v;
+    }
+}
+
+/* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
+   for d < 3 and j + d < n, four columns j at a time. */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out)
+{
+    for (size_t j = 0; j < n; j += 4) {
+        const double *p[6];
+        double s[12][FE__L] = {{0}}, v[12];
+        size_t t;
+        for (int c = 0; c < 6; c++)
+            p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
+        for (t = 0; t + FE__L <= q; t += FE__L)
+            for (int l = 0; l < FE__L; l++) {
+                double u0 = p[0][t + l], u1 = p[1][t + l], u2 = p[2][t + l],
+                       u3 = p[3][t + l], u4 = p[4][t + l], u5 = p[5][t + l];
+                s[0][l] += u0 * u0;
+                s[1][l] += u0 * u1;
+                s[2][l] += u0 * u2;
+                s[3][l] += u1 * u1;
+                s[4][l] += u1 * u2;
+                s[5][l] += u1 * u3;
+                s[6][l] += u2 * u2;
+                s[7][l] += u2 * u3;
+                s[8][l] += u2 * u4;
+                s[9][l] += u3 * u3;
+                s[10][l] += u3 * u4;
+                s[11][l] += u3 * u5;
+            }
+        for (int c = 0; c < 12; c++) {
+            v[c] = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                v[c] += s[c][l];
+            for (size_t u = t; u < q; u++)
+                v[c] += p[c / 3][u] * p[c / 3 + c % 3][u];
+        }
+        /* Keep the products that exist: (j + a, j + a + d) inside n. */
+        for (size_t a = 0; a < 4 && j + a < n; a++)
+            for (size_t d = 0; d < 3 && j + a + d < n; d++)
+                out[3 * (j + a) + d] += v[3 * a + d];
+    }
+}
+#undef FE__DISCOVER_TARGET
+#undef FE__L
+#undef FE__DISCOVER_DOTS_FN
+#undef FE__DISCOVER_BAND_FN
+#endif
+
+static void fe__discover_dots(const double *const *x, const double *const *y, size_t q,
+                              double *out)
+{
+#if defined(FE__LANES_X86)
+    if (FE__LANES_HAVE_WIDE()) {
+        fe__discover_dots8(x, y, q, out);
+        return;
+    }
+#endif
+    fe__discover_dots4(x, y, q, out);
+}
+
+static void fe__discover_band(const double *const *z, size_t n, size_t q, double *out)
+{
+#if defined(FE__LANES_X86)
+    if (FE__LANES_HAVE_WIDE()) {
+        fe__discover_band8(z, n, q, out);
+        return;
+    }
+#endif
+    fe__discover_band4(z, n, q, out);
+}
+/* Compile the discovery kernels ends here */
+/* [[file:../literate/discover.org::Fold a panel of columns][Fold a panel of columns]] */
+/* Whether panels take the column path: a screen, or a narrow full
+   accumulation. */
+static int fe__discover_by_columns(const fe_discover_acc *a)
+{
+    return a->base_cols < a->m || a->m + 1 <= 8;
+}
+
+/* out[a * ny + c] = sum_{t < q} col[xi[a]][t + xoff] col[yi[c]][t] for
+   a < nx, c < ny, in tiles of four by four (a short tile repeats a column
+   and drops its products). */
+static void fe__discover_cross(const double *const *col, const size_t *xi, size_t nx,
+                               size_t xoff, const size_t *yi, size_t ny, size_t q,
+                               double *out)
+{
+    for (size_t a = 0; a < nx; a += 4)
+        for (size_t c = 0; c < ny; c += 4) {
+            const double *x[4], *y[4];
+            double o[16] = {0};
+            size_t na = nx - a < 4 ? nx - a : 4, nc = ny - c < 4 ? ny - c : 4;
+            for (size_t k = 0; k < 4; k++) {
+                x[k] = col[xi[a + (k < na ? k : 0)]] + xoff;
+                y[k] = col[yi[c + (k < nc ? k : 0)]];
+            }
+            fe__discover_dots(x, y, q, o);
+            for (size_t k = 0; k < na; k++)
+                for (size_t h = 0; h < nc; h++)
+                    out[(a + k) * ny + c + h] = o[4 * k + h];
+        }
+}
+
+/* Fold the q rows of the columns col[0 .. m] (col[m] is r), all in block
+   k, and return 1; or return 0 and fold nothing when the panel's sums of
+   squares do not show every value to be at most 1e100 in magnitude. */
+static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
+                                     const double *const *col, size_t q)
+{
+    size_t dim = a->m + 1, m = a->m, nb = a->base_cols, nr = nb + 1;
+    size_t idx[FE_DISCOVER_MAX_COLUMNS + 1], whole[FE_DISCOVER_MAX_COLUMNS + 1] = {0};
+    double band[3 * FE_DISCOVER_MAX_COLUMNS], *out = a->work;  /* nr x dim <= dim x dim */
+    double *g = a->gram + k * dim * dim;
+    int fitted = k < a->blocks, linked = fitted && a->have_prev;
+
+    for (size_t j = 0; j < dim; j++)
+        idx[j] = j;
+    for (size_t u = 0; u < nr; u++)
+        whole[u] = fe__discover_whole(a, u);
+    /* The whole rows, each against every column: base column i keeps its
+       products with columns i .. m, r those with the others (its products
+       with the base columns are theirs). */
+    fe__discover_cross(col, whole, nr, 0, idx, dim, q, out);
+    if (nb < m) {
+        memset(band, 0, 3 * (m - nb) * sizeof *band);
+        fe__discover_band(col + nb, m - nb, q, band);
+    }
+    /* The guard, read off the sums: see the text. */
+    for (size_t u = 0; u < nr; u++)
+        if (!(out[u * dim + whole[u]] <= 1e200))
+            return 0;
+    for (size_t j = nb; j < m; j++)
+        if (!(band[3 * (j - nb)] <= 1e200))
+            return 0;
+    for (size_t u = 0; u < nr; u++) {
+        size_t i = whole[u];
+        for (size_t j = u < nb ? i : nb; j < dim; j++) {
+            if (i <= j)
+                g[i * dim + j] += out[u * dim + j];
+            else
+                g[j * dim + i] += out[u * dim + j];
+        }
+    }
+    /* The band of the other columns. */
+    for (size_t j = nb; j < m; j++)
+        for (size_t d = 0; d < 3 && j + d < m; d++)
+            g[j * dim + j + d] += band[3 * (j - nb) + d];
+    a->counts[k] += (double)q;
+    if (a->n == 0)
+        for (size_t c = 0; c < dim; c++)
+            a->first[c] = col[c][0];
+    /* The lag product among the whole columns: L_uv = sum_t z_t,i z_t-1,j,
+       with the row before the panel when it is a fitted neighbour. */
+    if (fitted && (linked || q > 1)) {
+        memset(out, 0, nr * nr * sizeof *out);
+        if (q > 1)
+            fe__discover_cross(col, whole, nr, 1, whole, nr, q - 1, out);
+        for (size_t u = 0; u < nr && linked; u++)
+            for (size_t v = 0; v < nr; v++)
+                out[u * nr + v] += col[whole[u]][0] * a->last[whole[v]];
+        for (size_t u = 0; u < nr; u++) {
+            double *t = a->lag + whole[u] * dim;
+            t[whole[u]] += out[u * nr + u];
+            for (size_t v = u + 1; v < nr; v++)
+                t[whole[v]] += out[u * nr + v] + out[v * nr + u];
+        }
+    }
+    for (size_t c = 0; c < dim; c++)
+        a->last[c] = col[c][q - 1];
+    a->have_prev = fitted;
+    a->n += q;
+    return 1;
+}
+
+/* Copy q rows, transposed, into the scratch panel's columns (ld
+   FE_DISCOVER_PANEL_ROWS), pointed to by col[0 .. m]; the count of rows
+   before the first with a value that is not finite or above 1e100 in
+   magnitude. */
+static size_t fe__discover_load_columns(fe_discover_acc *a, const double *phi,
+                                        size_t ldphi, const double *r, size_t q,
+                                        const double **col)
+{
+    size_t dim = a->m + 1, m = a->m;
+    double *z = a->work + dim * dim + dim;
+    for (size_t c = 0; c < dim; c++)
+        col[c] = z + c * FE_DISCOVER_PANEL_ROWS;
+    for (size_t t = 0; t < q; t++) {
+        const double *pt = phi + t * ldphi;
+        int ok = fabs(r[t]) <= 1e100;           /* false for NaN too */
+        for (size_t i = 0; i < m; i++) {
+            z[i * FE_DISCOVER_PANEL_ROWS + t] = pt[i];
+            ok &= fabs(pt[i]) <= 1e100;
+        }
+        z[m * FE_DISCOVER_PANEL_ROWS + t] = r[t];
+        if (!ok)
+            return t;
+    }
+    return q;
+}
+
+/* The count of rows before the first with a value the guard stops. */
+static size_t fe__discover_good_rows(const double *const *col, size_t n, size_t q)
+{
+    for (size_t t = 0; t < q; t++)
+        for (size_t c = 0; c < n; c++)
+            if (!(fabs(col[c][t]) <= 1e100))
+                return t;
+    return q;
+}
+
+/* The rows of the next panel: at most FE_DISCOVER_PANEL_ROWS of the
+   `left`, all in the block of the next row (returned in *k). */
+static size_t fe__discover_panel_rows(const fe_discover_acc *a, size_t left, size_t *k)
+{
+    uint64_t row = a->row0 + a->n;
+    size_t q = left < FE_DISCOVER_PANEL_ROWS ? left : FE_DISCOVER_PANEL_ROWS;
+    *k = fe__discover_block(a, row);
+    if (*k < a->blocks && fe__discover_cut(a, *k + 1) - row < q)
+        q = (size_t)(fe__discover_cut(a, *k + 1) - row);
+    return q;
+}
+/* Fold a panel of columns ends here */
+/* [[file:../literate/discover.org::Fold many rows][Fold many rows]] */
 int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
                          const double *r, size_t nrows, size_t *done)
 {
@@ -295,39 +697,91 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
         || (nrows > 1 && ldphi < a->m)
         || (nrows > 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN))
         return FE_EINVAL;
-    while (i < nrows) {
-        /* A panel: at most FE_DISCOVER_PANEL_ROWS rows, all in one block. */
-        uint64_t row = a->row0 + a->n;
-        size_t k = fe__discover_block(a, row), got = 0;
-        size_t q = nrows - i < FE_DISCOVER_PANEL_ROWS ? nrows - i : FE_DISCOVER_PANEL_ROWS;
-        if (k < a->blocks && fe__discover_cut(a, k + 1) - row < q)
-            q = (size_t)(fe__discover_cut(a, k + 1) - row);
+    while (i < nrows && rc == FE_OK) {
+        size_t k, got = 0, q = fe__discover_panel_rows(a, nrows - i, &k);
+        const double *col[FE_DISCOVER_MAX_COLUMNS + 1];
+        int by_columns = fe__discover_by_columns(a);
         if (!(a->have_prev && fe__discover_large(a->last, a->m + 1)))
-            got = fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
-        if (got > 0) {
-            fe__discover_panel(a, k, got);
+            got = by_columns
+                      ? fe__discover_load_columns(a, phi + i * ldphi, ldphi, r + i, q, col)
+                      : fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
+        if (got > 0 && (!by_columns || fe__discover_column_panel(a, k, col, got))) {
+            if (!by_columns)
+                fe__discover_panel(a, k, got);
             i += got;
             continue;
         }
         /* A row that is not finite, has a value above 1e100, or follows
-           one: the row step decides, with its guard against overflow. */
-        rc = fe_discover_add(a, phi + i * ldphi, r[i]);
-        if (rc != FE_OK)
-            break;
-        i++;
+           one (got == 0), or a panel whose sums the column path would not
+           trust: the row step decides, row by row, with its guard. */
+        for (size_t t = 0; t < (got > 0 ? got : 1) && rc == FE_OK; t++) {
+            rc = fe_discover_add(a, phi + i * ldphi, r[i]);
+            i += rc == FE_OK;
+        }
     }
     if (done != NULL)
         *done = i;
     return rc;
 }
-/* Fold a panel of rows ends here */
+
+int fe_discover_add_columns(fe_discover_acc *a, const double *phi, size_t ldphi,
+                            const double *r, size_t nrows, size_t *done)
+{
+    size_t i = 0;
+    int rc = FE_OK;
+
+    if (done != NULL)
+        *done = 0;
+    if (a == NULL || (nrows > 0 && (phi == NULL || r == NULL))
+        || (nrows > 0 && a->m > 1 && ldphi < nrows)
+        || (nrows > 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN))
+        return FE_EINVAL;
+    while (i < nrows && rc == FE_OK) {
+        size_t k, dim = a->m + 1, got = 0, q = fe__discover_panel_rows(a, nrows - i, &k);
+        const double *col[FE_DISCOVER_MAX_COLUMNS + 1];
+        double row[FE_DISCOVER_MAX_COLUMNS];
+        for (size_t c = 0; c < a->m; c++)
+            col[c] = phi + c * ldphi + i;
+        col[a->m] = r + i;
+        if (!(a->have_prev && fe__discover_large(a->last, dim))) {
+            if (fe__discover_by_columns(a)) {
+                got = fe__discover_column_panel(a, k, col, q) ? q : 0;
+            } else {
+                /* A wide full accumulation: rows into the scratch panel. */
+                double *z = a->work + dim * dim + dim;
+                got = fe__discover_good_rows(col, dim, q);
+                for (size_t t = 0; t < got; t++)
+                    for (size_t c = 0; c < dim; c++)
+                        z[t * dim + c] = col[c][t];
+                if (got > 0)
+                    fe__discover_panel(a, k, got);
+            }
+        }
+        if (got > 0) {
+            i += got;
+            continue;
+        }
+        /* The panel holds a row the guard stops, or follows one: the row
+           step decides, row by row, over the panel's rows. */
+        for (size_t t = 0; t < q && rc == FE_OK; t++) {
+            for (size_t c = 0; c < a->m; c++)
+                row[c] = phi[c * ldphi + i];
+            rc = fe_discover_add(a, row, r[i]);
+            i += rc == FE_OK;
+        }
+    }
+    if (done != NULL)
+        *done = i;
+    return rc;
+}
+/* Fold many rows ends here */
 /* [[file:../literate/discover.org::Fold rows that carry their index][Fold rows that carry their index]] */
 int fe_discover_rebind(fe_discover_acc *a, double *storage)
 {
     if (a == NULL || storage == NULL)
         return FE_EINVAL;
     if (a->m == 0 || a->m > FE_DISCOVER_MAX_COLUMNS || a->blocks < 2
-        || a->blocks > FE_DISCOVER_MAX_BLOCKS)
+        || a->blocks > FE_DISCOVER_MAX_BLOCKS || a->base_cols > a->m)
         return FE_ESIZE;
     fe__discover_layout(a, storage);
     return FE_OK;
@@ -375,7 +829,7 @@ int fe_discover_copy(fe_discover_acc *dst, const fe_discover_acc *src)
     if (dst == NULL || src == NULL || dst->gram == NULL || src->gram == NULL)
         return FE_EINVAL;
     if (dst->m != src->m || dst->blocks != src->blocks
-        || dst->fit_rows != src->fit_rows)
+        || dst->fit_rows != src->fit_rows || dst->base_cols != src->base_cols)
         return FE_EMISMATCH;
     if (dst == src)
         return FE_OK;
@@ -631,7 +1085,7 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
         || ncols > a->m)
         return FE_EINVAL;
     for (size_t i = 0; i < ncols; i++)
-        if (cols[i] >= a->m)
+        if (cols[i] >= a->base_cols)    /* a->m for a full accumulation */
             return FE_EINVAL;
     rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
     if (rc != FE_OK)
@@ -805,8 +1259,11 @@ int fe_discover_select(const fe_discover_acc *a,
             || groups[i].first + groups[i].count > a->m)
             return FE_EINVAL;
     for (size_t i = 0; i < o.nbase; i++)
-        if (o.base[i] >= ngroups)
+        if (o.base[i] >= ngroups
+            || groups[o.base[i]].first + groups[o.base[i]].count > a->base_cols)
             return FE_EINVAL;
+    if (a->base_cols < a->m && o.max_steps > 0)
+        return FE_EINVAL;       /* a screen ranks; the next step needs more */
     if (o.max_steps > FE_DISCOVER_MAX_STEPS)
         o.max_steps = FE_DISCOVER_MAX_STEPS;
     rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);

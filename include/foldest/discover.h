@@ -37,6 +37,9 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
 typedef struct fe_discover_acc {
     size_t m;                   /* term columns; M = m + 1 with r */
     size_t blocks;              /* K */
+    size_t base_cols;           /* columns 0 .. base_cols - 1 keep their
+                                   products with every column: m for a full
+                                   accumulation, fewer for a screen (below) */
     uint64_t fit_rows;          /* rows [0, fit_rows) are fitted, the rest held out */
     uint64_t row0;              /* global index of this part's first row */
     uint64_t n;                 /* rows folded into this part */
@@ -65,6 +68,22 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
                          uint64_t fit_rows, uint64_t row0, double *storage,
                          size_t storage_doubles);
 
+/* fe_discover_screen_init: an empty /screen/, the accumulation of the
+   ranking pass: as fe_discover_acc_init, but of the products of columns
+   base_cols .. m - 1 it keeps only those with r and with the next two
+   columns (and the lag product only among columns 0 .. base_cols - 1 and
+   r).  That is everything ranking each candidate against a base model in
+   columns 0 .. base_cols - 1 reads, for about (base_cols + 4) M
+   multiply-adds a row instead of M (M + 1).  Same storage; every
+   fe_discover_add* function folds into it, and it merges with screens of
+   the same base_cols.  fe_discover_select ranks from it with max_steps 0
+   and the base terms inside the base columns (FE_EINVAL otherwise).
+   base_cols == m is a full accumulation.  Errors: those of
+   fe_discover_acc_init; FE_ESIZE for base_cols > m. */
+int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
+                            size_t blocks, uint64_t fit_rows, uint64_t row0,
+                            double *storage, size_t storage_doubles);
+
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
    value is not finite or the sums would overflow (values above 1e100 are
@@ -86,6 +105,15 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r);
    row0 FE_DISCOVER_ROW_UNKNOWN (nothing folded). */
 int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
                          const double *r, size_t nrows, size_t *done);
+
+/* fe_discover_add_columns: fold `nrows` rows given as columns, the layout
+   in which terms are evaluated a vector at a time: term i of row t is
+   phi[i * ldphi + t] (ldphi >= nrows when m > 1), its residual r[t].  The
+   same accumulation, refusals and `*done` as fe_discover_add_rows, with no
+   copy: the fast path of a screen (and of a full accumulation of at most
+   8 columns M), by dot products in vector lanes. */
+int fe_discover_add_columns(fe_discover_acc *a, const double *phi, size_t ldphi,
+                            const double *r, size_t nrows, size_t *done);
 
 /* fe_discover_break: the next row does not follow the last in time (a new
    recording begins): no lag product is formed across. */
@@ -205,9 +233,11 @@ size_t fe_discover_workspace_doubles(size_t m, size_t blocks);
 
 /* fe_discover_select: rank the `ngroups` candidate groups, add terms by
    forward selection, fit them, and summarise baseline and final models,
-   all from the accumulation.  Errors: FE_EINVAL; FE_ETOOFEW (a block is
-   empty); FE_ESINGULAR (the base terms are collinear); FE_ESIZE
-   (workspace too small). */
+   all from the accumulation.  From a screen (fe_discover_screen_init) it
+   ranks only: max_steps must be 0 and the base groups must lie in the
+   screen's base columns.  Errors: FE_EINVAL (also for a screen asked for
+   more); FE_ETOOFEW (a block is empty); FE_ESINGULAR (the base terms are
+   collinear); FE_ESIZE (workspace too small). */
 int fe_discover_select(const fe_discover_acc *a,
                        const fe_discover_group *groups, size_t ngroups,
                        const fe_discover_options *options,
@@ -217,7 +247,8 @@ int fe_discover_select(const fe_discover_acc *a,
 /* fe_discover_fit_columns: least-squares fit of the given columns from
    the accumulation: coefficients, batch-means standard errors and the
    summary.  Used for the baseline and the final model, and by callers
-   who want a model of their own choosing. */
+   who want a model of their own choosing.  From a screen, only columns
+   among its base columns (FE_EINVAL otherwise). */
 int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
                             size_t ncols, double *coef, double *stderr_,
                             fe_discover_fit *fit, double *work,
