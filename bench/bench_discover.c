@@ -16,10 +16,12 @@
    Prints ns per record, the ratio (goal: ranking <= 3x the base fold), that
    the screen ranks as the full accumulation does, and the accumulation's
    size, which does not depend on the number of records. */
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bench.h"
 #include "foldest.h"
@@ -266,6 +268,69 @@ static double fold_panels(const double *state, const double *r, size_t n, size_t
     return best;
 }
 
+/* The same records from a CSV file, as a recording is read: each line
+   split and parsed (fe_csv_*), the records of a panel evaluated by columns
+   and folded.  Returns the best time, or -1 when the file cannot be read. */
+static double fold_file(const char *path, size_t n, size_t m, size_t base_cols,
+                        double *storage, size_t nst, fe_discover_acc *a, double *panel)
+{
+    double best, st[NS * PCOL], r[PCOL];
+    char buf[4096];
+    int bad = 0;
+    FE_BENCH_BEST(best, 3, {
+        fe_csv_reader rd;
+        int fd = open(path, O_RDONLY);
+        size_t q = 0;
+        char *line;
+        size_t len;
+        fe_discover_screen_init(a, m, base_cols, K, n, 0, storage, nst);
+        if (fd < 0 || fe_csv_reader_init(&rd, fd, buf, sizeof buf) != FE_OK) {
+            bad = 1;
+        } else {
+            for (;;) {
+                int end = fe_csv_next_line(&rd, &line, &len) != FE_OK;
+                if (!end) {
+                    fe_csv_field f[NS + 1];
+                    size_t nf;
+                    bad |= fe_csv_split(line, ',', f, NS + 1, &nf, NULL) != FE_OK || nf != NS + 1;
+                    for (size_t c = 0; c < NS && !bad; c++)
+                        bad |= fe_csv_number(&f[c], &st[NS * q + c]) != FE_OK;
+                    bad |= bad || fe_csv_number(&f[NS], &r[q]) != FE_OK;
+                    q++;
+                }
+                if (q == PCOL || (end && q > 0)) {
+                    terms_columns(st, q, m, panel, PCOL);
+                    bad |= fe_discover_add_columns(a, panel, PCOL, r, q, NULL) != FE_OK;
+                    q = 0;
+                }
+                if (end)
+                    break;
+            }
+        }
+        if (fd >= 0)
+            close(fd);
+    });
+    if (bad || a->n != n)
+        return -1.0;
+    return best;
+}
+
+/* Write the records as CSV (NS state columns and r, %.17g) to a new
+   temporary file; its path in `path`. */
+static int write_file(char *path, const double *state, const double *r, size_t n)
+{
+    int fd = mkstemp(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (f == NULL)
+        return -1;
+    for (size_t i = 0; i < n; i++) {
+        const double *st = state + NS * i;
+        fprintf(f, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", st[0], st[1], st[2],
+                st[3], st[4], st[5], st[6], r[i]);
+    }
+    return fclose(f) == 0 ? 0 : -1;
+}
+
 /* Rank from the accumulation: the base groups 0..2, the 50 candidates. */
 static int rank(const fe_discover_acc *a, fe_discover_result *res, double *work, size_t nw)
 {
@@ -304,6 +369,8 @@ int main(int argc, char **argv)
     double busy = fe_bench_busy_fraction();
     double t_terms_rows, t_terms_cols, t_base_rows, t_base_panels, t_base_cols, t_base;
     double t_full_panels, t_screen, t_select, tanh_err = 0.0, worst = 0.0;
+    double t_file_base = -1.0, t_file_screen = -1.0, t_file_select = 0.0;
+    char csv_path[4096];
     int rc;
     if (state == NULL || r == NULL || storage == NULL || storage2 == NULL || work == NULL
         || res == NULL || res_full == NULL || panel == NULL)
@@ -368,6 +435,18 @@ int main(int argc, char **argv)
         d = x->group != y->group || x->redundant != y->redundant ? 1.0 : d;
         worst = d > worst ? d : worst;
     }
+    {
+        /* From a file: the base model alone and the screen. */
+        const char *dir = getenv("TMPDIR");
+        snprintf(csv_path, sizeof csv_path, "%s/foldest-bench-XXXXXX", dir ? dir : "/tmp");
+        if (write_file(csv_path, state, r, n) == 0) {
+            t_file_base = fold_file(csv_path, n, BASE, BASE, storage, nst, &a, panel);
+            t_file_screen = fold_file(csv_path, n, BASE + CAND, BASE, storage, nst, &a, panel);
+            if (t_file_screen >= 0)
+                t_file_select = t_select;
+        }
+        remove(csv_path);
+    }
     printf("discovery over %zu records in memory (ns per record, best of 3; the caller's"
            " term evaluation included)\n", n);
     if (busy >= 0)
@@ -392,8 +471,19 @@ int main(int argc, char **argv)
            1e3 * t_select);
     printf("  the screen's ranking vs the full accumulation's: same order, %.1e relative at worst\n",
            worst);
-    printf("  ratio ranking / base fold, each by its fastest path: %.2f   (goal <= 3)\n",
+    printf("  ratio ranking / base fold in memory, each by its fastest path: %.2f   (goal <= 3)\n",
            (t_screen + t_select) / t_base);
+    if (t_file_base > 0 && t_file_screen > 0) {
+        printf("from a CSV file of the same records (%d columns, read, split and parsed):\n", NS + 1);
+        printf("    base model alone                               %8.1f\n",
+               1e9 * t_file_base / (double)n);
+        printf("    screen of the %d candidates                    %8.1f\n", CAND,
+               1e9 * t_file_screen / (double)n);
+        printf("  ratio ranking / base fold from the file: %.2f   (goal <= 3)\n",
+               (t_file_screen + t_file_select) / t_file_base);
+    } else {
+        printf("from a CSV file: could not write or read one in $TMPDIR or /tmp (skipped)\n");
+    }
     printf("  accumulation: %zu doubles = %.1f KiB with the candidates (%zu = %.1f KiB base),"
            " for any number of records\n", nst, (double)nst * 8.0 / 1024.0, nst0,
            (double)nst0 * 8.0 / 1024.0);

@@ -194,7 +194,7 @@ static void panel_rows(void)
 static void assert_same_sums(const fe_discover_acc *got, const fe_discover_acc *want)
 {
     size_t dim = want->m + 1, K = want->blocks;
-    double diag[PM + 1] = {0};
+    double diag[FE_DISCOVER_MAX_COLUMNS + 1] = {0};
     ck_assert_uint_eq(got->n, want->n);
     ck_assert_int_eq(got->have_prev, want->have_prev);
     ck_assert_int_eq(got->first_linked, want->first_linked);
@@ -376,6 +376,296 @@ START_TEST(panels_stop_at_the_first_refused_row)
 }
 END_TEST
 
+/* Wider rows for the column path and screens: the panel rows and four
+   more columns (products and a slow sine), also stored by columns. */
+enum { WM = 10 };
+static double wide[PN][WM], wcol[WM][PN];
+
+static void wide_rows(void)
+{
+    panel_rows();
+    for (size_t i = 0; i < PN; i++) {
+        for (size_t c = 0; c < PM; c++)
+            wide[i][c] = pphi[i][c];
+        wide[i][6] = pphi[i][1] * pphi[i][2];
+        wide[i][7] = pphi[i][3] * pphi[i][3] / 100.0;
+        wide[i][8] = pphi[i][4] * pphi[i][1];
+        wide[i][9] = sin(0.05 * (double)i);
+        for (size_t c = 0; c < WM; c++)
+            wcol[c][i] = wide[i][c];
+    }
+}
+
+/* Fold rows [from, to) of the wide data, m columns, by columns in uneven
+   pieces. */
+static void add_columns_in_pieces(fe_discover_acc *a, size_t from, size_t to)
+{
+    static const size_t piece[] = {37, 1, 300, 128, 2, 129, 1000, 5};
+    size_t i = from, p = 0, done = 0;
+    while (i < to) {
+        size_t q = piece[p++ % (sizeof piece / sizeof *piece)];
+        if (q > to - i)
+            q = to - i;
+        ck_assert_int_eq(fe_discover_add_columns(a, &wcol[0][i], PN, pr + i, q, &done), FE_OK);
+        ck_assert_uint_eq(done, q);
+        i += q;
+    }
+}
+
+/* Rows [from, to) of the wide data, m columns, row by row. */
+static void add_wide_rows(fe_discover_acc *a, size_t from, size_t to)
+{
+    int rc = FE_OK;
+    for (size_t i = from; i < to; i++)
+        rc |= fe_discover_add(a, wide[i], pr[i]);
+    ck_assert_int_eq(rc, FE_OK);
+}
+
+START_TEST(column_path_equals_row_path)
+{
+    /* By columns, narrow (M = 7: the lane kernels) and wide (M = 11: rows
+       into the dsyrk panel), with a break at row 1777: the same sums as
+       row by row. */
+    static const size_t ms[] = {PM, WM};
+    wide_rows();
+    for (size_t c = 0; c < 2; c++) {
+        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK);
+        double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+        fe_discover_acc rows, cols;
+        ck_assert_int_eq(fe_discover_acc_init(&rows, m, PK, PFIT, 0, s1, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_acc_init(&cols, m, PK, PFIT, 0, s2, nst), FE_OK);
+        add_wide_rows(&rows, 0, 1777);
+        fe_discover_break(&rows);
+        add_wide_rows(&rows, 1777, PN);
+        add_columns_in_pieces(&cols, 0, 1777);
+        fe_discover_break(&cols);
+        add_columns_in_pieces(&cols, 1777, PN);
+        assert_same_sums(&cols, &rows);
+        free(s1);
+        free(s2);
+    }
+}
+END_TEST
+
+/* The screen `got` keeps exactly the entries ranking reads, equal to the
+   full accumulation's to 1e-12 of their scale, and zeros elsewhere. */
+static void assert_screen_sums(const fe_discover_acc *got, const fe_discover_acc *full)
+{
+    size_t dim = full->m + 1, K = full->blocks, nb = got->base_cols;
+    double diag[FE_DISCOVER_MAX_COLUMNS + 1] = {0};
+    ck_assert_uint_eq(got->n, full->n);
+    for (size_t k = 0; k < K; k++)
+        for (size_t i = 0; i < dim; i++)
+            diag[i] += full->gram[k * dim * dim + i * dim + i];
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = i; j < dim; j++) {
+            int kept = i < nb || j == full->m || j - i < 3;
+            int lag_kept = (i < nb || i == full->m) && (j < nb || j == full->m);
+            double scale = sqrt(diag[i] * diag[j]);
+            for (size_t k = 0; k <= K; k++) {
+                size_t at = k * dim * dim + i * dim + j;
+                double want = kept ? full->gram[at] : 0.0;
+                ck_assert_msg(fabs(got->gram[at] - want) <= 1e-12 * scale,
+                              "block %zu G[%zu][%zu] = %.17g, want %.17g", k, i, j,
+                              got->gram[at], want);
+            }
+            ck_assert_msg(fabs(got->lag[i * dim + j] - (lag_kept ? full->lag[i * dim + j] : 0.0))
+                              <= 1e-12 * scale,
+                          "T[%zu][%zu] = %.17g", i, j, got->lag[i * dim + j]);
+        }
+}
+
+START_TEST(screen_keeps_what_ranking_reads)
+{
+    /* A screen with two base columns, folded row by row, by panels of rows
+       and by columns, with a break: the entries it keeps are the full
+       accumulation's; the others stay zero. */
+    size_t nst = fe_discover_acc_doubles(WM, PK);
+    double *sf = malloc(nst * sizeof *sf), *s1 = malloc(nst * sizeof *s1),
+           *s2 = malloc(nst * sizeof *s2), *s3 = malloc(nst * sizeof *s3);
+    fe_discover_acc full, byrow, bypanel, bycol;
+    size_t done;
+    wide_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&full, WM, PK, PFIT, 0, sf, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&byrow, WM, 2, PK, PFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&bypanel, WM, 2, PK, PFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&bycol, WM, 2, PK, PFIT, 0, s3, nst), FE_OK);
+    add_wide_rows(&full, 0, 2500);
+    fe_discover_break(&full);
+    add_wide_rows(&full, 2500, PN);
+    add_wide_rows(&byrow, 0, 2500);
+    fe_discover_break(&byrow);
+    add_wide_rows(&byrow, 2500, PN);
+    ck_assert_int_eq(fe_discover_add_rows(&bypanel, wide[0], WM, pr, 2500, &done), FE_OK);
+    fe_discover_break(&bypanel);
+    ck_assert_int_eq(fe_discover_add_rows(&bypanel, wide[2500], WM, pr + 2500, PN - 2500, &done),
+                     FE_OK);
+    add_columns_in_pieces(&bycol, 0, 2500);
+    fe_discover_break(&bycol);
+    add_columns_in_pieces(&bycol, 2500, PN);
+    assert_screen_sums(&byrow, &full);
+    assert_screen_sums(&bypanel, &full);
+    assert_screen_sums(&bycol, &full);
+    free(sf);
+    free(s1);
+    free(s2);
+    free(s3);
+}
+END_TEST
+
+static double rel_diff(double x, double y)
+{
+    double s = fabs(x) > fabs(y) ? fabs(x) : fabs(y);
+    return s > 0.0 ? fabs(x - y) / s : 0.0;
+}
+
+START_TEST(screen_ranks_as_the_full_accumulation)
+{
+    /* Base {constant, sine}, candidates one column each and one of three:
+       the screen, folded in three parts by columns and merged, ranks them
+       as the full accumulation does, and gives the same baseline. */
+    size_t nst = fe_discover_acc_doubles(WM, PK), nw = fe_discover_workspace_doubles(WM, PK);
+    double *sf = malloc(nst * sizeof *sf), *s1 = malloc(nst * sizeof *s1),
+           *s2 = malloc(nst * sizeof *s2), *s3 = malloc(nst * sizeof *s3);
+    double *w = malloc(nw * sizeof *w);
+    fe_discover_result *rf = malloc(sizeof *rf), *rs = malloc(sizeof *rs);
+    fe_discover_acc full, a, b, c;
+    fe_discover_group g[10] = {{"one", 0, 1},   {"sine", 1, 1}, {"cos", 2, 1},
+                               {"ramp", 3, 1},  {"white", 4, 1}, {"tanh", 5, 1},
+                               {"prod", 6, 1},  {"square", 7, 1}, {"three", 7, 3},
+                               {"slow", 9, 1}};
+    size_t base[2] = {0, 1};
+    fe_discover_options o = fe_discover_default_options();
+    wide_rows();
+    for (size_t i = 0; i < PN; i++)
+        pr[i] += 0.5 * wide[i][9];              /* something to find */
+    ck_assert_int_eq(fe_discover_acc_init(&full, WM, PK, PFIT, 0, sf, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&a, WM, 2, PK, PFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&b, WM, 2, PK, PFIT, 1500, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(&c, WM, 2, PK, PFIT, 3999, s3, nst), FE_OK);
+    add_wide_rows(&full, 0, PN);
+    add_columns_in_pieces(&a, 0, 1500);
+    add_columns_in_pieces(&b, 1500, 3999);
+    add_columns_in_pieces(&c, 3999, PN);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &c), FE_OK);
+    assert_screen_sums(&a, &full);
+    o.base = base;
+    o.nbase = 2;
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&full, g, 10, &o, rf, w, nw), FE_OK);
+    ck_assert_int_eq(fe_discover_select(&a, g, 10, &o, rs, w, nw), FE_OK);
+    ck_assert_uint_eq(rs->nranked[0], 8);
+    ck_assert_uint_eq(rs->nranked[0], rf->nranked[0]);
+    ck_assert_double_le(rel_diff(rs->baseline.rss, rf->baseline.rss), 1e-12);
+    ck_assert_double_le(rel_diff(rs->baseline.lag1, rf->baseline.lag1), 1e-9);
+    ck_assert_double_le(rel_diff(rs->baseline.heldout_rms, rf->baseline.heldout_rms), 1e-12);
+    for (size_t i = 0; i < rf->nranked[0]; i++) {
+        const fe_discover_rank *x = &rs->ranking[0][i], *y = &rf->ranking[0][i];
+        ck_assert_uint_eq(x->group, y->group);
+        ck_assert_int_eq(x->redundant, y->redundant);
+        ck_assert_msg(rel_diff(x->rss_drop, y->rss_drop) <= 1e-9
+                          && rel_diff(x->statistic, y->statistic) <= 1e-9
+                          && rel_diff(x->p_value, y->p_value) <= 1e-9
+                          && rel_diff(x->delta_bic, y->delta_bic) <= 1e-9,
+                      "group %zu: drop %g/%g, statistic %g/%g, p %g/%g", y->group, x->rss_drop,
+                      y->rss_drop, x->statistic, y->statistic, x->p_value, y->p_value);
+    }
+    /* The planted term is the most significant. */
+    ck_assert_uint_eq(rs->ranking[0][7].group, 9);
+    for (size_t i = 0; i < 7; i++)
+        ck_assert_double_gt(rs->ranking[0][i].p_value, rs->ranking[0][7].p_value);
+    free(sf);
+    free(s1);
+    free(s2);
+    free(s3);
+    free(w);
+    free(rf);
+    free(rs);
+}
+END_TEST
+
+START_TEST(screen_refuses_what_it_cannot_answer)
+{
+    /* A screen ranks and no more: further steps, base terms outside its
+       base columns, fits of candidate columns, merges with other shapes. */
+    size_t nst = fe_discover_acc_doubles(WM, PK), nw = fe_discover_workspace_doubles(WM, PK);
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+    double *w = malloc(nw * sizeof *w), coef[2];
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_discover_acc a, b;
+    fe_discover_fit fit;
+    fe_discover_group g[3] = {{"one", 0, 1}, {"sine", 1, 1}, {"cos", 2, 1}};
+    size_t base[2] = {0, 1}, bad_base[2] = {0, 2}, cols[2] = {0, 2};
+    fe_discover_options o = fe_discover_default_options();
+    wide_rows();
+    ck_assert_int_eq(fe_discover_screen_init(&a, WM, WM + 1, PK, PFIT, 0, s1, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_screen_init(&a, WM, 2, PK, PFIT, 0, s1, nst), FE_OK);
+    add_columns_in_pieces(&a, 0, PN);
+    o.base = base;
+    o.nbase = 2;
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_EINVAL);   /* 8 steps */
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_OK);
+    o.base = bad_base;
+    ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, cols, 2, coef, NULL, &fit, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, base, 2, coef, NULL, &fit, w, nw), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, WM, PK, PFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&b, &a), FE_EMISMATCH);
+    ck_assert_int_eq(fe_discover_copy(&b, &a), FE_EMISMATCH);
+    /* A screen whose base is every column is a full accumulation. */
+    ck_assert_int_eq(fe_discover_screen_init(&a, WM, WM, PK, PFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&b, &a), FE_OK);
+    free(s1);
+    free(s2);
+    free(w);
+    free(r);
+}
+END_TEST
+
+START_TEST(columns_stop_at_the_first_refused_row)
+{
+    /* By columns, into a screen and into a narrow full accumulation: a NaN
+       at row 150 stops the fold there, as row by row; a value of 1e150
+       goes through the row step's guard and the fold goes on; 1e200 is
+       refused at its row. */
+    static const size_t ms[] = {PM, WM}, nbs[] = {PM, 2};
+    wide_rows();
+    for (size_t c = 0; c < 2; c++) {
+        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK), done = 99;
+        double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2), keep;
+        fe_discover_acc rows, cols;
+        ck_assert_int_eq(fe_discover_screen_init(&rows, m, nbs[c], PK, PFIT, 0, s1, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_screen_init(&cols, m, nbs[c], PK, PFIT, 0, s2, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], 1, pr, 2, &done), FE_EINVAL);
+        ck_assert_uint_eq(done, 0);
+        add_wide_rows(&rows, 0, 150);
+        keep = wcol[3][150];
+        wcol[3][150] = NAN;
+        ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], PN, pr, 400, &done),
+                         FE_ENONFINITE);
+        ck_assert_uint_eq(done, 150);
+        assert_same_sums(&cols, &rows);
+        wcol[3][150] = 1e200;
+        ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 100, &done),
+                         FE_ENONFINITE);
+        ck_assert_uint_eq(done, 0);
+        wcol[3][150] = 1e150;
+        wide[150][3] = 1e150;
+        ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 300, &done),
+                         FE_OK);
+        ck_assert_uint_eq(done, 300);
+        add_wide_rows(&rows, 150, 450);
+        wcol[3][150] = keep;
+        wide[150][3] = keep;
+        assert_same_sums(&cols, &rows);
+        free(s1);
+        free(s2);
+    }
+}
+END_TEST
+
 START_TEST(refusals_leave_the_accumulation_unchanged)
 {
     enum { M = 3, K = 4 };
@@ -501,6 +791,11 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, panels_of_split_parts_merge_to_the_whole);
     tcase_add_test(t, panels_stop_at_the_first_refused_row);
     tcase_add_test(t, selection_refuses_empty_blocks_and_collinear_base);
+    tcase_add_test(t, column_path_equals_row_path);
+    tcase_add_test(t, screen_keeps_what_ranking_reads);
+    tcase_add_test(t, screen_ranks_as_the_full_accumulation);
+    tcase_add_test(t, screen_refuses_what_it_cannot_answer);
+    tcase_add_test(t, columns_stop_at_the_first_refused_row);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

@@ -276,6 +276,56 @@ done:
     free(snap);
 }
 
+/* Discovery by columns: panels of up to 40 rows into a screen or a full
+   accumulation (narrow: lane kernels; wide: the dsyrk panel), each call
+   against the same rows folded one by one: the same status and count, a
+   call that folds nothing leaves the bytes as they were, and every sum
+   stays finite. */
+static void fuzz_discover_columns(in *s, unsigned shape)
+{
+    size_t m = 1 + shape % 10, nb = shape & 16 ? (shape >> 5) % (m + 1) : m, K = 2;
+    size_t nd = fe_discover_acc_doubles(m, K);
+    double *mem = calloc(nd, sizeof *mem), *ref = calloc(nd, sizeof *ref);
+    double *snap = calloc(nd, sizeof *snap), col[10 * 40], r[40], row[10];
+    fe_discover_acc a, b, as;
+    int rc;
+    if (mem == NULL || ref == NULL || snap == NULL
+        || fe_discover_screen_init(&a, m, nb, K, 8 + byte(s), 0, mem, nd) != FE_OK
+        || fe_discover_screen_init(&b, m, nb, K, a.fit_rows, 0, ref, nd) != FE_OK)
+        goto done;
+    while (s->n > 0) {
+        size_t q = 1 + byte(s) % 40, done = 0, want = 0;
+        int want_rc = FE_OK;
+        for (size_t t = 0; t < q; t++) {
+            for (size_t c = 0; c < m; c++)
+                col[c * q + t] = number(s);
+            r[t] = number(s);
+        }
+        memcpy(&as, &a, sizeof a);
+        memcpy(snap, mem, nd * sizeof *mem);
+        rc = fe_discover_add_columns(&a, col, q, r, q, &done);
+        REQUIRE(fe_strerror(rc) != NULL);
+        for (size_t t = 0; t < q && want_rc == FE_OK; t++) {
+            for (size_t c = 0; c < m; c++)
+                row[c] = col[c * q + t];
+            want_rc = fe_discover_add(&b, row, r[t]);
+            want += want_rc == FE_OK;
+        }
+        REQUIRE(rc == want_rc && done == want && a.n == b.n);
+        if (done == 0)
+            REQUIRE(memcmp(&as, &a, sizeof a) == 0 && memcmp(snap, mem, nd * sizeof *mem) == 0);
+        REQUIRE(finite_all(mem, nd));
+        if (byte(s) == 0xff) {
+            fe_discover_break(&a);
+            fe_discover_break(&b);
+        }
+    }
+done:
+    free(mem);
+    free(ref);
+    free(snap);
+}
+
 /* Discovery's generic-fold path: rows that carry their index, in order or
    not, starting recordings now and then. */
 static void fuzz_discover_rows(in *s, unsigned shape)
@@ -420,7 +470,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     in s = {data, size};
     unsigned which = byte(&s), shape = byte(&s);
-    switch (which % 9) {
+    switch (which % 10) {
     case 0: fuzz_meanvar(&s); break;
     case 1: fuzz_quadric(&s, shape); break;
     case 2: fuzz_lsq(&s, shape); break;
@@ -429,6 +479,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case 5: fuzz_discover(&s, shape); break;
     case 6: fuzz_discover_rows(&s, shape); break;
     case 7: fuzz_innovations(&s, shape); break;
+    case 8: fuzz_discover_columns(&s, shape); break;
     default: fuzz_model(&s, shape); break;
     }
     return 0;
