@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -201,6 +202,63 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
 }
 /* Split a line into fields ends here */
 /* [[file:../literate/csv.org::Parse a field as a number][Parse a field as a number]] */
+/* 10^0 .. 10^22: every one a double exactly. */
+static const double fe__csv_pow10[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* A whole field that is a plain decimal with w <= 2^53 and |q| <= 22 (see
+   the text): *value, and 1.  Otherwise 0, and strtod decides. */
+static int fe__csv_fast_number(const char *s, double *value)
+{
+    uint64_t w = 0;
+    int q = 0, digits = 0, neg = 0, any = 0;
+    double v;
+    if (*s == '+' || *s == '-')
+        neg = *s++ == '-';
+    for (; *s >= '0' && *s <= '9'; s++, any = 1) {
+        if (w == 0 && *s == '0')
+            continue;                           /* leading zeros */
+        if (++digits > 16)
+            return 0;
+        w = 10 * w + (uint64_t)(*s - '0');
+    }
+    if (*s == '.')
+        for (s++; *s >= '0' && *s <= '9'; s++, any = 1) {
+            q--;
+            if (w == 0 && *s == '0')
+                continue;
+            if (++digits > 16)
+                return 0;
+            w = 10 * w + (uint64_t)(*s - '0');
+        }
+    if (!any)
+        return 0;
+    if (*s == 'e' || *s == 'E') {
+        int e = 0, eneg = 0;
+        s++;
+        if (*s == '+' || *s == '-')
+            eneg = *s++ == '-';
+        if (!(*s >= '0' && *s <= '9'))
+            return 0;
+        for (; *s >= '0' && *s <= '9'; s++)
+            if (e < 10000)
+                e = 10 * e + (*s - '0');
+        q += eneg ? -e : e;
+    }
+    if (*s != '\0' || w > (UINT64_C(1) << 53))
+        return 0;
+    if (w == 0) {
+        *value = neg ? -0.0 : 0.0;
+        return 1;
+    }
+    if (q < -22 || q > 22)
+        return 0;
+    v = q < 0 ? (double)w / fe__csv_pow10[-q] : (double)w * fe__csv_pow10[q];
+    *value = neg ? -v : v;
+    return 1;
+}
+
 int fe_csv_number(const fe_csv_field *field, double *value)
 {
     char *end;
@@ -212,6 +270,8 @@ int fe_csv_number(const fe_csv_field *field, double *value)
     s = field->text;
     if (*s == '\0')
         return FE_EPARSE;
+    if (fe__csv_fast_number(s, value))
+        return FE_OK;
     errno = 0;
     v = strtod(s, &end);
     if (end == s || *end != '\0')

@@ -140,6 +140,52 @@ START_TEST(numbers)
 }
 END_TEST
 
+START_TEST(numbers_equal_strtod_bit_for_bit)
+{
+    /* Random decimals in every form a recording or a printf writes (1 to
+       19 significant digits, points anywhere, exponents, signs, leading
+       zeros), and the edges of the fast path (2^53, 10^22): fe_csv_number
+       returns what strtod returns, to the bit. */
+    static const char *const edges[] = {
+        "9007199254740992", "9007199254740993", "-9007199254740993e-22", "1e22", "1e23",
+        "123456789012345678e4", "0.0000000000000000000001", "-0", "-0.0e5", "0e99999",
+        "00001.2500", "1.", ".5", "-.5e-3", "4.9e-324", "1.7976931348623157e308",
+        "1234567890123456789", "12345678901234567890", "0.1", "2.2250738585072014e-308"};
+    fe_rng g = fe_rng_seed(11);
+    char text[64];
+    for (int i = 0; i < 200000 + (int)(sizeof edges / sizeof *edges); i++) {
+        fe_csv_field f = {text, 1};
+        double v = 0.0, want;
+        int rc;
+        if (i < (int)(sizeof edges / sizeof *edges)) {
+            strcpy(text, edges[i]);
+        } else {
+            int digits = 1 + (int)(fe_rng_next(&g) % 19), form = (int)(fe_rng_next(&g) % 4);
+            double x = ldexp(fe_rng_uniform(&g), (int)(fe_rng_next(&g) % 160) - 80);
+            if (fe_rng_next(&g) & 1)
+                x = -x;
+            if (form == 0)
+                snprintf(text, sizeof text, "%.*g", digits, x);
+            else if (form == 1)
+                snprintf(text, sizeof text, "%.*e", digits - 1, x);
+            else if (form == 2)
+                snprintf(text, sizeof text, "%.*f", digits % 12, x * 1e6);
+            else
+                snprintf(text, sizeof text, "%lld%s%lld", (long long)(fe_rng_next(&g) % 100000),
+                         fe_rng_next(&g) & 1 ? "." : "e-",
+                         (long long)(fe_rng_next(&g) % 1000));
+        }
+        want = strtod(text, NULL);
+        rc = fe_csv_number(&f, &v);
+        if (isfinite(want) && !(fabs(want) > 1.7976931348623157e308)) {
+            ck_assert_msg(rc == FE_OK, "%s: %d", text, rc);
+            ck_assert_msg(memcmp(&v, &want, sizeof v) == 0, "%s: %.17g, strtod %.17g", text, v,
+                          want);
+        }
+    }
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -150,6 +196,7 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, split_commas_quotes_and_blanks);
     tcase_add_test(t, split_white_space_and_errors);
     tcase_add_test(t, numbers);
+    tcase_add_test(t, numbers_equal_strtod_bit_for_bit);
     suite_add_tcase(s, t);
     return s;
 }
