@@ -170,7 +170,8 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
                 for (size_t v = u; v <= a->base_cols; v++) {
                     const double *p = a->last;
                     size_t i = fe__discover_whole(a, u), j = fe__discover_whole(a, v);
-                    double add = j == i ? z[i] * p[i] : z[i] * p[j] + p[i] * z[j];
+                    /* z[0 .. m] are set above and i, j <= m. */
+                    double add = j == i ? z[i] * p[i] : z[i] * p[j] + p[i] * z[j]; /* NOLINT(clang-analyzer-core.UndefinedBinaryOperatorResult) */
                     if (!isfinite(a->lag[i * dim + j] + add))
                         return FE_ENONFINITE;
                 }
