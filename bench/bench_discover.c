@@ -13,9 +13,13 @@
    row by row with libm for the row paths.
    Also timed, for reference: the full accumulation of all 53 terms, which
    forward selection needs after the first step.
-   Prints ns per record, the ratio (goal: ranking <= 3x the base fold), that
-   the screen ranks as the full accumulation does, and the accumulation's
-   size, which does not depend on the number of records. */
+   Then the same two folds from CSV files of the same records, as a
+   recording is read (fe_csv_*): with the 6 significant digits of a sensor
+   recording, and with the 17 of an exact round trip.
+   Prints ns per record, the ratios (goal: ranking <= 3x the base fold) in
+   memory and from the files, that the screen ranks as the full
+   accumulation does, and the accumulation's size, which does not depend on
+   the number of records. */
 #include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
