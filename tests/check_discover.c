@@ -660,6 +660,21 @@ START_TEST(columns_stop_at_the_first_refused_row)
         wcol[3][150] = keep;
         wide[150][3] = keep;
         assert_same_sums(&cols, &rows);
+        /* Values of 8e99 in a column of 100 rows: each passes the row
+           step's guard, their sum of squares (6.4e201) does not pass the
+           panel's, so the panel goes row by row, by columns and by rows. */
+        for (size_t i = 450; i < 550; i++)
+            wcol[1][i] = wide[i][1] = 8e99;
+        ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][450], PN, pr + 450, 100, &done),
+                         FE_OK);
+        ck_assert_uint_eq(done, 100);
+        add_wide_rows(&rows, 450, 550);
+        for (size_t i = 550; i < 650; i++)
+            wide[i][1] = 8e99;
+        ck_assert_int_eq(fe_discover_add_rows(&cols, wide[550], WM, pr + 550, 100, &done), FE_OK);
+        ck_assert_uint_eq(done, 100);
+        add_wide_rows(&rows, 550, 650);
+        assert_same_sums(&cols, &rows);
         free(s1);
         free(s2);
     }
