@@ -222,19 +222,13 @@ static void assert_same_sums(const fe_discover_acc *got, const fe_discover_acc *
         }
 }
 
-/* Fold rows [from, to) through the panel path in uneven pieces. */
+/* Fold rows [from, to) in uneven pieces: of the panel rows by panels
+   (by_columns 0), or of the wide columns (wcol, below) by columns. */
+static void fold_in_pieces(fe_discover_acc *a, size_t from, size_t to, int by_columns);
+
 static void add_in_pieces(fe_discover_acc *a, size_t from, size_t to)
 {
-    static const size_t piece[] = {37, 1, 300, 128, 2, 129, 1000, 5};
-    size_t i = from, p = 0, done = 0;
-    while (i < to) {
-        size_t q = piece[p++ % (sizeof piece / sizeof *piece)];
-        if (q > to - i)
-            q = to - i;
-        ck_assert_int_eq(fe_discover_add_rows(a, pphi[i], PM, pr + i, q, &done), FE_OK);
-        ck_assert_uint_eq(done, q);
-        i += q;
-    }
+    fold_in_pieces(a, from, to, 0);
 }
 
 START_TEST(panel_path_equals_row_path)
@@ -396,9 +390,7 @@ static void wide_rows(void)
     }
 }
 
-/* Fold rows [from, to) of the wide data, m columns, by columns in uneven
-   pieces. */
-static void add_columns_in_pieces(fe_discover_acc *a, size_t from, size_t to)
+static void fold_in_pieces(fe_discover_acc *a, size_t from, size_t to, int by_columns)
 {
     static const size_t piece[] = {37, 1, 300, 128, 2, 129, 1000, 5};
     size_t i = from, p = 0, done = 0;
@@ -406,10 +398,18 @@ static void add_columns_in_pieces(fe_discover_acc *a, size_t from, size_t to)
         size_t q = piece[p++ % (sizeof piece / sizeof *piece)];
         if (q > to - i)
             q = to - i;
-        ck_assert_int_eq(fe_discover_add_columns(a, &wcol[0][i], PN, pr + i, q, &done), FE_OK);
+        ck_assert_int_eq(by_columns ? fe_discover_add_columns(a, &wcol[0][i], PN, pr + i, q, &done)
+                                    : fe_discover_add_rows(a, pphi[i], PM, pr + i, q, &done),
+                         FE_OK);
         ck_assert_uint_eq(done, q);
         i += q;
     }
+}
+
+/* Rows [from, to) of the wide data, its first a->m columns, by columns. */
+static void add_columns_in_pieces(fe_discover_acc *a, size_t from, size_t to)
+{
+    fold_in_pieces(a, from, to, 1);
 }
 
 /* Rows [from, to) of the wide data, m columns, row by row. */
