@@ -279,12 +279,14 @@ done:
 /* Discovery by columns: panels of up to 40 rows into a screen or a full
    accumulation (narrow: lane kernels; wide: the dsyrk panel), each call
    against the same rows folded one by one: the same status and count, a
-   call that folds nothing leaves the bytes as they were, and every sum
-   stays finite. */
+   call that folds nothing leaves the values' bytes as they were, and every
+   value stays finite.  (The storage's tail, from FE_DISCOVER_ACC_VALUES,
+   is the array paths' scratch, not the accumulation: a panel refused by
+   its sums leaves them there.) */
 static void fuzz_discover_columns(in *s, unsigned shape)
 {
     size_t m = 1 + shape % 10, nb = shape & 16 ? (shape >> 5) % (m + 1) : m, K = 2;
-    size_t nd = fe_discover_acc_doubles(m, K);
+    size_t nd = fe_discover_acc_doubles(m, K), nv = FE_DISCOVER_ACC_VALUES(m, K);
     double *mem = calloc(nd, sizeof *mem), *ref = calloc(nd, sizeof *ref);
     double *snap = calloc(nd, sizeof *snap), col[10 * 40], r[40], row[10];
     fe_discover_acc a, b, as;
@@ -313,8 +315,8 @@ static void fuzz_discover_columns(in *s, unsigned shape)
         }
         REQUIRE(rc == want_rc && done == want && a.n == b.n);
         if (done == 0)
-            REQUIRE(memcmp(&as, &a, sizeof a) == 0 && memcmp(snap, mem, nd * sizeof *mem) == 0);
-        REQUIRE(finite_all(mem, nd));
+            REQUIRE(memcmp(&as, &a, sizeof a) == 0 && memcmp(snap, mem, nv * sizeof *mem) == 0);
+        REQUIRE(finite_all(mem, nv));
         if (byte(s) == 0xff) {
             fe_discover_break(&a);
             fe_discover_break(&b);
@@ -479,8 +481,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case 5: fuzz_discover(&s, shape); break;
     case 6: fuzz_discover_rows(&s, shape); break;
     case 7: fuzz_innovations(&s, shape); break;
-    case 8: fuzz_discover_columns(&s, shape); break;
-    default: fuzz_model(&s, shape); break;
+    case 8: fuzz_model(&s, shape); break;
+    default: fuzz_discover_columns(&s, shape); break;
     }
     return 0;
 }
