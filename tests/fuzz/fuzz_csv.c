@@ -49,8 +49,13 @@ static void split_all(const char *line, size_t len, char delimiter)
         REQUIRE(strlen(fields[i].text) <= len);
         rc = fe_csv_number(&fields[i], &v);
         REQUIRE(rc == FE_OK || rc == FE_EPARSE || rc == FE_ENONFINITE);
-        if (rc == FE_OK)
+        if (rc == FE_OK) {
+            /* The fast path and strtod agree to the bit. */
+            char *end;
+            double w = strtod(fields[i].text, &end);
             REQUIRE(isfinite(v));
+            REQUIRE(*end == '\0' && memcmp(&v, &w, sizeof v) == 0);
+        }
     }
 }
 
