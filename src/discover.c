@@ -250,24 +250,26 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
 }
 /* Merge consecutive accumulations ends here */
 /* [[file:../literate/discover.org::Fold a panel of rows][Fold a panel of rows]] */
-/* Copy up to q rows into the panel Z (scratch rows 1..q; row 0 is kept for
-   the row before the panel), checking every value; the count of rows
-   before the first with a value that is not finite or above 1e100 in
-   magnitude. */
-static size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ldphi,
-                                const double *r, size_t q)
+/* Copy up to q rows into the scratch panel past its row 0 (kept for the
+   row before the panel): value i of row t at z[t * ts + i * is], rows
+   (ts = M, is = 1) for dsyrk or columns (ts = 1, is =
+   FE_DISCOVER_PANEL_ROWS) for the lane kernels, checking every value; the
+   count of rows before the first with a value that is not finite or above
+   1e100 in magnitude. */
+static inline size_t fe__discover_load(fe_discover_acc *a, const double *phi, size_t ldphi,
+                                       const double *r, size_t q, size_t ts, size_t is)
 {
     size_t dim = a->m + 1, m = a->m;
     double *z = a->work + dim * dim + dim;
     for (size_t t = 0; t < q; t++) {
         const double *pt = phi + t * ldphi;
-        double *zt = z + t * dim;
+        double *zt = z + t * ts;
         int ok = fabs(r[t]) <= 1e100;           /* false for NaN too */
         for (size_t i = 0; i < m; i++) {
-            zt[i] = pt[i];
+            zt[i * is] = pt[i];
             ok &= fabs(pt[i]) <= 1e100;
         }
-        zt[m] = r[t];
+        zt[m * is] = r[t];
         if (!ok)
             return t;
     }
@@ -639,28 +641,16 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
 
 /* Copy q rows, transposed, into the scratch panel's columns (ld
    FE_DISCOVER_PANEL_ROWS), pointed to by col[0 .. m]; the count of rows
-   before the first with a value that is not finite or above 1e100 in
-   magnitude. */
+   loaded, as fe__discover_load. */
 static size_t fe__discover_load_columns(fe_discover_acc *a, const double *phi,
                                         size_t ldphi, const double *r, size_t q,
                                         const double **col)
 {
-    size_t dim = a->m + 1, m = a->m;
-    double *z = a->work + dim * dim + dim;
+    size_t dim = a->m + 1;
+    const double *z = a->work + dim * dim + dim;
     for (size_t c = 0; c < dim; c++)
         col[c] = z + c * FE_DISCOVER_PANEL_ROWS;
-    for (size_t t = 0; t < q; t++) {
-        const double *pt = phi + t * ldphi;
-        int ok = fabs(r[t]) <= 1e100;           /* false for NaN too */
-        for (size_t i = 0; i < m; i++) {
-            z[i * FE_DISCOVER_PANEL_ROWS + t] = pt[i];
-            ok &= fabs(pt[i]) <= 1e100;
-        }
-        z[m * FE_DISCOVER_PANEL_ROWS + t] = r[t];
-        if (!ok)
-            return t;
-    }
-    return q;
+    return fe__discover_load(a, phi, ldphi, r, q, 1, FE_DISCOVER_PANEL_ROWS);
 }
 
 /* The count of rows before the first with a value the guard stops. */
@@ -705,7 +695,7 @@ int fe_discover_add_rows(fe_discover_acc *a, const double *phi, size_t ldphi,
         if (!(a->have_prev && fe__discover_large(a->last, a->m + 1)))
             got = by_columns
                       ? fe__discover_load_columns(a, phi + i * ldphi, ldphi, r + i, q, col)
-                      : fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q);
+                      : fe__discover_load(a, phi + i * ldphi, ldphi, r + i, q, a->m + 1, 1);
         if (got > 0 && (!by_columns || fe__discover_column_panel(a, k, col, got))) {
             if (!by_columns)
                 fe__discover_panel(a, k, got);

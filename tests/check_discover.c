@@ -513,12 +513,6 @@ START_TEST(screen_keeps_what_ranking_reads)
 }
 END_TEST
 
-static double rel_diff(double x, double y)
-{
-    double s = fabs(x) > fabs(y) ? fabs(x) : fabs(y);
-    return s > 0.0 ? fabs(x - y) / s : 0.0;
-}
-
 START_TEST(screen_ranks_as_the_full_accumulation)
 {
     /* Base {constant, sine}, candidates one column each and one of three:
@@ -557,19 +551,17 @@ START_TEST(screen_ranks_as_the_full_accumulation)
     ck_assert_int_eq(fe_discover_select(&a, g, 10, &o, rs, w, nw), FE_OK);
     ck_assert_uint_eq(rs->nranked[0], 8);
     ck_assert_uint_eq(rs->nranked[0], rf->nranked[0]);
-    ck_assert_double_le(rel_diff(rs->baseline.rss, rf->baseline.rss), 1e-12);
-    ck_assert_double_le(rel_diff(rs->baseline.lag1, rf->baseline.lag1), 1e-9);
-    ck_assert_double_le(rel_diff(rs->baseline.heldout_rms, rf->baseline.heldout_rms), 1e-12);
+    FE_ASSERT_REL(rs->baseline.rss, rf->baseline.rss, 1e-12);
+    FE_ASSERT_REL(rs->baseline.lag1, rf->baseline.lag1, 1e-9);
+    FE_ASSERT_REL(rs->baseline.heldout_rms, rf->baseline.heldout_rms, 1e-12);
     for (size_t i = 0; i < rf->nranked[0]; i++) {
         const fe_discover_rank *x = &rs->ranking[0][i], *y = &rf->ranking[0][i];
         ck_assert_uint_eq(x->group, y->group);
         ck_assert_int_eq(x->redundant, y->redundant);
-        ck_assert_msg(rel_diff(x->rss_drop, y->rss_drop) <= 1e-9
-                          && rel_diff(x->statistic, y->statistic) <= 1e-9
-                          && rel_diff(x->p_value, y->p_value) <= 1e-9
-                          && rel_diff(x->delta_bic, y->delta_bic) <= 1e-9,
-                      "group %zu: drop %g/%g, statistic %g/%g, p %g/%g", y->group, x->rss_drop,
-                      y->rss_drop, x->statistic, y->statistic, x->p_value, y->p_value);
+        FE_ASSERT_REL(x->rss_drop, y->rss_drop, 1e-9);
+        FE_ASSERT_REL(x->statistic, y->statistic, 1e-9);
+        FE_ASSERT_REL(x->p_value, y->p_value, 1e-9);
+        FE_ASSERT_REL(x->delta_bic, y->delta_bic, 1e-9);
     }
     /* The planted term is the most significant. */
     ck_assert_uint_eq(rs->ranking[0][7].group, 9);

@@ -17,13 +17,7 @@
 
 int fe_cli_main(int argc, char **argv);
 
-#define REQUIRE(cond)                                                          \
-    do {                                                                       \
-        if (!(cond)) {                                                         \
-            fprintf(stderr, "fuzz: %s:%d: %s\n", __FILE__, __LINE__, #cond);   \
-            abort();                                                           \
-        }                                                                      \
-    } while (0)
+#include "fuzz_require.h"
 
 /* Write `n` bytes to a fresh file `path`. */
 static void fe_fuzz_write(const char *path, const uint8_t *p, size_t n)

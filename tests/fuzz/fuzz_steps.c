@@ -58,13 +58,7 @@ static int finite_all(const double *x, size_t n)
     return 1;
 }
 
-#define REQUIRE(cond)                                                          \
-    do {                                                                       \
-        if (!(cond)) {                                                         \
-            fprintf(stderr, "fuzz_steps: %s:%d: %s\n", __FILE__, __LINE__, #cond); \
-            abort();                                                           \
-        }                                                                      \
-    } while (0)
+#include "fuzz_require.h"
 
 /* Step with a snapshot of `bytes` bytes at `mem`: refused means unchanged. */
 #define STEP(call, mem, bytes, snap)                                           \
