@@ -17,6 +17,114 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
     return i <= j ? g[i * dim + j] : g[j * dim + i];
 }
 /* Discovery Includes ends here */
+/* [[file:../literate/discover.org::Fold the lagged products][Fold the lagged products]] */
+/* Forget the rows that the next row would pair with: a break or a
+   held-out row. */
+static void fe__discover_lags_cut(fe_discover_acc *a)
+{
+    memset(a->hist, 0, a->nhist * (a->m + 1) * sizeof *a->hist);
+    a->nhist = 0;
+}
+
+/* Fold one row z (M values) of block k into the lagged products. */
+static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitted)
+{
+    size_t dim = a->m + 1, P = a->lags;
+    if (P == 0)
+        return;
+    if (!fitted) {
+        fe__discover_lags_cut(a);
+        a->head_open = 0;
+        return;
+    }
+    for (size_t l = 1; l <= a->nhist; l++) {
+        const double *p = a->hist + (l - 1) * dim;
+        double *zl = a->zlag + (l - 1) * dim * dim;
+        for (size_t i = 0; i < dim; i++) {
+            double zi = z[i], *row = zl + i * dim;
+            for (size_t j = 0; j < dim; j++)
+                row[j] += zi * p[j];
+        }
+    }
+    memmove(a->hist + dim, a->hist, (P - 1) * dim * sizeof *a->hist);
+    memcpy(a->hist, z, dim * sizeof *z);
+    if (a->nhist < P)
+        a->nhist++;
+    memset(a->hist + a->nhist * dim, 0, (P - a->nhist) * dim * sizeof *a->hist);
+    if (a->head_open && a->nhead < P)
+        memcpy(a->head + a->nhead++ * dim, z, dim * sizeof *z);
+}
+
+/* Fold q rows given by columns: value c of row t at col[c][t * ts]. */
+static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
+                                   size_t ts, size_t q, int fitted)
+{
+    double z[FE_DISCOVER_MAX_COLUMNS + 1];
+    if (a->lags == 0)
+        return;
+    for (size_t t = 0; t < q; t++) {
+        for (size_t c = 0; c <= a->m; c++)
+            z[c] = col[c][t * ts];
+        fe__discover_lags_row(a, z, fitted);
+    }
+}
+
+/* Whether folding z would keep every lagged sum finite (the slow path). */
+static int fe__discover_lags_finite(const fe_discover_acc *a, const double *z)
+{
+    size_t dim = a->m + 1;
+    for (size_t l = 1; l <= a->nhist; l++)
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = 0; j < dim; j++)
+                if (!isfinite(a->zlag[(l - 1) * dim * dim + i * dim + j]
+                              + z[i] * a->hist[(l - 1) * dim + j]))
+                    return 0;
+    return 1;
+}
+
+/* a <- a (+) b for the lagged products, b following a; before the
+   counts and rows of the merge are updated (a->n is a's own). */
+static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b)
+{
+    size_t dim = a->m + 1, P = a->lags;
+    if (P == 0)
+        return;
+    for (size_t i = 0; i < P * dim * dim; i++)
+        a->zlag[i] += b->zlag[i];
+    if (a->n > 0 && b->first_linked)      /* products across the cut */
+        for (size_t j = 0; j < b->nhead; j++)
+            for (size_t d = 1; d <= a->nhist && j + d <= P; d++) {
+                double *zl = a->zlag + (j + d - 1) * dim * dim;
+                const double *x = b->head + j * dim, *y = a->hist + (d - 1) * dim;
+                for (size_t u = 0; u < dim; u++)
+                    for (size_t v = 0; v < dim; v++)
+                        zl[u * dim + v] += x[u] * y[v];
+            }
+    if (a->n == 0) {
+        memcpy(a->head, b->head, P * dim * sizeof *a->head);
+        a->nhead = b->nhead;
+        a->head_open = b->head_open;
+    } else {
+        size_t add = 0;
+        if (a->head_open && b->first_linked)
+            for (; add < b->nhead && a->nhead + add < P; add++)
+                memcpy(a->head + (a->nhead + add) * dim, b->head + add * dim,
+                       dim * sizeof *a->head);
+        a->nhead += add;
+        a->head_open = a->head_open && b->first_linked && b->head_open;
+    }
+    /* The newest rows: b's, then a's when b is short and continues a. */
+    {
+        size_t keep = 0;
+        if (a->n > 0 && b->first_linked && b->head_open && b->nhist < P)
+            keep = a->nhist < P - b->nhist ? a->nhist : P - b->nhist;
+        memmove(a->hist + b->nhist * dim, a->hist, keep * dim * sizeof *a->hist);
+        memcpy(a->hist, b->hist, b->nhist * dim * sizeof *a->hist);
+        a->nhist = b->nhist + keep;
+        memset(a->hist + a->nhist * dim, 0, (P - a->nhist) * dim * sizeof *a->hist);
+    }
+}
+/* Fold the lagged products ends here */
 /* [[file:../literate/discover.org::Fold a row into its block][Fold a row into its block]] */
 size_t fe_discover_acc_doubles(size_t m, size_t blocks)
 {
@@ -46,7 +154,10 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->first = a->lag + dim * dim;
     a->last = a->first + dim;
     a->counts = a->last + dim;
-    a->work = a->counts + a->blocks + 1;
+    a->zlag = a->counts + a->blocks + 1;
+    a->hist = a->zlag + FE_DISCOVER_LAGS * dim * dim;
+    a->head = a->hist + FE_DISCOVER_LAGS * dim;
+    a->work = a->head + FE_DISCOVER_LAGS * dim;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -81,6 +192,10 @@ int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
     a->n = 0;
     a->have_prev = 0;
     a->first_linked = 1;
+    a->lags = base_cols == m ? FE_DISCOVER_LAGS : 0;
+    a->nhist = 0;
+    a->nhead = 0;
+    a->head_open = 1;
     fe__discover_layout(a, storage);
     return FE_OK;
 }
@@ -175,6 +290,8 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
                     if (!isfinite(a->lag[i * dim + j] + add))
                         return FE_ENONFINITE;
                 }
+        if (k < a->blocks && !fe__discover_lags_finite(a, z))
+            return FE_ENONFINITE;
     }
     /* Add z z^T to the block's upper triangle, where it is kept. */
     for (size_t i = 0; i < dim; i++) {
@@ -192,6 +309,7 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     /* Add z_t z_{t-1}^T, folded, when the previous row is a fitted neighbour. */
     if (a->have_prev && k < a->blocks)
         fe__discover_lag_pair(a, z, a->last);
+    fe__discover_lags_row(a, z, k < a->blocks);
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
@@ -205,8 +323,11 @@ void fe_discover_break(fe_discover_acc *a)
     if (a == NULL)
         return;
     a->have_prev = 0;
+    fe__discover_lags_cut(a);
     if (a->n == 0)
         a->first_linked = 0;
+    else
+        a->head_open = 0;
 }
 /* Fold a row into its block ends here */
 /* [[file:../literate/discover.org::Merge consecutive accumulations][Merge consecutive accumulations]] */
@@ -235,6 +356,7 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
         a->counts[i] += b->counts[i];
     for (size_t i = 0; i < dim * dim; i++)
         a->lag[i] += b->lag[i];
+    fe__discover_lags_merge(a, b);
     /* The lag product across the cut. */
     if (a->n > 0 && a->have_prev && b->first_linked
         && fe__discover_block(a, b->row0) < a->blocks)
@@ -284,7 +406,11 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
     double *g = a->gram + k * dim * dim, *t = a->lag;
     int fitted = k < a->blocks, linked = fitted && a->have_prev;
     size_t pairs = linked ? q : q - 1;
+    const double *rows[FE_DISCOVER_MAX_COLUMNS + 1];
 
+    for (size_t c = 0; c < dim; c++)
+        rows[c] = z + c;
+    fe__discover_lags_rows(a, rows, dim, q, fitted);
     /* X = Z^T Z, into the block. */
     cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)q, 1.0, z,
                 (int)dim, 0.0, x, (int)dim);
@@ -613,6 +739,7 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
         for (size_t d = 0; d < 3 && j + d < m; d++)
             g[j * dim + j + d] += band[3 * (j - nb) + d];
     a->counts[k] += (double)q;
+    fe__discover_lags_rows(a, col, 1, q, fitted);
     if (a->n == 0)
         for (size_t c = 0; c < dim; c++)
             a->first[c] = col[c][0];
@@ -772,7 +899,8 @@ int fe_discover_rebind(fe_discover_acc *a, double *storage)
     if (a == NULL || storage == NULL)
         return FE_EINVAL;
     if (a->m == 0 || a->m > FE_DISCOVER_MAX_COLUMNS || a->blocks < 2
-        || a->blocks > FE_DISCOVER_MAX_BLOCKS || a->base_cols > a->m)
+        || a->blocks > FE_DISCOVER_MAX_BLOCKS || a->base_cols > a->m
+        || a->lags > FE_DISCOVER_LAGS || a->nhist > a->lags || a->nhead > a->lags)
         return FE_ESIZE;
     fe__discover_layout(a, storage);
     return FE_OK;
@@ -787,18 +915,26 @@ int fe_discover_reset(fe_discover_acc *a)
     a->n = 0;
     a->have_prev = 0;
     a->first_linked = 1;
+    a->nhist = 0;
+    a->nhead = 0;
+    a->head_open = 1;
     return FE_OK;
 }
 
 int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row)
 {
     uint64_t row0;
-    int have_prev, first_linked, rc;
+    size_t nhist;
+    int have_prev, first_linked, head_open, rc;
+    double hist[FE_DISCOVER_LAGS * (FE_DISCOVER_MAX_COLUMNS + 1)];
     if (a == NULL || row == NULL || row->index == FE_DISCOVER_ROW_UNKNOWN)
         return FE_EINVAL;
     row0 = a->row0;
     have_prev = a->have_prev;
     first_linked = a->first_linked;
+    nhist = a->nhist;
+    head_open = a->head_open;
+    memcpy(hist, a->hist, nhist * (a->m + 1) * sizeof *hist);
     if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
         a->row0 = row->index;
     else if (row->index != a->row0 + a->n)
@@ -810,6 +946,9 @@ int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row)
         a->row0 = row0;
         a->have_prev = have_prev;
         a->first_linked = first_linked;
+        a->nhist = nhist;
+        memcpy(a->hist, hist, nhist * (a->m + 1) * sizeof *hist);
+        a->head_open = head_open;
     }
     return rc;
 }

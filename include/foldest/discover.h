@@ -13,7 +13,10 @@ enum {
     FE_DISCOVER_MAX_GROUPS = 64,    /* candidate terms (groups of columns) */
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
-    FE_DISCOVER_MAX_STEPS = 12      /* forward-selection steps */
+    FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
+    FE_DISCOVER_LAGS = 8            /* lagged products Z_1 .. Z_P kept by a
+                                       full accumulation: P, the highest
+                                       order of the noise model */
 };
 
 /* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
@@ -26,13 +29,16 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
    (blocks, T, first, last, counts) come first, the scratch last, at
    FE_DISCOVER_ACC_VALUES(m, blocks). */
 #define FE_DISCOVER_ACC_VALUES(m, blocks)                                   \
-    (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1)
+    (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1  \
+     + FE_DISCOVER_LAGS * (((m) + 1) * ((m) + 1) + 2 * ((m) + 1)))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
      + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
 
 /* The accumulation: K block Gram matrices of the rows (phi, r), one for
-   held-out rows, the lag-one cross product, and the first and last rows.
+   held-out rows, the lag-one cross product, and the first and last rows;
+   in a full accumulation also the lagged products Z_1 .. Z_P of the noise
+   model, with the first and last P rows that a merge joins them by.
    Memory is the caller's: fe_discover_acc_doubles() doubles. */
 typedef struct fe_discover_acc {
     size_t m;                   /* term columns; M = m + 1 with r */
@@ -52,6 +58,16 @@ typedef struct fe_discover_acc {
                                    that w^T lag w = w^T L w */
     double *first, *last;       /* M each */
     double *counts;             /* K + 1 row counts */
+    size_t lags;                /* P: FE_DISCOVER_LAGS, 0 in a screen */
+    size_t nhist;               /* fitted rows in hist, <= P */
+    size_t nhead;               /* rows in head, <= P */
+    int head_open;              /* no break or held-out row since the
+                                   part's first row */
+    double *zlag;               /* P x M x M, Z_l = sum z_t z_{t-l}^T over
+                                   fitted rows of one recording, full */
+    double *hist;               /* P x M: the last fitted rows, newest
+                                   first (rows past nhist are zero) */
+    double *head;               /* P x M: the part's first rows */
     double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
