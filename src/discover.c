@@ -1024,13 +1024,19 @@ typedef struct fe__ws {
     double *u;          /* K x S block gradients */
     double *omega;      /* S x S */
     double *tmp;        /* S x S */
+    double *gt;         /* M x M prewhitened Gram matrix, full */
+    double *inv;        /* S x S: its inverse on the model's columns */
+    double *uv;         /* M: a series' weights on the columns */
+    double *q;          /* P + 1 lagged sums of a series */
+    double *acov;       /* P + 1 whitened autocovariances of a series */
+    double *acov_e;     /* P + 1 those of the whitened residual */
 } fe__ws;
 
 size_t fe_discover_workspace_doubles(size_t m, size_t blocks)
 {
     size_t dim = m + 1, d = FE_DISCOVER_MAX_GROUP_SIZE;
-    return dim * dim * 4 + dim * (d + 2) + d * d * 2 + d + blocks * d
-           + blocks * dim + 64;
+    return dim * dim * 6 + dim * (d + 3) + d * d * 2 + d + blocks * d
+           + blocks * dim + 3 * (FE_DISCOVER_LAGS + 1) + 64;
 }
 
 static int fe__ws_carve(fe__ws *w, double *work, size_t len, size_t m,
@@ -1050,6 +1056,12 @@ static int fe__ws_carve(fe__ws *w, double *work, size_t len, size_t m,
     w->cj = w->v + d * d;
     w->ck = w->cj + d;
     w->u = w->ck + blocks * d;
+    w->gt = w->u + blocks * dim;
+    w->inv = w->gt + dim * dim;
+    w->uv = w->inv + dim * dim;
+    w->q = w->uv + dim;
+    w->acov = w->q + FE_DISCOVER_LAGS + 1;
+    w->acov_e = w->acov + FE_DISCOVER_LAGS + 1;
     return FE_OK;
 }
 
@@ -1228,6 +1240,51 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
 }
 /* Fit a set of columns ends here */
 /* [[file:../literate/discover.org::Score a candidate against the model][Score a candidate against the model]] */
+/* The drop in RSS, Delta_J = c^T S_JJ^{-1} c, of adding group `gr` to
+   the model `mo` (factored from g, coefficients beta), all from the Gram
+   matrix g (full, M x M): a_J, S_JJ and c_J are left in w.  Returns 0,
+   and sets no drop, when the candidate is already expressible by the
+   model (a tiny Schur complement). */
+static int fe__drop(const double *g, size_t dim, const fe__ws *w, const fe__model *mo,
+                    const double *beta, const fe_discover_group *gr, double *drop)
+{
+    size_t r = dim - 1, d = gr->count, s = mo->n;
+    double sc[FE_DISCOVER_MAX_GROUP_SIZE * FE_DISCOVER_MAX_GROUP_SIZE];
+    double x[FE_DISCOVER_MAX_GROUP_SIZE];
+    /* a_J = G_SS^{-1} G_SJ. */
+    for (size_t i = 0; i < s; i++)
+        for (size_t q = 0; q < d; q++)
+            w->aj[i * d + q] = g[mo->cols[i] * dim + gr->first + q];
+    fe__solve(mo, w->aj, d);
+    /* S_JJ and c_J. */
+    for (size_t p = 0; p < d; p++) {
+        size_t jp = gr->first + p;
+        w->cj[p] = g[jp * dim + r];
+        for (size_t i = 0; i < s; i++)
+            w->cj[p] -= g[jp * dim + mo->cols[i]] * beta[i];
+        for (size_t q = 0; q < d; q++) {
+            double v = g[jp * dim + gr->first + q];
+            for (size_t i = 0; i < s; i++)
+                v -= g[jp * dim + mo->cols[i]] * w->aj[i * d + q];
+            w->sjj[p * d + q] = v;
+        }
+    }
+    for (size_t p = 0; p < d; p++) {
+        double gjj = g[(gr->first + p) * dim + gr->first + p];
+        if (!(w->sjj[p * d + p] > 1e-9 * gjj))
+            return 0;
+    }
+    memcpy(sc, w->sjj, d * d * sizeof *sc);
+    memcpy(x, w->cj, d * sizeof *x);
+    if (LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', (lapack_int)d, 1, sc, (lapack_int)d,
+                      x, 1) != 0)
+        return 0;
+    *drop = 0.0;
+    for (size_t p = 0; p < d; p++)
+        *drop += w->cj[p] * x[p];
+    return 1;
+}
+
 static void fe__score(const fe_discover_acc *a, const fe__ws *w,
                       const fe__model *mo, const double *beta,
                       const fe_discover_group *gr, double rss,
@@ -1237,45 +1294,9 @@ static void fe__score(const fe_discover_acc *a, const fe__ws *w,
     double drop = 0.0, t2 = 0.0;
     memset(out, 0, sizeof *out);
     out->p_value = 1.0;
-    /* a_J = G_SS^{-1} G_SJ. */
-    for (size_t i = 0; i < s; i++)
-        for (size_t q = 0; q < d; q++)
-            w->aj[i * d + q] = w->g[mo->cols[i] * dim + gr->first + q];
-    fe__solve(mo, w->aj, d);
-    /* S_JJ and c_J. */
-    for (size_t p = 0; p < d; p++) {
-        size_t jp = gr->first + p;
-        w->cj[p] = w->g[jp * dim + r];
-        for (size_t i = 0; i < s; i++)
-            w->cj[p] -= w->g[jp * dim + mo->cols[i]] * beta[i];
-        for (size_t q = 0; q < d; q++) {
-            double v = w->g[jp * dim + gr->first + q];
-            for (size_t i = 0; i < s; i++)
-                v -= w->g[jp * dim + mo->cols[i]] * w->aj[i * d + q];
-            w->sjj[p * d + q] = v;
-        }
-    }
-    /* Delta_J = c^T S_JJ^{-1} c; a tiny Schur complement means the
-       candidate is already expressible by the model. */
-    {
-        double sc[FE_DISCOVER_MAX_GROUP_SIZE * FE_DISCOVER_MAX_GROUP_SIZE];
-        double x[FE_DISCOVER_MAX_GROUP_SIZE];
-        for (size_t p = 0; p < d; p++) {
-            double gjj = w->g[(gr->first + p) * dim + gr->first + p];
-            if (!(w->sjj[p * d + p] > 1e-9 * gjj)) {
-                out->redundant = 1;
-                return;
-            }
-        }
-        memcpy(sc, w->sjj, d * d * sizeof *sc);
-        memcpy(x, w->cj, d * sizeof *x);
-        if (LAPACKE_dposv(LAPACK_ROW_MAJOR, 'U', (lapack_int)d, 1, sc, (lapack_int)d,
-                          x, 1) != 0) {
-            out->redundant = 1;
-            return;
-        }
-        for (size_t p = 0; p < d; p++)
-            drop += w->cj[p] * x[p];
+    if (!fe__drop(w->g, dim, w, mo, beta, gr, &drop)) {
+        out->redundant = 1;
+        return;
     }
     /* Per-block shares c_{J,k}. */
     for (size_t k = 0; k < K; k++) {
@@ -1336,10 +1357,376 @@ static void fe__score(const fe_discover_acc *a, const fe__ws *w,
     }
 }
 /* Score a candidate against the model ends here */
+/* [[file:../literate/discover.org::Fit the noise model][Fit the noise model]] */
+int fe_discover_noise_fit(const double *q, double n, size_t maxp,
+                          fe_discover_noise *nz)
+{
+    double phi[FE_DISCOVER_LAGS], prev[FE_DISCOVER_LAGS], sig, best, sum = 0.0;
+    if (q == NULL || nz == NULL || !(n >= 2.0) || maxp >= FE_DISCOVER_LAGS)
+        return FE_EINVAL;
+    memset(nz, 0, sizeof *nz);
+    nz->kind = FE_DISCOVER_NOISE_AR;
+    nz->portmanteau_p = NAN;
+    nz->variance = q[0] / n;
+    nz->innovation_variance = nz->variance;
+    nz->n_eff = n;
+    if (!(q[0] > 0.0) || !isfinite(q[0]))
+        return FE_OK;
+    sig = q[0];
+    best = n * log(sig / n);
+    for (size_t k = 1; k <= maxp; k++) {
+        double acc = q[k], kappa, bic;
+        for (size_t i = 1; i < k; i++)
+            acc -= prev[i - 1] * q[k - i];
+        kappa = acc / sig;
+        if (!(fabs(kappa) < 1.0))
+            break;
+        for (size_t i = 1; i < k; i++)
+            phi[i - 1] = prev[i - 1] - kappa * prev[k - i - 1];
+        phi[k - 1] = kappa;
+        sig *= 1.0 - kappa * kappa;
+        memcpy(prev, phi, k * sizeof *phi);
+        if (!(sig > 0.0))
+            break;
+        bic = n * log(sig / n) + (double)k * log(n);
+        if (bic < best) {
+            best = bic;
+            nz->order = k;
+            memcpy(nz->phi, phi, k * sizeof *phi);
+            nz->innovation_variance = sig / n;
+        }
+    }
+    for (size_t i = 0; i < nz->order; i++)
+        sum += nz->phi[i];
+    nz->n_eff = n * nz->variance * (1.0 - sum) * (1.0 - sum) / nz->innovation_variance;
+    if (nz->n_eff < 1.0)
+        nz->n_eff = 1.0;
+    return FE_OK;
+}
+
+/* The whitening filter alpha (alpha_0 = 1, alpha_i = -phi_i) and its
+   autocorrelation c_l = sum_i alpha_i alpha_{i+l}, l = 0 .. p. */
+static void fe__whitening(const fe_discover_noise *nz, double *alpha, double *c)
+{
+    size_t p = nz->order;
+    alpha[0] = 1.0;
+    for (size_t i = 1; i <= p; i++)
+        alpha[i] = -nz->phi[i - 1];
+    for (size_t l = 0; l <= p; l++) {
+        c[l] = 0.0;
+        for (size_t i = 0; i + l <= p; i++)
+            c[l] += alpha[i] * alpha[i + l];
+    }
+}
+
+/* The lagged sums q_l = u^T Z_l u, l = 0 .. P, of the series u^T z_t
+   (Z_0 = g, the total Gram matrix, full). */
+static void fe__lagged_sums(const fe_discover_acc *a, const double *g,
+                            const double *u, double *q)
+{
+    size_t dim = a->m + 1;
+    for (size_t l = 0; l <= a->lags; l++) {
+        const double *z = l == 0 ? g : a->zlag + (l - 1) * dim * dim;
+        double s = 0.0;
+        for (size_t i = 0; i < dim; i++) {
+            double t = 0.0;
+            if (u[i] == 0.0)
+                continue;
+            for (size_t j = 0; j < dim; j++)
+                t += z[i * dim + j] * u[j];
+            s += u[i] * t;
+        }
+        q[l] = s;
+    }
+}
+
+/* The prewhitened Gram matrix gt = c_0 g + sum_l c_l (Z_l + Z_l^T). */
+static void fe__whiten_gram(const fe_discover_acc *a, const double *g,
+                            const fe_discover_noise *nz, double *gt)
+{
+    size_t dim = a->m + 1;
+    double alpha[FE_DISCOVER_LAGS + 1], c[FE_DISCOVER_LAGS + 1];
+    fe__whitening(nz, alpha, c);
+    for (size_t i = 0; i < dim * dim; i++)
+        gt[i] = c[0] * g[i];
+    for (size_t l = 1; l <= nz->order; l++) {
+        const double *z = a->zlag + (l - 1) * dim * dim;
+        for (size_t i = 0; i < dim; i++)
+            for (size_t j = 0; j < dim; j++)
+                gt[i * dim + j] += c[l] * (z[i * dim + j] + z[j * dim + i]);
+    }
+}
+
+/* The whitened series' autocovariances (unnormalised) at lags h = 0 ..
+   H = P - p from its lagged sums q_0 .. q_P: sum_{i,k} alpha_i alpha_k
+   q_|h+k-i|.  Returns H. */
+static size_t fe__white_acov(const double *q, size_t P, const fe_discover_noise *nz,
+                             double *out)
+{
+    size_t p = nz->order, H = P - p;
+    double alpha[FE_DISCOVER_LAGS + 1], c[FE_DISCOVER_LAGS + 1];
+    fe__whitening(nz, alpha, c);
+    for (size_t h = 0; h <= H; h++) {
+        double s = 0.0;
+        for (size_t i = 0; i <= p; i++)
+            for (size_t k = 0; k <= p; k++) {
+                size_t d = h + k >= i ? h + k - i : i - h - k;
+                s += alpha[i] * alpha[k] * q[d];
+            }
+        out[h] = s;
+    }
+    return H;
+}
+/* Fit the noise model ends here */
+/* [[file:../literate/discover.org::Fit by generalised least squares][Fit by generalised least squares]] */
+/* u <- the weights of the residual r - sum coef_i z_cols[i] on the columns. */
+static void fe__residual_weights(size_t dim, const size_t *cols, size_t ncols,
+                                 const double *coef, double *u)
+{
+    memset(u, 0, dim * sizeof *u);
+    u[dim - 1] = 1.0;
+    for (size_t i = 0; i < ncols; i++)
+        u[cols[i]] -= coef[i];
+}
+
+/* u^T g u for a full matrix g. */
+static double fe__quad(const double *g, size_t dim, const double *u)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < dim; i++) {
+        double t = 0.0;
+        for (size_t j = 0; j < dim; j++)
+            t += g[i * dim + j] * u[j];
+        s += u[i] * t;
+    }
+    return s;
+}
+
+static double fe__fitted_rows(const fe_discover_acc *a)
+{
+    double n = 0.0;
+    for (size_t k = 0; k < a->blocks; k++)
+        n += a->counts[k];
+    return n;
+}
+
+/* Feasible GLS of the columns `cols`: the coefficients, the summary and
+   the noise model, leaving the prewhitened Gram matrix in w->gt, the
+   factor of its model block in w->css and the whitened residual's
+   autocovariances in w->acov_e. */
+static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
+                   size_t ncols, size_t maxp, double *coef, fe_discover_fit *fit,
+                   fe_discover_noise *nz)
+{
+    size_t dim = a->m + 1, r = a->m, K = a->blocks;
+    fe__model mo = {ncols, cols, w->css, {0}};
+    double n = fe__fitted_rows(a), rsst, q2 = 0.0;
+    int rc = fe__factor(&mo, w->g, dim);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t i = 0; i < ncols; i++)
+        coef[i] = w->g[cols[i] * dim + r];
+    fe__solve(&mo, coef, 1);
+    memset(nz, 0, sizeof *nz);
+    for (int round = 0; round < 8; round++) {
+        fe_discover_noise prev = *nz;
+        int same = 1;
+        fe__residual_weights(dim, cols, ncols, coef, w->uv);
+        fe__lagged_sums(a, w->g, w->uv, w->q);
+        fe_discover_noise_fit(w->q, n, maxp, nz);
+        if (round == 0 || nz->order != prev.order)
+            same = 0;
+        for (size_t i = 0; i < nz->order && same; i++)
+            same = fabs(nz->phi[i] - prev.phi[i]) < 1e-6;
+        if (round > 0 && same) {
+            *nz = prev;         /* gt, css and coef are this model's */
+            break;
+        }
+        fe__whiten_gram(a, w->g, nz, w->gt);
+        rc = fe__factor(&mo, w->gt, dim);
+        if (rc != FE_OK)
+            return rc;
+        for (size_t i = 0; i < ncols; i++)
+            coef[i] = w->gt[cols[i] * dim + r];
+        fe__solve(&mo, coef, 1);
+    }
+    /* The summary: raw residual for the RMS, whitened for the BIC. */
+    fe__residual_weights(dim, cols, ncols, coef, w->uv);
+    fe__lagged_sums(a, w->g, w->uv, w->q);
+    rsst = fe__quad(w->gt, dim, w->uv);
+    fit->rss = w->q[0] > 0.0 ? w->q[0] : 0.0;
+    fit->n = n;
+    fit->params = ncols;
+    fit->rms = sqrt(fit->rss / n);
+    fit->lag1 = fit->rss > 0.0 ? w->q[1] / fit->rss : 0.0;
+    fit->n_eff = nz->n_eff;
+    fit->bic = n * log(rsst > 0.0 ? rsst / n : 1e-300)
+               + (double)(ncols + nz->order) * log(n);
+    nz->innovation_variance = rsst / n;
+    fit->heldout_n = a->counts[K];
+    if (a->counts[K] > 0) {
+        double h = fe__quad_resid(a->gram + K * dim * dim, dim, cols, ncols, coef, r, 1);
+        fit->heldout_rms = sqrt((h > 0 ? h : 0) / a->counts[K]);
+    } else {
+        fit->heldout_rms = NAN;
+    }
+    /* Whiteness of the whitened residual. */
+    nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
+    for (size_t h = 1; h <= nz->lags_tested && w->acov_e[0] > 0.0; h++) {
+        double rho = w->acov_e[h] / w->acov_e[0];
+        q2 += rho * rho / (n - (double)h);
+    }
+    nz->portmanteau = n * (n + 2.0) * q2;
+    nz->portmanteau_dof = nz->lags_tested > nz->order
+                              ? (double)(nz->lags_tested - nz->order) : 1.0;
+    nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
+    nz->long_run = nz->portmanteau_p < 0.05;
+    return FE_OK;
+}
+
+/* Degrees of freedom of the whitened regression. */
+static double fe__gls_dof(const fe_discover_fit *fit, const fe_discover_noise *nz)
+{
+    double nu = fit->n - (double)fit->params - (double)nz->order;
+    return nu >= 1.0 ? nu : 1.0;
+}
+
+/* After fe__gls: the covariance of the coefficients, sigma^2 gt_SS^{-1}
+   with each variance (and covariance) scaled by the long-run factors
+   when nz->long_run, into w->inv (ncols x ncols), and the standard
+   errors into se (if not NULL). */
+static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
+                        size_t ncols, const fe_discover_fit *fit,
+                        const fe_discover_noise *nz, double *se)
+{
+    size_t dim = a->m + 1;
+    fe__model mo = {ncols, cols, w->css, {0}};
+    double s2 = nz->innovation_variance * fit->n / fe__gls_dof(fit, nz);
+    double f[FE_DISCOVER_MAX_COLUMNS];
+    /* The factor of gt_SS is in w->css (scales recomputed). */
+    for (size_t i = 0; i < ncols; i++)
+        mo.scale[i] = 1.0 / sqrt(w->gt[cols[i] * dim + cols[i]]);
+    for (size_t i = 0; i < ncols * ncols; i++)
+        w->inv[i] = 0.0;
+    for (size_t i = 0; i < ncols; i++)
+        w->inv[i * ncols + i] = 1.0;
+    fe__solve(&mo, w->inv, ncols);
+    for (size_t i = 0; i < ncols; i++) {
+        f[i] = 1.0;
+        if (nz->long_run && w->acov_e[0] > 0.0) {
+            size_t H = nz->lags_tested;
+            double sum = 0.0;
+            memset(w->uv, 0, dim * sizeof *w->uv);
+            for (size_t k = 0; k < ncols; k++)
+                w->uv[cols[k]] = w->inv[k * ncols + i];
+            fe__lagged_sums(a, w->g, w->uv, w->q);
+            fe__white_acov(w->q, a->lags, nz, w->acov);
+            for (size_t h = 1; h <= H && w->acov[0] > 0.0; h++)
+                sum += (1.0 - (double)h / (double)(H + 1)) * (w->acov_e[h] / w->acov_e[0])
+                       * (w->acov[h] / w->acov[0]);
+            f[i] = 1.0 + 2.0 * sum;
+            if (f[i] < 1.0)
+                f[i] = 1.0;
+        }
+    }
+    for (size_t i = 0; i < ncols; i++)
+        for (size_t j = 0; j < ncols; j++)
+            w->inv[i * ncols + j] *= s2 * sqrt(f[i] * f[j]);
+    if (se != NULL)
+        for (size_t i = 0; i < ncols; i++)
+            se[i] = sqrt(fabs(w->inv[i * ncols + i]));
+}
+
+int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
+                          size_t ncols, size_t max_order, double *coef,
+                          double *stderr_, fe_discover_fit *fit,
+                          fe_discover_noise *noise, double *work,
+                          size_t work_doubles)
+{
+    fe__ws w;
+    int rc;
+    if (a == NULL || fit == NULL || noise == NULL
+        || (ncols > 0 && (cols == NULL || coef == NULL)) || ncols > a->m
+        || a->lags == 0 || max_order >= a->lags)
+        return FE_EINVAL;
+    for (size_t i = 0; i < ncols; i++)
+        if (cols[i] >= a->m)
+            return FE_EINVAL;
+    rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t k = 0; k < a->blocks; k++)
+        if (a->counts[k] < 1.0)
+            return FE_ETOOFEW;
+    fe__total_gram(a, w.g);
+    rc = fe__gls(a, &w, cols, ncols, max_order, coef, fit, noise);
+    if (rc == FE_OK && ncols > 0)
+        fe__gls_cov(a, &w, cols, ncols, fit, noise, stderr_);
+    return rc;
+}
+
+/* Test group gr against the model (cols, fitted by fe__gls: w->gt and
+   w->css are its own, beta its coefficients, rsst its whitened RSS, nz its
+   noise model) in the whitened regression: the partial t (or F) test of
+   adding gr, with the drop Delta_J from fe__drop. */
+static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__model *mo,
+                          const double *beta, const fe_discover_group *gr,
+                          const fe_discover_fit *cur, const fe_discover_noise *nz,
+                          double rsst, fe_discover_rank *out)
+{
+    size_t dim = a->m + 1, d = gr->count, s = mo->n;
+    double drop = 0.0, nu, s2, f = 1.0;
+    memset(out, 0, sizeof *out);
+    out->p_value = 1.0;
+    if (!fe__drop(w->gt, dim, w, mo, beta, gr, &drop)) {
+        out->redundant = 1;
+        return;
+    }
+    out->rss_drop = drop > 0.0 ? drop : 0.0;
+    nu = cur->n - (double)(s + d + nz->order);
+    if (nu < 1.0)
+        nu = 1.0;
+    s2 = (rsst - out->rss_drop) / nu;
+    if (!(s2 > 0.0))
+        return;                 /* an exact fit: nothing to test */
+    /* The long-run factor of the candidate made orthogonal to the model:
+       its weights e_J - sum a_J,i e_cols[i] (a_J from fe__drop), the
+       first column of a group standing for it. */
+    if (nz->long_run && w->acov_e[0] > 0.0) {
+        size_t H = nz->lags_tested;
+        double sum = 0.0;
+        memset(w->uv, 0, dim * sizeof *w->uv);
+        w->uv[gr->first] = 1.0;
+        for (size_t i = 0; i < s; i++)
+            w->uv[mo->cols[i]] -= w->aj[i * d];
+        fe__lagged_sums(a, w->g, w->uv, w->q);
+        fe__white_acov(w->q, a->lags, nz, w->acov);
+        for (size_t h = 1; h <= H && w->acov[0] > 0.0; h++)
+            sum += (1.0 - (double)h / (double)(H + 1)) * (w->acov_e[h] / w->acov_e[0])
+                   * (w->acov[h] / w->acov[0]);
+        f = 1.0 + 2.0 * sum;
+        if (f < 1.0)
+            f = 1.0;
+    }
+    if (d == 1) {
+        out->statistic = (w->cj[0] >= 0.0 ? 1.0 : -1.0) * sqrt(out->rss_drop / (s2 * f));
+        out->p_value = fe_student_t_two_sided(out->statistic, nu);
+    } else {
+        out->statistic = out->rss_drop / ((double)d * s2 * f);
+        out->p_value = fe_f_upper(out->statistic, (double)d, nu);
+    }
+    {
+        double after = rsst - out->rss_drop;
+        if (after < 1e-300)
+            after = 1e-300;
+        out->delta_bic = cur->n * log(after / rsst) + (double)d * log(cur->n);
+    }
+}
+/* Fit by generalised least squares ends here */
 /* [[file:../literate/discover.org::Select terms by forward selection][Select terms by forward selection]] */
 fe_discover_options fe_discover_default_options(void)
 {
-    fe_discover_options o = {0.05, 8, NULL, 0};
+    fe_discover_options o = {0.05, 8, NULL, 0, FE_DISCOVER_NOISE_AR, 4};
     return o;
 }
 
@@ -1368,6 +1755,90 @@ static size_t fe__model_columns(const fe_discover_group *groups,
     return n;
 }
 
+/* The batch-means summary of a fit as a noise record: no model, the
+   portmanteau of the raw residual when the lagged products are there. */
+static void fe__batch_noise(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
+                            size_t ncols, const double *coef, const fe_discover_fit *fit,
+                            fe_discover_noise *nz)
+{
+    memset(nz, 0, sizeof *nz);
+    nz->kind = FE_DISCOVER_NOISE_BATCH;
+    nz->variance = fit->rss / fit->n;
+    nz->innovation_variance = nz->variance;
+    nz->n_eff = fit->n_eff;
+    nz->portmanteau_p = NAN;
+    if (a->lags > 0) {
+        double q2 = 0.0;
+        fe__residual_weights(a->m + 1, cols, ncols, coef, w->uv);
+        fe__lagged_sums(a, w->g, w->uv, w->q);
+        nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
+        for (size_t h = 1; h <= nz->lags_tested && w->acov_e[0] > 0.0; h++)
+            q2 += (w->acov_e[h] / w->acov_e[0]) * (w->acov_e[h] / w->acov_e[0])
+                  / (fit->n - (double)h);
+        nz->portmanteau = fit->n * (fit->n + 2.0) * q2;
+        nz->portmanteau_dof = (double)nz->lags_tested;
+        nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
+    }
+}
+
+/* Fit the model of the current step, by the noise model or by batch
+   means, with standard errors and noise record when `st` is not NULL. */
+static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_t maxp,
+                        const size_t *cols, size_t ncols, double *beta,
+                        fe_discover_fit *fit, fe_discover_step *st)
+{
+    fe_discover_noise nz;
+    int rc;
+    if (ar) {
+        rc = fe__gls(a, w, cols, ncols, maxp, beta, fit, &nz);
+        if (rc == FE_OK && st != NULL && ncols > 0)
+            fe__gls_cov(a, w, cols, ncols, fit, &nz, st->stderr_);
+    } else {
+        rc = fe__fit(a, w, cols, ncols, beta, st != NULL ? st->stderr_ : NULL, fit);
+        if (rc == FE_OK && st != NULL)
+            fe__batch_noise(a, w, cols, ncols, beta, fit, &nz);
+    }
+    if (rc == FE_OK && st != NULL) {
+        st->ncols = ncols;
+        memcpy(st->coef, beta, ncols * sizeof *beta);
+        st->fit = *fit;
+        st->noise = nz;
+    }
+    return rc;
+}
+
+/* Rank every group not in the model against it (the model fitted by
+   fe__fit_step just before, so that w holds its matrices). */
+static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
+                           const fe_discover_group *groups, size_t ngroups,
+                           const fe_discover_options *o, const fe_discover_result *res,
+                           const size_t *cols, size_t ncols, const double *beta,
+                           const fe_discover_fit *cur, const fe_discover_noise *nz,
+                           fe_discover_rank *rk, int *rc)
+{
+    size_t dim = a->m + 1, nr = 0;
+    fe__model mo = {ncols, cols, w->css, {0}};
+    *rc = fe__factor(&mo, ar ? w->gt : w->g, dim);
+    if (*rc != FE_OK)
+        return 0;
+    double rsst = 0.0;
+    if (ar) {
+        fe__residual_weights(dim, cols, ncols, beta, w->uv);
+        rsst = fe__quad(w->gt, dim, w->uv);
+    }
+    for (size_t g = 0; g < ngroups; g++) {
+        if (fe__in_model(res->added, res->steps, o->base, o->nbase, g))
+            continue;
+        if (ar)
+            fe__gls_score(a, w, &mo, beta, &groups[g], cur, nz, rsst, &rk[nr]);
+        else
+            fe__score(a, w, &mo, beta, &groups[g], cur->rss, cur, &rk[nr]);
+        rk[nr].group = g;
+        nr++;
+    }
+    return nr;
+}
+
 int fe_discover_select(const fe_discover_acc *a,
                        const fe_discover_group *groups, size_t ngroups,
                        const fe_discover_options *options,
@@ -1379,10 +1850,11 @@ int fe_discover_select(const fe_discover_acc *a,
     size_t cols[FE_DISCOVER_MAX_COLUMNS], ncols;
     double beta[FE_DISCOVER_MAX_COLUMNS];
     fe_discover_fit cur;
-    int rc;
+    int rc, ar;
 
     if (a == NULL || groups == NULL || res == NULL || ngroups == 0
-        || ngroups > FE_DISCOVER_MAX_GROUPS || (o.nbase > 0 && o.base == NULL))
+        || ngroups > FE_DISCOVER_MAX_GROUPS || (o.nbase > 0 && o.base == NULL)
+        || (o.noise != FE_DISCOVER_NOISE_AR && o.noise != FE_DISCOVER_NOISE_BATCH))
         return FE_EINVAL;
     for (size_t i = 0; i < ngroups; i++)
         if (groups[i].count == 0 || groups[i].count > FE_DISCOVER_MAX_GROUP_SIZE
@@ -1396,6 +1868,10 @@ int fe_discover_select(const fe_discover_acc *a,
         return FE_EINVAL;       /* a screen ranks; the next step needs more */
     if (o.max_steps > FE_DISCOVER_MAX_STEPS)
         o.max_steps = FE_DISCOVER_MAX_STEPS;
+    /* The noise model needs the lagged products: a screen has none. */
+    ar = o.noise == FE_DISCOVER_NOISE_AR && a->lags > 0;
+    if (ar && o.max_order >= a->lags)
+        return FE_EINVAL;
     rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
     if (rc != FE_OK)
         return rc;
@@ -1404,29 +1880,23 @@ int fe_discover_select(const fe_discover_acc *a,
             return FE_ETOOFEW;
     memset(res, 0, sizeof *res);
     fe__total_gram(a, w.g);
-    res->t_critical = fe_student_t_quantile(0.05, (double)(a->blocks - 1));
 
     ncols = fe__model_columns(groups, o.base, o.nbase, res->added, 0, cols);
-    rc = fe__fit(a, &w, cols, ncols, beta, NULL, &res->baseline);
+    res->path[0].added = (size_t)-1;
+    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &res->baseline, &res->path[0]);
     if (rc != FE_OK)
         return rc;
     cur = res->baseline;
     for (size_t step = 0;; step++) {
-        fe__model mo = {ncols, cols, w.css, {0}};
         fe_discover_rank *rk = res->ranking[step];
-        size_t nr = 0, in_play = 0, best = (size_t)-1;
-        rc = fe__factor(&mo, w.g, a->m + 1);
+        size_t nr, in_play = 0, best = (size_t)-1;
+        nr = fe__rank_all(a, &w, ar, groups, ngroups, &o, res, cols, ncols, beta, &cur,
+                          &res->path[res->steps].noise, rk, &rc);
         if (rc != FE_OK)
             return rc;
-        for (size_t g = 0; g < ngroups; g++) {
-            if (fe__in_model(res->added, res->steps, o.base, o.nbase, g))
-                continue;
-            fe__score(a, &w, &mo, beta, &groups[g], cur.rss, &cur, &rk[nr]);
-            rk[nr].group = g;
-            in_play += !rk[nr].redundant;
-            nr++;
-        }
         res->nranked[step] = nr;
+        for (size_t i = 0; i < nr; i++)
+            in_play += !rk[i].redundant;
         for (size_t i = 0; i < nr; i++) {
             if (rk[i].redundant || !(rk[i].p_value < o.alpha / (double)in_play)
                 || !(rk[i].delta_bic < 0.0))
@@ -1434,7 +1904,6 @@ int fe_discover_select(const fe_discover_acc *a,
             if (best == (size_t)-1 || rk[i].delta_bic < rk[best].delta_bic)
                 best = i;
         }
-        /* Note the look-alikes of the previous pick, now that it is in. */
         if (step > 0) {
             size_t prev = step - 1;
             const fe_discover_rank *before = res->ranking[prev];
@@ -1456,25 +1925,30 @@ int fe_discover_select(const fe_discover_acc *a,
         res->added_rank[res->steps] = rk[best];
         res->steps++;
         ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
-        rc = fe__fit(a, &w, cols, ncols, beta, NULL, &cur);
+        res->path[res->steps].added = rk[best].group;
+        rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur,
+                          &res->path[res->steps]);
         if (rc != FE_OK)
             return rc;
     }
-    res->ncols = ncols;
-    memcpy(res->cols, cols, ncols * sizeof *cols);
-    rc = fe__fit(a, &w, cols, ncols, res->coef, res->stderr_, &res->final);
-    if (rc != FE_OK)
-        return rc;
-    /* Report both BICs with one effective sample size, the final model's
-       (its residual is the best estimate of the noise's correlation), so
-       that they can be compared. */
     {
-        double ne = res->final.n_eff, n = res->final.n;
-        fe_discover_fit *f[2] = {&res->baseline, &res->final};
-        for (int i = 0; i < 2; i++) {
-            f[i]->bic = ne * log(f[i]->rss > 0 ? f[i]->rss / n : 1e-300)
-                        + (double)f[i]->params * log(ne);
-            f[i]->n_eff = ne;
+        const fe_discover_step *last = &res->path[res->steps];
+        res->ncols = ncols;
+        memcpy(res->cols, cols, ncols * sizeof *cols);
+        memcpy(res->coef, last->coef, ncols * sizeof *res->coef);
+        memcpy(res->stderr_, last->stderr_, ncols * sizeof *res->stderr_);
+        res->final = last->fit;
+        res->noise = last->noise;
+        res->dof = ar ? fe__gls_dof(&res->final, &res->noise) : (double)(a->blocks - 1);
+        res->t_critical = fe_student_t_quantile(0.05, res->dof);
+        if (!ar) {
+            double ne = res->final.n_eff, n = res->final.n;
+            fe_discover_fit *f[2] = {&res->baseline, &res->final};
+            for (int i = 0; i < 2; i++) {
+                f[i]->bic = ne * log(f[i]->rss > 0 ? f[i]->rss / n : 1e-300)
+                            + (double)f[i]->params * log(ne);
+                f[i]->n_eff = ne;
+            }
         }
     }
     return FE_OK;

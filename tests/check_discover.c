@@ -107,6 +107,7 @@ START_TEST(score_is_the_drop_in_rss)
     o.base = sc.base;
     o.nbase = sc.nbase;
     o.max_steps = 0;
+    o.noise = FE_DISCOVER_NOISE_BATCH;
     ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork), FE_OK);
     ck_assert_uint_eq(r->steps, 0);
     for (size_t i = 0; i < r->nranked[0]; i++) {
@@ -547,6 +548,10 @@ START_TEST(screen_ranks_as_the_full_accumulation)
     o.base = base;
     o.nbase = 2;
     o.max_steps = 0;
+    /* A screen has no lagged products: it ranks by batch means, and says so. */
+    ck_assert_int_eq(fe_discover_select(&a, g, 10, &o, rs, w, nw), FE_OK);
+    ck_assert_int_eq(rs->noise.kind, FE_DISCOVER_NOISE_BATCH);
+    o.noise = FE_DISCOVER_NOISE_BATCH;
     ck_assert_int_eq(fe_discover_select(&full, g, 10, &o, rf, w, nw), FE_OK);
     ck_assert_int_eq(fe_discover_select(&a, g, 10, &o, rs, w, nw), FE_OK);
     ck_assert_uint_eq(rs->nranked[0], 8);
@@ -727,6 +732,238 @@ START_TEST(selection_refuses_empty_blocks_and_collinear_base)
 }
 END_TEST
 
+
+/* The noise model against brute force.  Rows: a constant, a ramp, a sine
+   and a white column; r = 0.3 ramp - 0.2 sine + AR(2) noise. */
+enum { NN = 3000, NM = 4, NK = 10, NFIT = 2400, NBREAK = 1100 };
+static double nphi[NN][NM], nr[NN];
+
+static void noise_rows(void)
+{
+    fe_rng g = fe_rng_seed(31);
+    double e1 = 0, e2 = 0;
+    for (size_t t = 0; t < NN; t++) {
+        double e = 1.2 * e1 - 0.5 * e2 + fe_rng_normal(&g);
+        e2 = e1;
+        e1 = e;
+        nphi[t][0] = 1.0;
+        nphi[t][1] = (double)t / NN;
+        nphi[t][2] = sin(0.01 * (double)t);
+        nphi[t][3] = fe_rng_normal(&g);
+        nr[t] = 0.3 * nphi[t][1] - 0.2 * nphi[t][2] + 0.1 * e;
+    }
+}
+
+/* Z_l by brute force over the stored rows: fitted rows only, no pair
+   across the break before row NBREAK. */
+static double brute_lag(size_t l, size_t i, size_t j)
+{
+    long double s = 0;
+    for (size_t t = l; t < NFIT; t++) {
+        const double *z = nphi[t], *p = nphi[t - l];
+        if (t >= NBREAK && t - l < NBREAK)
+            continue;
+        s += (long double)(i < NM ? z[i] : nr[t]) * (j < NM ? p[j] : nr[t - l]);
+    }
+    return (double)s;
+}
+
+START_TEST(lagged_products_match_brute_force_in_every_path)
+{
+    size_t nst = fe_discover_acc_doubles(NM, NK), dim = NM + 1;
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2),
+           *s3 = malloc(nst * sizeof *s3), *s4 = malloc(nst * sizeof *s4);
+    static double cols[NM][NN];
+    fe_discover_acc rows, panels, columns, part;
+    const size_t cuts[3] = {0, 700, 1103};       /* parts, the second ends past the break */
+    noise_rows();
+    for (size_t t = 0; t < NN; t++)
+        for (size_t c = 0; c < NM; c++)
+            cols[c][t] = nphi[t][c];
+    ck_assert_int_eq(fe_discover_acc_init(&rows, NM, NK, NFIT, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&panels, NM, NK, NFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&columns, NM, NK, NFIT, 0, s3, nst), FE_OK);
+    for (size_t t = 0; t < NN; t++) {
+        if (t == NBREAK)
+            fe_discover_break(&rows);
+        ck_assert_int_eq(fe_discover_add(&rows, nphi[t], nr[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_add_rows(&panels, nphi[0], NM, nr, NBREAK, NULL), FE_OK);
+    fe_discover_break(&panels);
+    ck_assert_int_eq(fe_discover_add_rows(&panels, nphi[NBREAK], NM, nr + NBREAK, NN - NBREAK,
+                                          NULL), FE_OK);
+    ck_assert_int_eq(fe_discover_add_columns(&columns, cols[0], NN, nr, NBREAK, NULL), FE_OK);
+    fe_discover_break(&columns);
+    ck_assert_int_eq(fe_discover_add_columns(&columns, cols[0] + NBREAK, NN, nr + NBREAK,
+                                             NN - NBREAK, NULL), FE_OK);
+    /* Three parts merged, the break inside the second (3 rows before its end). */
+    {
+        fe_discover_acc merged;
+        double *s5 = malloc(nst * sizeof *s5);
+        ck_assert_int_eq(fe_discover_acc_init(&merged, NM, NK, NFIT, 0, s5, nst), FE_OK);
+        for (int k = 0; k < 3; k++) {
+            size_t lo = cuts[k], hi = k < 2 ? cuts[k + 1] : NN;
+            ck_assert_int_eq(fe_discover_acc_init(&part, NM, NK, NFIT, lo, s4, nst), FE_OK);
+            for (size_t t = lo; t < hi; t++) {
+                if (t == NBREAK)
+                    fe_discover_break(&part);
+                ck_assert_int_eq(fe_discover_add(&part, nphi[t], nr[t]), FE_OK);
+            }
+            ck_assert_int_eq(fe_discover_merge(&merged, &part), FE_OK);
+        }
+        for (size_t l = 1; l <= FE_DISCOVER_LAGS; l++)
+            for (size_t i = 0; i < dim; i++)
+                for (size_t j = 0; j < dim; j++) {
+                    double want = brute_lag(l, i, j);
+                    const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
+                    for (int q = 0; q < 4; q++)
+                        FE_ASSERT_REL(acc[q]->zlag[(l - 1) * dim * dim + i * dim + j] + 1.0,
+                                      want + 1.0, 1e-11);
+                }
+        free(s5);
+    }
+    free(s1);
+    free(s2);
+    free(s3);
+    free(s4);
+}
+END_TEST
+
+START_TEST(levinson_recovers_a_known_autoregression)
+{
+    /* The autocovariances of AR(2), phi = (1.2, -0.5), unit innovations:
+       gamma_0 = (1 - phi2) / ((1 + phi2)((1 - phi2)^2 - phi1^2)), then the
+       Yule-Walker recursion; the fit returns phi exactly and the
+       innovation variance 1 (q = n gamma). */
+    double phi1 = 1.2, phi2 = -0.5, n = 1e4, q[FE_DISCOVER_LAGS];
+    fe_discover_noise nz;
+    q[0] = (1 - phi2) / ((1 + phi2) * ((1 - phi2) * (1 - phi2) - phi1 * phi1));
+    q[1] = phi1 * q[0] / (1 - phi2);
+    for (size_t l = 2; l < FE_DISCOVER_LAGS; l++)
+        q[l] = phi1 * q[l - 1] + phi2 * q[l - 2];
+    for (size_t l = 0; l < FE_DISCOVER_LAGS; l++)
+        q[l] *= n;
+    ck_assert_int_eq(fe_discover_noise_fit(q, n, 4, &nz), FE_OK);
+    ck_assert_uint_eq(nz.order, 2);
+    ck_assert_double_eq_tol(nz.phi[0], phi1, 1e-12);
+    ck_assert_double_eq_tol(nz.phi[1], phi2, 1e-12);
+    ck_assert_double_eq_tol(nz.innovation_variance, 1.0, 1e-12);
+    /* n_eff = n gamma_0 (1 - phi1 - phi2)^2 / sigma^2. */
+    ck_assert_double_eq_tol(nz.n_eff, n * q[0] / n * 0.3 * 0.3, 1e-8);
+    ck_assert_int_eq(fe_discover_noise_fit(q, 1.0, 4, &nz), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_noise_fit(q, n, FE_DISCOVER_LAGS, &nz), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_noise_fit(NULL, n, 4, &nz), FE_EINVAL);
+}
+END_TEST
+
+START_TEST(gls_matches_prewhitened_least_squares)
+{
+    /* fe_discover_fit_noise against brute force on the stored rows: whiten
+       each recording (zero-padded at both ends) with the returned filter,
+       solve the normal equations, and compare coefficients, whitened RSS
+       (through the BIC) and standard errors. */
+    size_t nst = fe_discover_acc_doubles(NM, NK), nw = fe_discover_workspace_doubles(NM, NK);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    size_t cols[3] = {0, 1, 2};
+    double coef[3], se[3];
+    long double xtx[3][3] = {{0}}, xty[3] = {0}, rss = 0;
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    fe_discover_acc a;
+    noise_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < NN; t++) {
+        if (t == NBREAK)
+            fe_discover_break(&a);
+        ck_assert_int_eq(fe_discover_add(&a, nphi[t], nr[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 3, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_int_eq(nz.kind, FE_DISCOVER_NOISE_AR);
+    ck_assert_uint_ge(nz.order, 2);
+    ck_assert_double_eq_tol(nz.phi[0], 1.2, 0.1);
+    {
+        /* Whitened rows of each recording [0, NBREAK) and [NBREAK, NFIT),
+           with p rows of transient past each end. */
+        size_t seg[2][2] = {{0, NBREAK}, {NBREAK, NFIT}}, p = nz.order;
+        for (int g = 0; g < 2; g++)
+            for (size_t t = seg[g][0]; t < seg[g][1] + p; t++) {
+                long double x[3] = {0}, y = 0;
+                for (size_t i = 0; i <= p; i++) {
+                    double al = i == 0 ? 1.0 : -nz.phi[i - 1];
+                    if (t < seg[g][0] + i || t - i >= seg[g][1])
+                        continue;
+                    for (int c = 0; c < 3; c++)
+                        x[c] += al * nphi[t - i][c];
+                    y += al * nr[t - i];
+                }
+                for (int c = 0; c < 3; c++) {
+                    for (int d = 0; d < 3; d++)
+                        xtx[c][d] += x[c] * x[d];
+                    xty[c] += x[c] * y;
+                }
+            }
+        {
+            /* Solve the 3 x 3 system by Gaussian elimination. */
+            long double m[3][4], b[3];
+            for (int c = 0; c < 3; c++) {
+                for (int d = 0; d < 3; d++)
+                    m[c][d] = xtx[c][d];
+                m[c][3] = xty[c];
+            }
+            for (int c = 0; c < 3; c++)
+                for (int r = c + 1; r < 3; r++) {
+                    long double f = m[r][c] / m[c][c];
+                    for (int d = c; d < 4; d++)
+                        m[r][d] -= f * m[c][d];
+                }
+            for (int c = 2; c >= 0; c--) {
+                b[c] = m[c][3];
+                for (int d = c + 1; d < 3; d++)
+                    b[c] -= m[c][d] * b[d];
+                b[c] /= m[c][c];
+            }
+            for (int c = 0; c < 3; c++)
+                FE_ASSERT_REL(coef[c], (double)b[c], 1e-8);
+            /* The whitened RSS, through the BIC. */
+            {
+                long double yy = 0;
+                /* RSS = y'y - b'X'y, with y'y accumulated again. */
+                size_t segs[2][2] = {{0, NBREAK}, {NBREAK, NFIT}};
+                for (int g = 0; g < 2; g++)
+                    for (size_t t = segs[g][0]; t < segs[g][1] + p; t++) {
+                        long double y = 0;
+                        for (size_t i = 0; i <= p; i++) {
+                            double al = i == 0 ? 1.0 : -nz.phi[i - 1];
+                            if (t < segs[g][0] + i || t - i >= segs[g][1])
+                                continue;
+                            y += al * nr[t - i];
+                        }
+                        yy += y * y;
+                    }
+                rss = yy - (b[0] * xty[0] + b[1] * xty[1] + b[2] * xty[2]);
+            }
+            FE_ASSERT_REL(fit.bic, (double)(NFIT * logl(rss / NFIT) + (3 + p) * log(NFIT)), 1e-9);
+            ck_assert_int_eq(nz.long_run, 0);   /* AR(2) noise: whitened to white */
+            {
+                /* se_c^2 = s^2 [(X'X)^-1]_cc, s^2 = RSS / (n - 3 - p): the
+                   inverse's diagonal from the cofactors. */
+                long double det = xtx[0][0] * (xtx[1][1] * xtx[2][2] - xtx[1][2] * xtx[2][1])
+                                  - xtx[0][1] * (xtx[1][0] * xtx[2][2] - xtx[1][2] * xtx[2][0])
+                                  + xtx[0][2] * (xtx[1][0] * xtx[2][1] - xtx[1][1] * xtx[2][0]);
+                long double s2 = rss / (NFIT - 3 - (long double)p);
+                long double inv00 = (xtx[1][1] * xtx[2][2] - xtx[1][2] * xtx[2][1]) / det;
+                FE_ASSERT_REL(se[0], (double)sqrtl(s2 * inv00), 1e-8);
+            }
+        }
+    }
+    /* A screen has no lagged products. */
+    ck_assert_int_eq(fe_discover_screen_init(&a, NM, 2, NK, NFIT, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, 4, coef, se, &fit, &nz, w, nw), FE_EINVAL);
+    free(st);
+    free(w);
+}
+END_TEST
+
 /* The acceptance suite of the discovery issue. */
 START_TEST(concealed_effects_are_found_and_nulls_are_not)
 {
@@ -803,6 +1040,9 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, screen_ranks_as_the_full_accumulation);
     tcase_add_test(t, screen_refuses_what_it_cannot_answer);
     tcase_add_test(t, columns_stop_at_the_first_refused_row);
+    tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
+    tcase_add_test(t, levinson_recovers_a_known_autoregression);
+    tcase_add_test(t, gls_matches_prewhitened_least_squares);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

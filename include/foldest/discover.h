@@ -194,22 +194,62 @@ typedef struct fe_discover_group {
     size_t first, count;        /* columns first .. first + count - 1 */
 } fe_discover_group;
 
+/* How the noise's correlation is handled. */
+enum {
+    FE_DISCOVER_NOISE_AR = 0,   /* an AR(p) noise model, generalised least
+                                   squares (needs a full accumulation) */
+    FE_DISCOVER_NOISE_BATCH = 1 /* batch means over the K blocks */
+};
+
 typedef struct fe_discover_options {
     double alpha;               /* family-wise level of a step: 0.05 */
     size_t max_steps;           /* at most this many terms added: 8 */
     const size_t *base;         /* groups always in the model (may be NULL) */
     size_t nbase;
+    int noise;                  /* FE_DISCOVER_NOISE_AR (default) or _BATCH */
+    size_t max_order;           /* highest AR order tried: 4, at most
+                                   FE_DISCOVER_LAGS - 1 */
 } fe_discover_options;
 
-/* fe_discover_default_options: alpha 0.05, 8 steps, no base terms. */
+/* fe_discover_default_options: alpha 0.05, 8 steps, no base terms, the AR
+   noise model up to order 4. */
 fe_discover_options fe_discover_default_options(void);
+
+/* The noise model of a fitted model's residual e_t. */
+typedef struct fe_discover_noise {
+    int kind;                   /* FE_DISCOVER_NOISE_AR or _BATCH: what was
+                                   used (batch for a screen, which has no
+                                   lagged products) */
+    size_t order;               /* p: e_t = sum phi_i e_{t-i} + eta_t */
+    double phi[FE_DISCOVER_LAGS];
+    double variance;            /* of e: gamma_0 */
+    double innovation_variance; /* of eta (whitened residual, per row) */
+    double n_eff;               /* n gamma_0 (1 - sum phi)^2 / sigma_eta^2:
+                                   rows worth as many independent ones */
+    size_t lags_tested;         /* H: lags of the portmanteau test (0: none) */
+    double portmanteau;         /* Ljung-Box Q of the whitened residual */
+    double portmanteau_dof;     /* H - p (at least 1) */
+    double portmanteau_p;       /* its p-value; NaN without lagged products */
+    int long_run;               /* 1 when whiteness was rejected (p < 0.05)
+                                   and variances carry the long-run factor */
+} fe_discover_noise;
+
+/* fe_discover_noise_fit: the AR noise model of a series from its lagged
+   sums q[0 .. maxp] (q_l = sum_t e_t e_{t-l} over n rows): Levinson-Durbin
+   for every order up to maxp (< FE_DISCOVER_LAGS), the order chosen by
+   BIC, n ln sigma_p^2 + p ln n.  Fills kind, order, phi, variance,
+   innovation_variance and n_eff (not the portmanteau).  FE_EINVAL for
+   NULL, n < 2 or maxp out of range; a series of zero variance has order 0. */
+int fe_discover_noise_fit(const double *q, double n, size_t maxp,
+                          fe_discover_noise *noise);
 
 /* One candidate's test at one step. */
 typedef struct fe_discover_rank {
     size_t group;
-    double rss_drop;            /* Delta_J: the drop in RSS if added */
+    double rss_drop;            /* Delta_J: the drop in RSS if added (in the
+                                   current noise model's whitened metric) */
     double statistic;           /* t (one column) or F (several) */
-    double p_value;             /* batch-means p-value */
+    double p_value;             /* under the noise model (or batch means) */
     double delta_bic;           /* BIC change if added (negative: better) */
     int redundant;              /* already expressible by the model */
 } fe_discover_rank;
@@ -217,12 +257,26 @@ typedef struct fe_discover_rank {
 /* A summary of a fitted model. */
 typedef struct fe_discover_fit {
     double rss, rms;            /* fitted rows */
-    double bic;                 /* with the effective sample size */
+    double bic;                 /* GLS: n ln(whitened RSS / n) + (params +
+                                   p) ln n; batch: with the effective
+                                   sample size */
     double heldout_rms;         /* NaN when nothing is held out */
     double lag1;                /* lag-one autocorrelation of the residual */
     double n, n_eff, heldout_n;
     size_t params;
 } fe_discover_fit;
+
+/* One step of the selection path: the model after the step (the base
+   terms, then the terms added so far), refitted. */
+typedef struct fe_discover_step {
+    size_t added;                               /* the group added; for
+                                                   step 0 (the base)
+                                                   (size_t)-1 */
+    size_t ncols;                               /* = result's cols[0 .. ncols) */
+    double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
+    fe_discover_fit fit;
+    fe_discover_noise noise;
+} fe_discover_step;
 
 /* What discovery found. */
 typedef struct fe_discover_result {
@@ -241,7 +295,10 @@ typedef struct fe_discover_result {
     size_t cols[FE_DISCOVER_MAX_COLUMNS];
     double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
     double t_critical;                          /* for 95% intervals */
+    double dof;                                 /* of t_critical */
     fe_discover_fit baseline, final;
+    fe_discover_noise noise;                    /* of the final model */
+    fe_discover_step path[FE_DISCOVER_MAX_STEPS + 1];  /* steps + 1 */
 } fe_discover_result;
 
 /* fe_discover_workspace_doubles: scratch needed by fe_discover_select. */
@@ -269,6 +326,19 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
                             size_t ncols, double *coef, double *stderr_,
                             fe_discover_fit *fit, double *work,
                             size_t work_doubles);
+
+/* fe_discover_fit_noise: the same fit by feasible generalised least
+   squares under an AR noise model of order at most max_order (<
+   FE_DISCOVER_LAGS), re-estimated from the fit's own residual:
+   coefficients, their standard errors (stderr_ may be NULL), the summary
+   and the noise model (with the portmanteau test of the whitened
+   residual).  A full accumulation only (FE_EINVAL for a screen); other
+   errors as fe_discover_fit_columns. */
+int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
+                          size_t ncols, size_t max_order, double *coef,
+                          double *stderr_, fe_discover_fit *fit,
+                          fe_discover_noise *noise, double *work,
+                          size_t work_doubles);
 
 #endif /* FOLDEST_DISCOVER_H */
 /* Discovery Selection Declarations ends here */

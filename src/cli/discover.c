@@ -196,6 +196,42 @@ typedef struct fe__located {
     char region[64];
     double n, z, t, mean_before, mean_after, ms_ratio_before, ms_ratio_after;
 } fe__located;
+
+/* What one row is worth in independent rows under a noise model: n_eff / n,
+   at most 1, so that a block of n_k rows weighs n_k times it. */
+static double fe__row_worth(const fe_discover_noise *nz, double n)
+{
+    double w = n > 0 ? nz->n_eff / n : 1.0;
+    return w > 1.0 ? 1.0 : w < 1e-6 ? 1e-6 : w;
+}
+
+/* The largest |t| (mean) or z (mean square) of any fitted block or
+   region, for the residual after the final model (sum1, sq1), under the
+   final noise model. */
+static double fe__largest_after(const fe__stat *blocks, size_t K, const fe__stat *regions,
+                                size_t nregions, double worth)
+{
+    double all_n = 0, all_sq = 0, all_sum = 0, worst = 0.0;
+    for (size_t k = 0; k < K; k++) {
+        all_n += blocks[k].n;
+        all_sq += blocks[k].sq1;
+        all_sum += blocks[k].sum1;
+    }
+    if (!(all_n > 0 && all_sq > 0))
+        return 0.0;
+    for (size_t g = 0; g < K + nregions; g++) {
+        const fe__stat *b = g < K ? &blocks[g] : &regions[g - K];
+        double ms = all_sq / all_n, neff, t, z;
+        if (b->n < 2 || b->n > all_n - 2)
+            continue;
+        neff = b->n * worth;
+        t = (b->sum1 / b->n - all_sum / all_n) / sqrt(ms / neff);
+        z = (b->sq1 / b->n / ms - 1.0) / sqrt(2.0 / neff);
+        worst = fabs(t) > worst ? fabs(t) : worst;
+        worst = z > worst ? z : worst;
+    }
+    return worst;
+}
 /* Region statistics ends here */
 /* [[file:../../literate/cli_discover.org::Discover Options][Discover Options]] */
 static const char fe__discover_help[] =
@@ -216,7 +252,11 @@ static const char fe__discover_help[] =
     "                         e.g. bias,gain; default none\n"
     "  --holdout F            keep the last fraction F of rows out of selection and\n"
     "                         fitting, and report the RMS on them (default 0.2; 0: none)\n"
-    "  --blocks K             time blocks for the batch-means tests (default 20)\n"
+    "  --noise MODEL          how the noise's correlation is handled: 'ar' (default),\n"
+    "                         an autoregression re-estimated as terms enter, with\n"
+    "                         generalised least squares; 'batch', batch means over\n"
+    "                         the time blocks\n"
+    "  --blocks K             time blocks for locating (and batch means) (default 20)\n"
     "  --alpha A              family-wise false discovery level (default 0.05)\n"
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
     "  --json                 print one JSON object instead of the story\n"
@@ -238,6 +278,7 @@ typedef struct fe__discover_args {
     double holdout, alpha;
     long blocks;
     int json;
+    int noise;                  /* FE_DISCOVER_NOISE_AR or _BATCH */
 } fe__discover_args;
 
 static void fe__discover_usage(FILE *out)
@@ -308,6 +349,15 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
             rc = fe_cli_parse_double(o, v, &a->alpha, err, errlen);
             if (rc == FE_CLI_OK && !(a->alpha > 0.0 && a->alpha < 0.5)) {
                 snprintf(err, errlen, "--alpha: %s is not in (0, 0.5)", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--noise") == 0) {
+            if (strcmp(v, "ar") == 0)
+                a->noise = FE_DISCOVER_NOISE_AR;
+            else if (strcmp(v, "batch") == 0)
+                a->noise = FE_DISCOVER_NOISE_BATCH;
+            else {
+                snprintf(err, errlen, "--noise: '%s' is not 'ar' or 'batch'", v);
                 rc = FE_CLI_USAGE;
             }
         } else if (strcmp(o, "--blocks") == 0) {
@@ -453,6 +503,7 @@ typedef struct fe__outcome {
     fe__located located[128];
     size_t nlocated;
     const char *verdict;
+    const char *why;                            /* why not "explained", or NULL */
     /* The final model refitted on each recording alone (classical errors). */
     const fe__stat *regions;
     const char *const *region_var;
@@ -501,6 +552,56 @@ static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
     fprintf(f, ", \"params\": %zu}", fit->params);
 }
 
+static void fe__json_noise(FILE *f, const fe_discover_noise *nz)
+{
+    fprintf(f, "{\"model\": \"%s\", \"order\": %zu, \"phi\": [",
+            nz->kind == FE_DISCOVER_NOISE_AR ? "ar" : "batch", nz->order);
+    for (size_t i = 0; i < nz->order; i++) {
+        fprintf(f, "%s", i ? ", " : "");
+        fe__json_number(f, nz->phi[i]);
+    }
+    fprintf(f, "], \"variance\": ");
+    fe__json_number(f, nz->variance);
+    fe__json_pair(f, "innovation_variance", nz->innovation_variance);
+    fe__json_pair(f, "effective_sample_size", nz->n_eff);
+    fprintf(f, ", \"portmanteau\": {\"test\": \"ljung-box\", \"lags\": %zu",
+            nz->lags_tested);
+    fe__json_pair(f, "q", nz->portmanteau);
+    fe__json_pair(f, "dof", nz->portmanteau_dof);
+    fe__json_pair(f, "p_value", nz->portmanteau_p);
+    fprintf(f, "}, \"long_run_correction\": %s}", nz->long_run ? "true" : "false");
+}
+
+/* The selection path: each step's model refitted. */
+static void fe__json_path(FILE *f, const fe__outcome *o)
+{
+    const fe_discover_result *r = o->r;
+    fprintf(f, "\"path\": [");
+    for (size_t s = 0; s <= r->steps; s++) {
+        const fe_discover_step *st = &r->path[s];
+        fprintf(f, "%s{\"step\": %zu, \"added\": ", s ? ", " : "", s);
+        if (s == 0)
+            fprintf(f, "null");
+        else
+            fe_cli_json_string(f, o->c->terms[st->added].name);
+        fprintf(f, ", \"coefficients\": {");
+        for (size_t j = 0; j < st->ncols; j++) {
+            fprintf(f, "%s", j ? ", " : "");
+            fe_cli_json_string(f, o->c->terms[r->cols[j]].name);
+            fprintf(f, ": {\"value\": ");
+            fe__json_number(f, st->coef[j]);
+            fe__json_pair(f, "stderr", st->stderr_[j]);
+            fprintf(f, "}");
+        }
+        fprintf(f, "}, \"rms\": ");
+        fe__json_number(f, st->fit.rms);
+        fe__json_pair(f, "heldout_rms", st->fit.heldout_rms);
+        fe__json_pair(f, "bic", st->fit.bic);
+        fprintf(f, ", \"noise_order\": %zu}", st->noise.order);
+    }
+    fprintf(f, "]");
+}
+
 static void fe__print_json(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
@@ -516,6 +617,12 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     fe__json_fit(f, "baseline", &r->baseline);
     fprintf(f, ", ");
     fe__json_fit(f, "final", &r->final);
+    fprintf(f, ", \"noise\": ");
+    fe__json_noise(f, &r->noise);
+    fprintf(f, ", \"baseline_noise\": ");
+    fe__json_noise(f, &r->path[0].noise);
+    fprintf(f, ", ");
+    fe__json_path(f, o);
     fprintf(f, ", \"located\": [");
     for (size_t i = 0; i < o->nlocated; i++) {
         const fe__located *l = &o->located[i];
@@ -594,6 +701,47 @@ static int fe__cmp_rank(const void *a, const void *b)
     return (x->p_value > y->p_value) - (x->p_value < y->p_value);
 }
 
+/* "noise: AR(2) ..." for the story. */
+static void fe__story_noise(FILE *f, const char *what, const fe_discover_noise *nz,
+                            double n, size_t blocks)
+{
+    fprintf(f, "noise (%s): ", what);
+    if (nz->kind == FE_DISCOVER_NOISE_BATCH)
+        fprintf(f, "batch means over %zu time blocks", blocks);
+    else if (nz->order == 0)
+        fprintf(f, "white (AR(0))");
+    else {
+        fprintf(f, "AR(%zu), phi =", nz->order);
+        for (size_t i = 0; i < nz->order; i++)
+            fprintf(f, "%s %.3g", i ? "," : "", nz->phi[i]);
+    }
+    fprintf(f, "; effective sample size %.0f of %.0f rows", nz->n_eff, n);
+    if (nz->lags_tested > 0)
+        fprintf(f, "; %s residual %s (Ljung-Box over %zu lags, p = %.2g)%s",
+                nz->kind == FE_DISCOVER_NOISE_AR ? "whitened" : "the",
+                nz->portmanteau_p < 0.01 ? "not white" : "white", nz->lags_tested,
+                nz->portmanteau_p, nz->long_run ? ", variances widened by the long-run factor" : "");
+    fprintf(f, "\n");
+}
+
+static void fe__story_path(FILE *f, const fe__outcome *o)
+{
+    const fe_discover_result *r = o->r;
+    fprintf(f, "\nselection path (each step refitted; coefficient +/- standard error):\n");
+    fprintf(f, "  %-4s %-20s %11s %12s %12s  %s\n", "step", "added", "RMS", "held-out RMS",
+            "BIC", "coefficients");
+    for (size_t s = 0; s <= r->steps; s++) {
+        const fe_discover_step *st = &r->path[s];
+        fprintf(f, "  %-4zu %-20s %11.5g %12.5g %12.6g ", s,
+                s == 0 ? "(base)" : o->c->terms[st->added].name, st->fit.rms,
+                st->fit.heldout_rms, st->fit.bic);
+        for (size_t j = 0; j < st->ncols; j++)
+            fprintf(f, " %s %.4g+/-%.2g", o->c->terms[r->cols[j]].name, st->coef[j],
+                    st->stderr_[j]);
+        fprintf(f, "\n");
+    }
+}
+
 static void fe__print_story(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
@@ -622,8 +770,14 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
                    " after: %+.3g, %.2fx\n", l->mean_before, l->ms_ratio_before, l->z, l->t,
                 l->mean_after, l->ms_ratio_after);
     }
-    fprintf(f, "\ncandidates, first step (batch-means tests over %zu time blocks):\n",
-            o->blocks);
+    fprintf(f, "\n");
+    fe__story_noise(f, "baseline", &r->path[0].noise, r->baseline.n, o->blocks);
+    if (r->noise.kind == FE_DISCOVER_NOISE_BATCH)
+        fprintf(f, "\ncandidates, first step (batch-means tests over %zu time blocks):\n",
+                o->blocks);
+    else
+        fprintf(f, "\ncandidates, first step (generalised least squares, noise re-estimated "
+                   "with each candidate):\n");
     memcpy(sorted, r->ranking[0], r->nranked[0] * sizeof *sorted);
     qsort(sorted, r->nranked[0], sizeof *sorted, fe__cmp_rank);
     for (size_t i = 0; i < r->nranked[0]; i++)
@@ -650,6 +804,8 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             fprintf(f, "\n");
         }
     }
+    if (r->steps > 0)
+        fe__story_path(f, o);
     if (r->steps > 0 && o->npairs > 1 && o->per_coef != NULL) {
         fprintf(f, "\nthe same model fitted on each recording alone (classical standard errors):\n");
         for (size_t q = 0; q < o->npairs; q++) {
@@ -688,7 +844,10 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
                 r->baseline.heldout_rms, r->final.heldout_rms,
                 100.0 * (r->final.heldout_rms / r->baseline.heldout_rms - 1.0));
+    fe__story_noise(f, "final", &r->noise, r->final.n, o->blocks);
     fprintf(f, "\nverdict: %s\n", o->verdict);
+    if (o->why != NULL)
+        fprintf(f, "  (%s)\n", o->why);
 }
 /* Print the story ends here */
 /* [[file:../../literate/cli_discover.org::Write the report][Write the report]] */
@@ -929,6 +1088,7 @@ int fe_cli_discover(int argc, char **argv)
     opt.alpha = a.alpha;
     opt.base = base;
     opt.nbase = nbase;
+    opt.noise = a.noise;
     rc = fe_discover_select(&acc, groups, cat.count, &opt, res, work, nwork);
     if (rc != FE_OK) {
         fprintf(stderr, "foldest discover: %s%s\n", fe_strerror(rc),
@@ -937,13 +1097,7 @@ int fe_cli_discover(int argc, char **argv)
         rc = FE_CLI_REFUSED;
         goto cleanup;
     }
-    {
-        fe_discover_fit bf;
-        double bse[FE_DISCOVER_MAX_COLUMNS];
-        if (fe_discover_fit_columns(&acc, base, nbase, out.baseline_coef, bse, &bf, work,
-                                    nwork) != FE_OK)
-            goto internal;
-    }
+    memcpy(out.baseline_coef, res->path[0].coef, nbase * sizeof *out.baseline_coef);
 
     /* Regions of the state to test. */
     if (roles & FE_ROLE_VELOCITY) {
@@ -1082,11 +1236,10 @@ int fe_cli_discover(int argc, char **argv)
 
     /* Locate: time blocks, then regions. */
     {
-        double ms[FE_DISCOVER_MAX_BLOCKS] = {0}, med, rho = res->baseline.lag1, all_n = 0, all_sq = 0;
-        double infl;
+        double ms[FE_DISCOVER_MAX_BLOCKS] = {0}, med, all_n = 0, all_sq = 0;
+        double infl = fe__row_worth(&res->path[0].noise, res->baseline.n);
         size_t K = (size_t)a.blocks;
-        rho = rho < 0 ? 0 : rho > 0.99 ? 0.99 : rho;
-        infl = (1.0 - rho) / (1.0 + rho);
+        double thr = fe_student_t_quantile(a.alpha / (double)(2 * (K + nregions)), 1e6);
         for (size_t k = 0; k < K; k++) {
             ms[k] = blocks[k].n > 0 ? blocks[k].sq0 / blocks[k].n : 0.0;
             all_n += blocks[k].n;
@@ -1105,7 +1258,7 @@ int fe_cli_discover(int argc, char **argv)
                 continue;
             z = (ms[k] / med - 1.0) / sqrt(2.0 / neff);
             t = (b->sum0 / b->n) / sqrt(med / neff);
-            if (z > 4.0 || fabs(t) > 4.0) {
+            if (z > thr || fabs(t) > thr) {
                 fe__located *l = out.nlocated > 0 ? &out.located[out.nlocated - 1] : NULL;
                 if (l != NULL && l->is_time && l->pair1 == b->pair && l->t1 <= b->t0
                     && k > 0 && blocks[k - 1].t1 == l->t1) {
@@ -1148,7 +1301,7 @@ int fe_cli_discover(int argc, char **argv)
             neff = b->n * infl;
             t = (b->sum0 / b->n - mean_all) / sqrt(msall / neff);
             z = (b->sq0 / b->n / msall - 1.0) / sqrt(2.0 / neff);
-            if ((fabs(t) > 4.0 || z > 4.0) && out.nlocated < 128) {
+            if ((fabs(t) > thr || z > thr) && out.nlocated < 128) {
                 fe__located *l = &out.located[out.nlocated++];
                 memset(l, 0, sizeof *l);
                 l->variable = region_var[g];
@@ -1173,9 +1326,25 @@ int fe_cli_discover(int argc, char **argv)
     out.alpha = a.alpha;
     out.base = base;
     out.nbase = nbase;
-    out.verdict = res->steps > 0 ? "mismatch explained"
-                  : out.nlocated > 0 ? "mismatch not explained by the catalog"
-                                     : "no significant mismatch";
+    {
+        double worst = fe__largest_after(blocks, (size_t)a.blocks, regions, nregions,
+                                         fe__row_worth(&res->noise, res->final.n));
+        double thr = fe_student_t_quantile(a.alpha / (double)(2 * ((size_t)a.blocks + nregions)), 1e6);
+        out.why = NULL;
+        if (res->steps == 0)
+            out.verdict = out.nlocated > 0 ? "mismatch not explained by the catalog"
+                                           : "no significant mismatch";
+        else if (res->noise.kind == FE_DISCOVER_NOISE_AR && res->noise.portmanteau_p < 0.001) {
+            out.verdict = "mismatch not explained by the catalog";
+            out.why = "terms were found, but the residual left is not white noise: "
+                      "something else is missing";
+        } else if (worst > thr) {
+            out.verdict = "mismatch not explained by the catalog";
+            out.why = "terms were found, but a time window or state region stays out of line "
+                      "after them";
+        } else
+            out.verdict = "mismatch explained";
+    }
     if (a.json)
         fe__print_json(stdout, &out);
     else
@@ -1434,6 +1603,7 @@ static int fe__discover_sphere(fe__sphere_args *a)
         opt.alpha = a->alpha;
         opt.base = base;
         opt.nbase = 2;
+        opt.noise = FE_DISCOVER_NOISE_BATCH;    /* see the text */
         rc = fe_discover_select(&acc, groups, ngroups, &opt, res, work, nw);
         if (rc != FE_OK) {
             fprintf(stderr, "foldest discover: %s: %s\n", t.name, fe_strerror(rc));
