@@ -52,7 +52,7 @@ export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
         check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
-        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage
+        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept
 
 all: lib cli examples
 
@@ -219,6 +219,18 @@ check-install: lib
 	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest)' _ "$$d" "$$e"; \
 	  echo "built $$e against $$d/usr/local"; \
 	done
+
+# ---------------------------------------------------------------- acceptance
+# `make accept`: foldest discover on cases drawn by an independent generator
+# (tests/accept/gen.c: its own random numbers, rigs, noise and clocks; it
+# includes nothing of foldest) and on the real recordings; long, so outside
+# `make check` and CI.  SEEDS=20 by default, QUICK=1 for three seeds.
+$(B)/accept/gen: tests/accept/gen.c $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) -o $@ $< -lm
+
+accept: all $(B)/accept/gen
+	FOLDEST=$(CLI) GEN=$(B)/accept/gen ACCEPT_OUT=$(B)/accept/runs python3 tests/accept/run.py
 
 # ---------------------------------------------------------------- fuzzing
 # libFuzzer harnesses (tests/fuzz/fuzz_*.c), clang with ASan and UBSan; the
