@@ -55,11 +55,19 @@ static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitte
         memcpy(a->head + a->nhead++ * dim, z, dim * sizeof *z);
 }
 
-/* Fold q rows given by columns: value c of row t at col[c][t * ts]. */
+/* Fold q rows of block k given by columns (value c of row t at
+   col[c][t * ts]): the block's sums, and the lagged products. */
 static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
-                                   size_t ts, size_t q, int fitted)
+                                   size_t ts, size_t q, size_t k)
 {
     double z[FE_DISCOVER_MAX_COLUMNS + 1];
+    int fitted = k < a->blocks;
+    for (size_t c = 0; c <= a->m && fitted; c++) {
+        double s = 0.0;
+        for (size_t t = 0; t < q; t++)
+            s += col[c][t * ts];
+        a->bsum[k * (a->m + 1) + c] += s;
+    }
     if (a->lags == 0)
         return;
     for (size_t t = 0; t < q; t++) {
@@ -87,6 +95,8 @@ static int fe__discover_lags_finite(const fe_discover_acc *a, const double *z)
 static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b)
 {
     size_t dim = a->m + 1, P = a->lags;
+    for (size_t i = 0; i < a->blocks * dim; i++)
+        a->bsum[i] += b->bsum[i];
     if (P == 0)
         return;
     for (size_t i = 0; i < P * dim * dim; i++)
@@ -157,7 +167,8 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->zlag = a->counts + a->blocks + 1;
     a->hist = a->zlag + FE_DISCOVER_LAGS * dim * dim;
     a->head = a->hist + FE_DISCOVER_LAGS * dim;
-    a->work = a->head + FE_DISCOVER_LAGS * dim;
+    a->bsum = a->head + FE_DISCOVER_LAGS * dim;
+    a->work = a->bsum + a->blocks * dim;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -310,6 +321,8 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     if (a->have_prev && k < a->blocks)
         fe__discover_lag_pair(a, z, a->last);
     fe__discover_lags_row(a, z, k < a->blocks);
+    for (size_t i = 0; i < dim && k < a->blocks; i++)
+        a->bsum[k * dim + i] += z[i];
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
@@ -406,11 +419,11 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
     double *g = a->gram + k * dim * dim, *t = a->lag;
     int fitted = k < a->blocks, linked = fitted && a->have_prev;
     size_t pairs = linked ? q : q - 1;
-    const double *rows[FE_DISCOVER_MAX_COLUMNS + 1];
+    const double *rows[FE_DISCOVER_MAX_COLUMNS + 1] = {0};
 
-    for (size_t c = 0; c < dim; c++)
-        rows[c] = z + c;
-    fe__discover_lags_rows(a, rows, dim, q, fitted);
+    for (size_t j = 0; j < dim; j++)
+        rows[j] = z + j;
+    fe__discover_lags_rows(a, rows, dim, q, k);
     /* X = Z^T Z, into the block. */
     cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)q, 1.0, z,
                 (int)dim, 0.0, x, (int)dim);
@@ -739,7 +752,7 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
         for (size_t d = 0; d < 3 && j + d < m; d++)
             g[j * dim + j + d] += band[3 * (j - nb) + d];
     a->counts[k] += (double)q;
-    fe__discover_lags_rows(a, col, 1, q, fitted);
+    fe__discover_lags_rows(a, col, 1, q, k);
     if (a->n == 0)
         for (size_t c = 0; c < dim; c++)
             a->first[c] = col[c][0];
@@ -1510,6 +1523,93 @@ static double fe__fitted_rows(const fe_discover_acc *a)
     return n;
 }
 
+/* The whitened series x~ of x_t = u^T z_t summed over each fitted block,
+   from the blocks' sums of rows: alpha(1) u^T s_k (the filter's edge rows
+   aside), as deviations from the overall mean; their sum of squares
+   divided by each block's rows: sum_k n_k xbar_k^2. */
+static double fe__block_energy(const fe_discover_acc *a, const double *u,
+                               const fe_discover_noise *nz)
+{
+    size_t dim = a->m + 1, K = a->blocks;
+    double alpha1 = 1.0, n = fe__fitted_rows(a), mean = 0.0, e = 0.0;
+    for (size_t i = 0; i < nz->order; i++)
+        alpha1 -= nz->phi[i];
+    for (size_t k = 0; k < K; k++)
+        for (size_t c = 0; c < dim; c++)
+            mean += alpha1 * u[c] * a->bsum[k * dim + c] / n;
+    for (size_t k = 0; k < K; k++) {
+        double b = 0.0;
+        for (size_t c = 0; c < dim; c++)
+            b += alpha1 * u[c] * a->bsum[k * dim + c];
+        b -= a->counts[k] * mean;
+        if (a->counts[k] > 0)
+            e += b * b / a->counts[k];
+    }
+    return e;
+}
+
+/* R for the residual with weights u: the variance of the whitened
+   residual's block means, times the block length, over its variance per
+   row; tested against chi-square with K - 1 degrees of freedom.  Blocks
+   shorter than 20 rows are too short to tell (R = 1, not tested). */
+static void fe__block_ratio(const fe_discover_acc *a, const double *u, fe_discover_noise *nz)
+{
+    double n = fe__fitted_rows(a), K = (double)a->blocks;
+    double var = nz->innovation_variance;
+    nz->block_ratio = 1.0;
+    nz->block_p = NAN;
+    nz->long_range = 0;
+    if (n / K < 20.0 || !(var > 0.0))
+        return;
+    nz->block_ratio = fe__block_energy(a, u, nz) / (K - 1.0) / var;
+    nz->block_p = fe_chi2_upper((K - 1.0) * nz->block_ratio, K - 1.0);
+    nz->long_range = nz->block_p < 0.05 && nz->block_ratio > 1.0;
+}
+
+/* The factor by which the variance of sum_t x~_t e~_t exceeds the white
+   noise value sigma^2 sum x~^2, for the series x_t = u^T z_t whitened by
+   nz, and the degrees of freedom of that variance (nu for white noise):
+   the short-lag factor f_s (Bartlett over the whitened residual's first H
+   autocorrelations, when whiteness was rejected), and the long-range
+   part for the share lambda of x~'s energy in its block means,
+   f = f_s (1 - lambda) + R lambda, with Satterthwaite's degrees of
+   freedom for the two parts.  Uses w->q and w->acov. */
+static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
+                                  const fe_discover_noise *nz, const double *u, double nu,
+                                  double *dof)
+{
+    double fs = 1.0, lambda, f, parts;
+    *dof = nu;
+    if (!nz->long_run && !nz->long_range)
+        return 1.0;
+    fe__lagged_sums(a, w->g, u, w->q);
+    fe__white_acov(w->q, a->lags, nz, w->acov);
+    if (!(w->acov[0] > 0.0) || !(w->acov_e[0] > 0.0))
+        return 1.0;
+    if (nz->long_run) {
+        size_t H = nz->lags_tested;
+        double sum = 0.0;
+        for (size_t h = 1; h <= H; h++)
+            sum += (1.0 - (double)h / (double)(H + 1)) * (w->acov_e[h] / w->acov_e[0])
+                   * (w->acov[h] / w->acov[0]);
+        fs = 1.0 + 2.0 * sum;
+        if (fs < 1.0)
+            fs = 1.0;
+    }
+    if (!nz->long_range)
+        return fs;
+    lambda = fe__block_energy(a, u, nz) / w->acov[0];
+    lambda = lambda < 0.0 ? 0.0 : lambda > 1.0 ? 1.0 : lambda;
+    f = fs * (1.0 - lambda) + nz->block_ratio * lambda;
+    parts = fs * (1.0 - lambda) * fs * (1.0 - lambda) / nu
+            + nz->block_ratio * lambda * nz->block_ratio * lambda / ((double)a->blocks - 1.0);
+    if (parts > 0.0)
+        *dof = f * f / parts;
+    if (*dof > nu)
+        *dof = nu;
+    return f;
+}
+
 /* Feasible GLS of the columns `cols`: the coefficients, the summary and
    the noise model, leaving the prewhitened Gram matrix in w->gt, the
    factor of its model block in w->css and the whitened residual's
@@ -1581,6 +1681,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
                               ? (double)(nz->lags_tested - nz->order) : 1.0;
     nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
     nz->long_run = nz->portmanteau_p < 0.05;
+    fe__block_ratio(a, w->uv, nz);
     return FE_OK;
 }
 
@@ -1597,11 +1698,11 @@ static double fe__gls_dof(const fe_discover_fit *fit, const fe_discover_noise *n
    errors into se (if not NULL). */
 static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
                         size_t ncols, const fe_discover_fit *fit,
-                        const fe_discover_noise *nz, double *se)
+                        const fe_discover_noise *nz, double *se, double *dof)
 {
     size_t dim = a->m + 1;
     fe__model mo = {ncols, cols, w->css, {0}};
-    double s2 = nz->innovation_variance * fit->n / fe__gls_dof(fit, nz);
+    double nu = fe__gls_dof(fit, nz), s2 = nz->innovation_variance * fit->n / nu;
     double f[FE_DISCOVER_MAX_COLUMNS];
     /* The factor of gt_SS is in w->css (scales recomputed). */
     for (size_t i = 0; i < ncols; i++)
@@ -1611,23 +1712,16 @@ static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t 
     for (size_t i = 0; i < ncols; i++)
         w->inv[i * ncols + i] = 1.0;
     fe__solve(&mo, w->inv, ncols);
+    if (dof != NULL)
+        *dof = nu;
     for (size_t i = 0; i < ncols; i++) {
-        f[i] = 1.0;
-        if (nz->long_run && w->acov_e[0] > 0.0) {
-            size_t H = nz->lags_tested;
-            double sum = 0.0;
-            memset(w->uv, 0, dim * sizeof *w->uv);
-            for (size_t k = 0; k < ncols; k++)
-                w->uv[cols[k]] = w->inv[k * ncols + i];
-            fe__lagged_sums(a, w->g, w->uv, w->q);
-            fe__white_acov(w->q, a->lags, nz, w->acov);
-            for (size_t h = 1; h <= H && w->acov[0] > 0.0; h++)
-                sum += (1.0 - (double)h / (double)(H + 1)) * (w->acov_e[h] / w->acov_e[0])
-                       * (w->acov[h] / w->acov[0]);
-            f[i] = 1.0 + 2.0 * sum;
-            if (f[i] < 1.0)
-                f[i] = 1.0;
-        }
+        double di;
+        memset(w->uv, 0, dim * sizeof *w->uv);
+        for (size_t k = 0; k < ncols; k++)
+            w->uv[cols[k]] = w->inv[k * ncols + i];
+        f[i] = fe__variance_factor(a, w, nz, w->uv, nu, &di);
+        if (dof != NULL && di < *dof)
+            *dof = di;
     }
     for (size_t i = 0; i < ncols; i++)
         for (size_t j = 0; j < ncols; j++)
@@ -1661,7 +1755,7 @@ int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
     fe__total_gram(a, w.g);
     rc = fe__gls(a, &w, cols, ncols, max_order, coef, fit, noise);
     if (rc == FE_OK && ncols > 0)
-        fe__gls_cov(a, &w, cols, ncols, fit, noise, stderr_);
+        fe__gls_cov(a, &w, cols, ncols, fit, noise, stderr_, NULL);
     return rc;
 }
 
@@ -1689,25 +1783,14 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
     s2 = (rsst - out->rss_drop) / nu;
     if (!(s2 > 0.0))
         return;                 /* an exact fit: nothing to test */
-    /* The long-run factor of the candidate made orthogonal to the model:
+    /* The variance factor of the candidate made orthogonal to the model:
        its weights e_J - sum a_J,i e_cols[i] (a_J from fe__drop), the
        first column of a group standing for it. */
-    if (nz->long_run && w->acov_e[0] > 0.0) {
-        size_t H = nz->lags_tested;
-        double sum = 0.0;
-        memset(w->uv, 0, dim * sizeof *w->uv);
-        w->uv[gr->first] = 1.0;
-        for (size_t i = 0; i < s; i++)
-            w->uv[mo->cols[i]] -= w->aj[i * d];
-        fe__lagged_sums(a, w->g, w->uv, w->q);
-        fe__white_acov(w->q, a->lags, nz, w->acov);
-        for (size_t h = 1; h <= H && w->acov[0] > 0.0; h++)
-            sum += (1.0 - (double)h / (double)(H + 1)) * (w->acov_e[h] / w->acov_e[0])
-                   * (w->acov[h] / w->acov[0]);
-        f = 1.0 + 2.0 * sum;
-        if (f < 1.0)
-            f = 1.0;
-    }
+    memset(w->uv, 0, dim * sizeof *w->uv);
+    w->uv[gr->first] = 1.0;
+    for (size_t i = 0; i < s; i++)
+        w->uv[mo->cols[i]] -= w->aj[i * d];
+    f = fe__variance_factor(a, w, nz, w->uv, nu, &nu);
     if (d == 1) {
         out->statistic = (w->cj[0] >= 0.0 ? 1.0 : -1.0) * sqrt(out->rss_drop / (s2 * f));
         out->p_value = fe_student_t_two_sided(out->statistic, nu);
@@ -1767,6 +1850,8 @@ static void fe__batch_noise(const fe_discover_acc *a, const fe__ws *w, const siz
     nz->innovation_variance = nz->variance;
     nz->n_eff = fit->n_eff;
     nz->portmanteau_p = NAN;
+    nz->block_ratio = 1.0;
+    nz->block_p = NAN;
     if (a->lags > 0) {
         double q2 = 0.0;
         fe__residual_weights(a->m + 1, cols, ncols, coef, w->uv);
@@ -1792,11 +1877,13 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     if (ar) {
         rc = fe__gls(a, w, cols, ncols, maxp, beta, fit, &nz);
         if (rc == FE_OK && st != NULL && ncols > 0)
-            fe__gls_cov(a, w, cols, ncols, fit, &nz, st->stderr_);
+            fe__gls_cov(a, w, cols, ncols, fit, &nz, st->stderr_, &st->dof);
     } else {
         rc = fe__fit(a, w, cols, ncols, beta, st != NULL ? st->stderr_ : NULL, fit);
-        if (rc == FE_OK && st != NULL)
+        if (rc == FE_OK && st != NULL) {
             fe__batch_noise(a, w, cols, ncols, beta, fit, &nz);
+            st->dof = (double)(a->blocks - 1);
+        }
     }
     if (rc == FE_OK && st != NULL) {
         st->ncols = ncols;
@@ -1939,7 +2026,7 @@ int fe_discover_select(const fe_discover_acc *a,
         memcpy(res->stderr_, last->stderr_, ncols * sizeof *res->stderr_);
         res->final = last->fit;
         res->noise = last->noise;
-        res->dof = ar ? fe__gls_dof(&res->final, &res->noise) : (double)(a->blocks - 1);
+        res->dof = ar ? last->dof : (double)(a->blocks - 1);
         res->t_critical = fe_student_t_quantile(0.05, res->dof);
         if (!ar) {
             double ne = res->final.n_eff, n = res->final.n;

@@ -14,7 +14,7 @@ enum {
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
-    FE_DISCOVER_LAGS = 8            /* lagged products Z_1 .. Z_P kept by a
+    FE_DISCOVER_LAGS = 16           /* lagged products Z_1 .. Z_P kept by a
                                        full accumulation: P, the highest
                                        order of the noise model */
 };
@@ -30,7 +30,8 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
    FE_DISCOVER_ACC_VALUES(m, blocks). */
 #define FE_DISCOVER_ACC_VALUES(m, blocks)                                   \
     (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1  \
-     + FE_DISCOVER_LAGS * (((m) + 1) * ((m) + 1) + 2 * ((m) + 1)))
+     + FE_DISCOVER_LAGS * (((m) + 1) * ((m) + 1) + 2 * ((m) + 1))           \
+     + (blocks) * ((m) + 1))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
      + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
@@ -68,6 +69,7 @@ typedef struct fe_discover_acc {
     double *hist;               /* P x M: the last fitted rows, newest
                                    first (rows past nhist are zero) */
     double *head;               /* P x M: the part's first rows */
+    double *bsum;               /* K x M: each fitted block's sum of rows */
     double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
@@ -232,6 +234,12 @@ typedef struct fe_discover_noise {
     double portmanteau_p;       /* its p-value; NaN without lagged products */
     int long_run;               /* 1 when whiteness was rejected (p < 0.05)
                                    and variances carry the long-run factor */
+    double block_ratio;         /* R: the whitened residual's variance of
+                                   block means over its variance per row
+                                   (1 for white noise) */
+    double block_p;             /* chi-square test of R = 1 (NaN: not made) */
+    int long_range;             /* 1 when R > 1 is significant (p < 0.05)
+                                   and variances of slow series carry it */
 } fe_discover_noise;
 
 /* fe_discover_noise_fit: the AR noise model of a series from its lagged
@@ -274,6 +282,7 @@ typedef struct fe_discover_step {
                                                    (size_t)-1 */
     size_t ncols;                               /* = result's cols[0 .. ncols) */
     double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
+    double dof;                                 /* of the intervals */
     fe_discover_fit fit;
     fe_discover_noise noise;
 } fe_discover_step;

@@ -569,7 +569,11 @@ static void fe__json_noise(FILE *f, const fe_discover_noise *nz)
     fe__json_pair(f, "q", nz->portmanteau);
     fe__json_pair(f, "dof", nz->portmanteau_dof);
     fe__json_pair(f, "p_value", nz->portmanteau_p);
-    fprintf(f, "}, \"long_run_correction\": %s}", nz->long_run ? "true" : "false");
+    fprintf(f, "}, \"long_run_correction\": %s, \"block_ratio\": ",
+            nz->long_run ? "true" : "false");
+    fe__json_number(f, nz->block_ratio);
+    fe__json_pair(f, "block_p_value", nz->block_p);
+    fprintf(f, ", \"long_range_correction\": %s}", nz->long_range ? "true" : "false");
 }
 
 /* The selection path: each step's model refitted. */
@@ -721,6 +725,10 @@ static void fe__story_noise(FILE *f, const char *what, const fe_discover_noise *
                 nz->kind == FE_DISCOVER_NOISE_AR ? "whitened" : "the",
                 nz->portmanteau_p < 0.01 ? "not white" : "white", nz->lags_tested,
                 nz->portmanteau_p, nz->long_run ? ", variances widened by the long-run factor" : "");
+    if (nz->long_range)
+        fprintf(f, "; slow variation beyond the model: block means vary %.3g times as much as "
+                   "white noise would (p = %.2g), variances of slow terms widened", nz->block_ratio,
+                nz->block_p);
     fprintf(f, "\n");
 }
 
