@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # foldest: foldable estimators.
 #
 # The two commands a new user needs are `make demo` and `make check`; both
@@ -320,7 +321,11 @@ check-tangle: tangle-scratch
 	for f in $$(find include src -type f | sort); do \
 	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
 	done; \
-	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org"; exit $$status
+	for f in $$(find include src tests examples bench -path tests/fuzz/corpus -prune -o -type f \
+	              \( -name '*.[ch]' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el; do \
+	  head -2 "$$f" | grep -q 'SPDX-License-Identifier: MIT' || { echo "check-tangle: $$f has no SPDX line at its top"; status=1; }; \
+	done; \
+	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
 
 doc: $(B)/.deps
 	@mkdir -p $(B)/doc

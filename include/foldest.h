@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/index.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/index.org::Umbrella Header][Umbrella Header]] */
 #ifndef FOLDEST_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/special.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/special.org::Special Function Includes][Special Function Includes]] */
 #include <float.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Hostile input end to end: every foldest command that reads a file, on
    every kind of bad file (empty, header only, truncated, binary, a field
    that is not a number, NaN and Inf text, a wrong field count, a very long

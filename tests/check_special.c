@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tail probabilities against table values and identities. */
 #define _DEFAULT_SOURCE
 #include "foldest.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/catalog.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/catalog.org::Catalog Declarations][Catalog Declarations]] */
 #ifndef FOLDEST_CATALOG_H

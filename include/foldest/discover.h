@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/discover.org::Discovery Accumulation Declarations][Discovery Accumulation Declarations]] */
 #ifndef FOLDEST_DISCOVER_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/lm.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/lm.org::Levenberg-Marquardt Declarations][Levenberg-Marquardt Declarations]] */
 #ifndef FOLDEST_LM_H

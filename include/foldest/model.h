@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/model.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/model.org::Model Declarations][Model Declarations]] */
 #ifndef FOLDEST_MODEL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/mpi.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/mpi.org::MPI Helper Declarations][MPI Helper Declarations]] */
 #ifndef FOLDEST_MPI_H

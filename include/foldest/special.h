@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/special.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/special.org::Tail Probability Declarations][Tail Probability Declarations]] */
 #ifndef FOLDEST_SPECIAL_H

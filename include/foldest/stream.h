@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/stream.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/stream.org::Stream Declarations][Stream Declarations]] */
 #ifndef FOLDEST_STREAM_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli_discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli_discover.org::Write a synthetic pair][Write a synthetic pair]] */
 #include "cli.h"
