@@ -6,6 +6,10 @@
 
 #define FE_VERSION "0.1.0"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #include "foldest/error.h"
 #include "foldest/fold.h"
 #include "foldest/stream.h"
@@ -26,6 +30,10 @@
 #include "foldest/parallel.h"
 #include "foldest/quadric.h"
 #include "foldest/sphere.h"
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

@@ -9,6 +9,10 @@
 
 #include "foldest/discover.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Roles of the simulation's state columns, as bits. */
 enum fe_role {
     FE_ROLE_POSITION = 1u << 0,
@@ -85,6 +89,10 @@ void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups);
    Writes at most len bytes (NUL-terminated); returns FE_OK. */
 int fe_catalog_explain(const char *name, double coef, double stderr_,
                        char *buf, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_CATALOG_H */
 /* Catalog Declarations ends here */

@@ -6,6 +6,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* A line reader over a file descriptor, through a caller buffer. */
 typedef struct fe_csv_reader {
     int fd;
@@ -53,6 +57,10 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
    FE_EPARSE when it is empty or not entirely a number; FE_ENONFINITE
    for "nan", "inf" and values that overflow. */
 int fe_csv_number(const fe_csv_field *field, double *value);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_CSV_H */
 /* CSV Field Declarations ends here */

@@ -9,6 +9,10 @@
 
 #include "foldest/fold.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 enum {
     FE_DISCOVER_MAX_COLUMNS = 64,   /* term columns m */
     FE_DISCOVER_MAX_GROUPS = 64,    /* candidate terms (groups of columns) */
@@ -254,6 +258,10 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
                             size_t ncols, double *coef, double *stderr_,
                             fe_discover_fit *fit, double *work,
                             size_t work_doubles);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_DISCOVER_H */
 /* Discovery Selection Declarations ends here */

@@ -9,6 +9,10 @@
 
 #include "foldest/schur.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Where a model sends its residuals; owned by the solver. */
 typedef struct fe_lm_sink fe_lm_sink;
 
@@ -109,6 +113,10 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
                 const fe_lm_params *params, double *x, double *work,
                 fe_lm_report_fn *report, void *report_ctx,
                 fe_lm_result *result);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_LM_H */
 /* Levenberg-Marquardt Declarations ends here */

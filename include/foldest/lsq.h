@@ -9,6 +9,10 @@
 
 #include "foldest/fold.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* A sub-model column whose pivot ratio 1 - R^2 (its unexplained part,
    relative to its norm) is at or below this is treated as dependent. */
 #define FE_LSQ_RANK_TOL 1e-12
@@ -124,6 +128,10 @@ int fe_lsq_scores(const fe_lsq *a, const size_t *base, size_t qb,
    by fe_lsq_init first: fe_init resets, fe_copy copies contents, fe_merge
    adds).  fe_scan is not supported (the accumulation points to storage). */
 fe_accumulator fe_lsq_accumulator(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_LSQ_H */
 /* Least Squares Declarations ends here */

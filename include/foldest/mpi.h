@@ -12,6 +12,10 @@
 
 #include "foldest.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The MPI handles of one reduction: the datatype of one cell and the
    (non-commutative) operation merging two cells.  Create with the
    <name>_reduction function made by FE_MPI_DEFINE_REDUCTION, free with
@@ -256,6 +260,10 @@ static inline int fe_mpi_allreduce(const fe_mpi_reduction *r,
                ? FE_OK
                : FE_EIO;
 }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_MPI_H */
 /* Reduce cells across ranks ends here */

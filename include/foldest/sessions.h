@@ -8,6 +8,10 @@
 
 #include "foldest/lm.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 enum { FE_SESSIONS_MAX = 64 };
 
 /* Sessions of raw readings: session s has n[s] readings m[s][3i..3i+2].
@@ -49,6 +53,10 @@ size_t fe_sessions_work(const fe_sessions *c);
    Errors as fe_lm_solve; FE_EINVAL for no sessions or too many. */
 int fe_sessions_fit(const fe_sessions *c, double *x, double *work,
                     fe_lm_result *result);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SESSIONS_H */
 /* Session Calibration Declarations ends here */

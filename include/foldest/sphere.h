@@ -9,6 +9,10 @@
 
 #include "foldest/quadric.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The models. */
 typedef enum fe_sphere_model {
     FE_FIT_SPHERE = 0,          /* centre and radius: 4 parameters */
@@ -142,6 +146,10 @@ int fe_sphere_model_parse(const char *name, fe_sphere_model *model);
 
 /* fe_sphere_refusal_string: a sentence for fit->refusal. */
 const char *fe_sphere_refusal_string(int refusal);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SPHERE_H */
 /* Sphere Fit Declarations ends here */

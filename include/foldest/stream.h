@@ -8,6 +8,10 @@
 
 #include "foldest/fold.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* A pull-based stream of observations of obs_size bytes each. */
 typedef struct fe_source {
     /* Point *obs at the next observation: FE_OK; FE_END when there is no
@@ -83,6 +87,10 @@ typedef struct fe_fd_source {
    FE_EPARSE; a read error FE_EIO. */
 int fe_source_from_fd(fe_source *src, fe_fd_source *state, int fd,
                       size_t obs_size, void *buffer, size_t buffer_size);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_STREAM_H */
 /* File Descriptor Source Declarations ends here */

@@ -10,6 +10,10 @@
 #include "foldest/catalog.h"
 #include "foldest/random.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct fe_synth_spec {
     const char *effect;         /* a built-in term's name, or "none" */
     uint64_t seed;
@@ -58,6 +62,10 @@ size_t fe_synth_base(const fe_synth *g, const fe_catalog *c, size_t *base);
 /* fe_synth_effects: the effect names with a rig, in catalog order, then
    "none" twice (one null case per rig: "none" and "none_thermal"). */
 const char *const *fe_synth_effects(size_t *count);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SYNTH_H */
 /* Synthetic Experiment Declarations ends here */
