@@ -250,7 +250,7 @@ $(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 $(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -Iinclude -Isrc/cli -c $< -o $@
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -DFE_CLI_KEEP_STDOUT -Iinclude -Isrc/cli -c $< -o $@
 $(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
 	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
