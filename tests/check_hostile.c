@@ -392,6 +392,19 @@ static void read_stderr(const char *d, char *buf, size_t len)
     fclose(f);
 }
 
+/* A valid recording d/good.csv: a header and GOOD_ROWS samples. */
+static void write_good(const char *d)
+{
+    char path[128];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/good.csv", d);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs("t,mx,my,mz\n", f);
+    write_rows(f, GOOD_ROWS, 0, 0, 0.0);
+    fclose(f);
+}
+
 /* A synthetic pair r.csv, s.csv of `rows` rows in `d`. */
 static void make_pair(const char *d, const char *rows)
 {
@@ -449,16 +462,7 @@ START_TEST(outputs_take_the_umask_mode)
     const char *report[] = DISCOVER_ARGS("rep");
     snprintf(d, sizeof d, "/tmp/foldest-mode-XXXXXX");
     ck_assert_ptr_nonnull(mkdtemp(d));
-    {
-        char path[128];
-        FILE *f;
-        snprintf(path, sizeof path, "%s/good.csv", d);
-        f = fopen(path, "w");
-        ck_assert_ptr_nonnull(f);
-        fputs("t,mx,my,mz\n", f);
-        write_rows(f, GOOD_ROWS, 0, 0, 0.0);
-        fclose(f);
-    }
+    write_good(d);
     {
         const char *args[] = {"synth", "--effect", "quadratic_drag", "--rows", "2000",
                               "--real", "r.csv", "--sim", "s.csv", NULL};
@@ -486,17 +490,11 @@ static const char *const full_commands[][8] = {
 
 START_TEST(full_standard_output_is_an_error)
 {
-    char d[64], path[128], err[4096];
-    FILE *f;
+    char d[64], err[4096];
     int status;
     snprintf(d, sizeof d, "/tmp/foldest-full-XXXXXX");
     ck_assert_ptr_nonnull(mkdtemp(d));
-    snprintf(path, sizeof path, "%s/good.csv", d);
-    f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs("t,mx,my,mz\n", f);
-    write_rows(f, GOOD_ROWS, 0, 0, 0.0);
-    fclose(f);
+    write_good(d);
     status = run_argv(d, 022, "/dev/full", full_commands[_i]);
     read_stderr(d, err, sizeof err);
     ck_assert_msg(status == 4, "foldest %s > /dev/full: status %d\n%s", full_commands[_i][0],
