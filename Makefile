@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # foldest: foldable estimators.
 #
 # The two commands a new user needs are `make demo` and `make check`; both
@@ -17,6 +18,8 @@ BINDIR       ?= $(PREFIX)/bin
 CC           ?= cc
 CFLAGS       ?= -O2 -g
 WARN         := -std=c11 -Wall -Wextra -Werror -pedantic
+CXX          ?= g++
+CXXWARN      := -std=c++17 -Wall -Wextra -Werror -pedantic
 SAN          := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 TSAN         := -fsanitize=thread -fno-omit-frame-pointer
 B            := build
@@ -209,7 +212,10 @@ check-tsan: $(B)/tests/check_foldest_tsan
 	@echo "== parallel tests (ThreadSanitizer)"
 	CK_RUN_SUITE=parallel FE_TEST_QUICK=1 TSAN_OPTIONS=halt_on_error=1 $(B)/tests/check_foldest_tsan
 
-# Install into a scratch DESTDIR and build every example from it with pkg-config.
+# Install into a scratch DESTDIR and build every example from it with
+# pkg-config; then build tests/cxx/use_from_cxx.cpp the same way as C++17
+# (every public header included from C++) and run it on the installed
+# shared library.
 check-install: lib
 	@echo "== install into a scratch DESTDIR; build the examples with pkg-config"
 	@set -e; d=$$(mktemp -d); trap 'rm -rf "$$d"' EXIT; \
@@ -218,7 +224,10 @@ check-install: lib
 	  PKG_CONFIG_SYSROOT_DIR="$$d" PKG_CONFIG_PATH="$$d/usr/local/lib/pkgconfig" \
 	  sh -c 'set -e; $(CC) $(WARN) -o "$$1/$$(basename $$2 .c)" "$$2" $$(pkg-config --cflags --libs foldest)' _ "$$d" "$$e"; \
 	  echo "built $$e against $$d/usr/local"; \
-	done
+	done; \
+	PKG_CONFIG_SYSROOT_DIR="$$d" PKG_CONFIG_PATH="$$d/usr/local/lib/pkgconfig" \
+	  sh -c 'set -e; $(CXX) $(CXXWARN) -o "$$1/use_from_cxx" tests/cxx/use_from_cxx.cpp $$(pkg-config --cflags --libs foldest)' _ "$$d"; \
+	LD_LIBRARY_PATH="$$d/usr/local/lib" "$$d/use_from_cxx"
 
 # ---------------------------------------------------------------- acceptance
 # `make accept`: foldest discover on cases drawn by an independent generator
@@ -253,7 +262,7 @@ $(B)/fuzz/obj/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 $(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	@mkdir -p $(@D)
-	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -Iinclude -Isrc/cli -c $< -o $@
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -DFE_CLI_KEEP_STDOUT -Iinclude -Isrc/cli -c $< -o $@
 $(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
 	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
@@ -332,7 +341,11 @@ check-tangle: tangle-scratch
 	for f in $$(find include src -type f | sort); do \
 	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
 	done; \
-	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org"; exit $$status
+	for f in $$(find include src tests examples bench -path tests/fuzz/corpus -prune -o -type f \
+	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el; do \
+	  head -2 "$$f" | grep -q 'SPDX-License-Identifier: MIT' || { echo "check-tangle: $$f has no SPDX line at its top"; status=1; }; \
+	done; \
+	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
 
 doc: $(B)/.deps
 	@mkdir -p $(B)/doc

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared by the benchmarks: a monotonic clock and a best-of-k timer. */
 #ifndef FE_BENCH_H
 #define FE_BENCH_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Discovery's ranking pass, in one run, over 10^6 records in memory:
      - the base model alone: its 3 terms (bias, gain, input) folded into the
        block Gram matrices, by every path the library has (row by row,

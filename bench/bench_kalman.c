@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Kalman update at n = 4, for packets of b = 1 and b = 3 measurements,
    in one run (b = 3 twice: a full Z, and a diagonal Z, i.e. decorrelated
    measurements):

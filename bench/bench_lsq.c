@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Structured least squares, in one run:
      1. the normal-equation fold: ns per row for p = 8, 32, 128 columns,
         blocked (fe_lsq_add_rows) and row by row (fe_lsq_add), against

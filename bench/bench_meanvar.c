@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Mean and variance over 10^8 doubles in memory, in one run:
      - the memory read floor (a sum that only reads),
      - a naive two-pass loop (sum, then squared deviations),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Parallel folds over data in memory, in one run: each accumulator of the
    table below folded with fe_parallel_fold on 1 thread (exactly fe_fold)
    and on 2 threads (and 4 when the machine has them), best of several

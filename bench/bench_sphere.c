@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Sphere and ellipsoid calibration, in one run, on the same synthetic
    points: centre (100, -50, 30), semi-axes (400, 380, 420), noise 2.
      - the moment pass (fe_quadric_add_many) over 10^7 points in memory,

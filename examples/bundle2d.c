@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Two-dimensional bundle adjustment, after EJML's "Non-Linear Least
    Squares: Sparse Schur Complement" example.
 

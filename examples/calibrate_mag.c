@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Calibrate a magnetometer: fold a recording into the 35 moments of
    degree four, fit a sphere, an axis-aligned ellipsoid and a full
    ellipsoid, print them, and plot raw against calibrated samples.

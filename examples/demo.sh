@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # make demo: the main job.  foldest finds what a simulation left out:
 #   1. a synthetic experiment whose recording hides quadratic drag (at most
 #      0.3 noise standard deviations per sample, coloured noise), generated

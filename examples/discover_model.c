@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Discovery with the model given as a C function.
 
    A cart on a spring is driven by a force u(t).  Our model of its

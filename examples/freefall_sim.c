@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A vacuum free-fall simulation of each recorded drop, for foldest discover.
 
    The recordings (../shared/data/freefall-drag/csv/fall_N.csv, or

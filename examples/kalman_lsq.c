@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Least squares by Kalman folding (Beckman, Kalman Folding part 1).
 
    Five observations of a cubic, z = x0 + x1 t + x2 t^2 + x3 t^3 + noise at

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The falling object of Kalman Folding 2, tracked by a fold.
 
    State: height and vertical speed.  Each step of 0.1 s the object falls

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Where does a Kalman filter's model stop being right?
 
    A cart coasts at about 10 m/s; a position sensor reads it every 0.1 s

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Multi-session magnetometer calibration with the Schur complement.
 
    A magnetometer reads m = A u + o + noise, where u is the (unit) field

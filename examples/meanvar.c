@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Mean and variance of a stream, three ways: an array with fe_fold, a
    generator with fe_fold_source (constant memory, any length), and two
    halves folded apart and merged, as threads or machines would.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The mean and variance of 4 million values folded on 1, 2 and 4 threads:
    the same answer each time (to rounding; bit for bit for a given thread
    count), and the first bad value found wherever it is.

@@ -1,9 +1,14 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/index.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/index.org::Umbrella Header][Umbrella Header]] */
 #ifndef FOLDEST_H
 #define FOLDEST_H
 
 #define FE_VERSION "0.1.0"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 #include "foldest/error.h"
 #include "foldest/fold.h"
@@ -25,6 +30,10 @@
 #include "foldest/parallel.h"
 #include "foldest/quadric.h"
 #include "foldest/sphere.h"
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_H */
 /* Umbrella Header ends here */

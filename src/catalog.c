@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/catalog.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/catalog.org::Catalog Includes][Catalog Includes]] */
 #include <math.h>

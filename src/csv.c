@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/csv.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/csv.org::CSV Includes][CSV Includes]] */
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/discover.org::Discovery Includes][Discovery Includes]] */
 #include <math.h>
@@ -1576,11 +1577,11 @@ static void fe__block_ratio(const fe_discover_acc *a, const double *u, fe_discov
    freedom for the two parts.  Uses w->q and w->acov. */
 static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
                                   const fe_discover_noise *nz, const double *u, double nu,
-                                  double *dof)
+                                  double ratio, int long_range, double *dof)
 {
     double fs = 1.0, lambda, f, parts;
     *dof = nu;
-    if (!nz->long_run && !nz->long_range)
+    if (!nz->long_run && !long_range)
         return 1.0;
     fe__lagged_sums(a, w->g, u, w->q);
     fe__white_acov(w->q, a->lags, nz, w->acov);
@@ -1596,13 +1597,13 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
         if (fs < 1.0)
             fs = 1.0;
     }
-    if (!nz->long_range)
+    if (!long_range)
         return fs;
     lambda = fe__block_energy(a, u, nz) / w->acov[0];
     lambda = lambda < 0.0 ? 0.0 : lambda > 1.0 ? 1.0 : lambda;
-    f = fs * (1.0 - lambda) + nz->block_ratio * lambda;
+    f = fs * (1.0 - lambda) + ratio * lambda;
     parts = fs * (1.0 - lambda) * fs * (1.0 - lambda) / nu
-            + nz->block_ratio * lambda * nz->block_ratio * lambda / ((double)a->blocks - 1.0);
+            + ratio * lambda * ratio * lambda / ((double)a->blocks - 1.0);
     if (parts > 0.0)
         *dof = f * f / parts;
     if (*dof > nu)
@@ -1719,7 +1720,7 @@ static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t 
         memset(w->uv, 0, dim * sizeof *w->uv);
         for (size_t k = 0; k < ncols; k++)
             w->uv[cols[k]] = w->inv[k * ncols + i];
-        f[i] = fe__variance_factor(a, w, nz, w->uv, nu, &di);
+        f[i] = fe__variance_factor(a, w, nz, w->uv, nu, nz->block_ratio, nz->long_range, &di);
         if (dof != NULL && di < *dof)
             *dof = di;
     }
@@ -1790,7 +1791,23 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
     w->uv[gr->first] = 1.0;
     for (size_t i = 0; i < s; i++)
         w->uv[mo->cols[i]] -= w->aj[i * d];
-    f = fe__variance_factor(a, w, nz, w->uv, nu, &nu);
+    /* The block ratio of the residual with the candidate in the model:
+       a slow effect that is missing inflates the block means of the
+       residual without it, and must not hide itself. */
+    {
+        double ures[FE_DISCOVER_MAX_COLUMNS + 1], ratio = nz->block_ratio, bp;
+        int long_range = nz->long_range;
+        if (d == 1 && w->sjj[0] > 0.0 && (double)cur->n / (double)a->blocks >= 20.0) {
+            double gamma = w->cj[0] / w->sjj[0], K = (double)a->blocks;
+            fe__residual_weights(dim, mo->cols, s, beta, ures);
+            for (size_t c = 0; c < dim; c++)
+                ures[c] -= gamma * w->uv[c];
+            ratio = fe__block_energy(a, ures, nz) / (K - 1.0) / (s2 * nu / cur->n);
+            bp = fe_chi2_upper((K - 1.0) * ratio, K - 1.0);
+            long_range = bp < 0.05 && ratio > 1.0;
+        }
+        f = fe__variance_factor(a, w, nz, w->uv, nu, ratio, long_range, &nu);
+    }
     if (d == 1) {
         out->statistic = (w->cj[0] >= 0.0 ? 1.0 : -1.0) * sqrt(out->rss_drop / (s2 * f));
         out->p_value = fe_student_t_two_sided(out->statistic, nu);

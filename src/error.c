@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/error.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/error.org::Error Messages][Error Messages]] */
 #include "foldest/error.h"

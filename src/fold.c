@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/fold.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/fold.org::Fold Includes][Fold Includes]] */
 #include <string.h>

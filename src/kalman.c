@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/kalman.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/kalman.org::Kalman Filter Includes][Kalman Filter Includes]] */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/quadric.org: do not edit; edit the .org and run make tangle. */
 /* Private: how the library's lane kernels are compiled (quadric.c,
    discover.c).  Not installed. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/lm.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/lm.org::Levenberg-Marquardt Includes][Levenberg-Marquardt Includes]] */
 #include <float.h>

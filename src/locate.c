@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/locate.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/locate.org::Locate Includes][Locate Includes]] */
 #include <float.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/lsq.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/lsq.org::Least Squares Includes][Least Squares Includes]] */
 #include <float.h>

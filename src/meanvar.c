@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/meanvar.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/meanvar.org::Mean and Variance Includes][Mean and Variance Includes]] */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/model.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/model.org::Model Includes][Model Includes]] */
 #include <float.h>

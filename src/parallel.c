@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/parallel.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/parallel.org::Parallel Fold Includes][Parallel Fold Includes]] */
 #include <pthread.h>

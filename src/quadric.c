@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/quadric.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/quadric.org::Quadric Includes][Quadric Includes]] */
 #include "foldest/error.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/random.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/random.org::Random Generator][Random Generator]] */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/schur.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/schur.org::Schur Includes][Schur Includes]] */
 #include <float.h>

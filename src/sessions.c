@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/sessions.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/sessions.org::Session Calibration Includes][Session Calibration Includes]] */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/special.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/special.org::Special Function Includes][Special Function Includes]] */
 #include <float.h>
@@ -74,14 +75,31 @@ double fe_log_gamma(double x)
 }
 
 
+/* log(x^a e^-x / Gamma(a)), the factor in front of the series and the
+   fraction.  For a >= 10, Stirling's series for log Gamma(a) with the
+   large terms gathered into a (log1p(t) - t), t = (x - a) / a: nothing of
+   the size of a log x is left to cancel. */
+static double fe__gamma_prefix_log(double a, double x)
+{
+    double t, a2, corr;
+    if (a < 10.0)
+        return -x + a * log(x) - fe_log_gamma(a);
+    t = (x - a) / a;
+    a2 = a * a;
+    corr = (1.0 / 12.0 - (1.0 / 360.0 - (1.0 / 1260.0 - 1.0 / (1680.0 * a2)) / a2) / a2) / a;
+    return a * (log1p(t) - t) + 0.5 * log(a / (2.0 * 3.14159265358979323846)) - corr;
+}
+
 /* P(a, x) and Q(a, x), each of the pair computed directly where it is the
-   smaller, the other as its complement. */
+   smaller, the other as its complement.  Near x = a both the series and
+   the fraction need about 10 sqrt(a) terms: the budget grows with a. */
 static void fe__gamma_pq(double a, double x, double *p, double *q)
 {
-    double lpre = -x + a * log(x) - fe_log_gamma(a);
+    double lpre = fe__gamma_prefix_log(a, x);
+    int budget = FE__SPECIAL_ITERATIONS + (int)fmin(16.0 * sqrt(a), 1e8);
     if (x < a + 1.0) {                  /* series for P */
         double ap = a, sum = 1.0 / a, del = sum;
-        for (int n = 0; n < FE__SPECIAL_ITERATIONS; n++) {
+        for (int n = 0; n < budget; n++) {
             ap += 1.0;
             del *= x / ap;
             sum += del;
@@ -92,7 +110,7 @@ static void fe__gamma_pq(double a, double x, double *p, double *q)
         *q = 1.0 - *p;
     } else {                            /* continued fraction for Q */
         double b = x + 1.0 - a, c = 1.0 / FE__SPECIAL_TINY, d = 1.0 / b, h = d;
-        for (int i = 1; i <= FE__SPECIAL_ITERATIONS; i++) {
+        for (int i = 1; i <= budget; i++) {
             double an = -i * (i - a), delta;
             b += 2.0;
             d = an * d + b;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/sphere.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/sphere.org::Sphere Fit Includes][Sphere Fit Includes]] */
 #include <float.h>

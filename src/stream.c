@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/stream.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/stream.org::Stream Includes][Stream Includes]] */
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/synth.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../literate/synth.org::Synthetic Includes][Synthetic Includes]] */
 #include <math.h>

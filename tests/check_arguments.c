@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Bad arguments to the public functions: null pointers, zero and
    oversized dimensions, mismatched shapes, out-of-range indices and
    parameters.  Each gives its documented status (FE_EINVAL, FE_ESIZE,

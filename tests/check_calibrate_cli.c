@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* foldest calibrate: fits, JSON, refusals, located errors with no partial
    output, --apply (atomic; refused for standard input), --help.  Runs the
    built binary (FE_TEST_CLI) on recordings written here. */

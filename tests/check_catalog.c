@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The catalog: every built-in term evaluated against its documented
    formula, the scale's first pass, user terms, and every coefficient read in
    words (the sign conventions of catalog.org). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The foldest command: tables with metadata, headers, quotes, CRLF and
    white space; every malformed input gives FILE:LINE:COLUMN and its exit
    status.  Runs the built binary (FE_TEST_CLI) on files written here. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The CSV reader: lines (LF, CRLF, no final newline, too long, binary),
    fields (delimiters, quotes, white space) and numbers. */
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Discovery: the engine's algebra against brute force, merge, refusals, and
    the acceptance suite on concealed synthetic cases (every catalog term as
    the hidden effect, and null cases). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* foldest discover and foldest synth end to end: a concealed case and a
    null case, malformed and misaligned inputs, and the phone free-fall
    recordings (skipped without them). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Status codes: every code has its own message; unknown codes are safe. */
 #include "foldest.h"
 #include "testutil.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The fold core: fold, scan, merge, copy and the product of accumulators,
    with a toy accumulator whose behaviour the tests control. */
 #include "foldest.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Hostile input end to end: every foldest command that reads a file, on
    every kind of bad file (empty, header only, truncated, binary, a field
    that is not a number, NaN and Inf text, a wrong field count, a very long
@@ -8,8 +9,11 @@
    (--apply, --report, synth's pair) or temporary file left behind. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "foldest.h"
@@ -293,6 +297,286 @@ START_TEST(synth_leaves_no_partial_pair)
 }
 END_TEST
 
+/* ---------------------------------------------------------------- no shell,
+   file modes, standard output, interruption.  These run foldest without a
+   shell (fork and exec), so that a hostile name reaches it unchanged. */
+
+/* Start foldest with `args` (NULL-terminated, without argv[0]) in the
+   directory `cwd`, under `mask`, its stdout to `out` (NULL: /dev/null) and
+   stderr to cwd/stderr.txt.  The child's pid. */
+static pid_t start(const char *cwd, mode_t mask, const char *out, const char *const *args)
+{
+    char *argv[32];
+    size_t n = 0;
+    pid_t pid;
+    argv[n++] = (char *)FE_TEST_CLI;
+    while (args[n - 1] != NULL && n < 31) {
+        argv[n] = (char *)args[n - 1];
+        n++;
+    }
+    argv[n] = NULL;
+    fflush(NULL);
+    pid = fork();
+    ck_assert_int_ge(pid, 0);
+    if (pid == 0) {
+        int fd;
+        if (chdir(cwd) != 0)
+            _exit(120);
+        umask(mask);
+        fd = open(out != NULL ? out : "/dev/null", O_WRONLY);
+        if (fd < 0 || dup2(fd, 1) < 0)
+            _exit(121);
+        fd = open("stderr.txt", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd < 0 || dup2(fd, 2) < 0)
+            _exit(122);
+        execv(argv[0], argv);
+        _exit(123);
+    }
+    return pid;
+}
+
+/* Wait for the child; its exit status, or 1000 + the signal that killed it. */
+static int finish(pid_t pid)
+{
+    int status;
+    ck_assert_int_eq(waitpid(pid, &status, 0), pid);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+}
+
+static int run_argv(const char *cwd, mode_t mask, const char *out, const char *const *args)
+{
+    return finish(start(cwd, mask, out, args));
+}
+
+static int exists(const char *dirpath, const char *name)
+{
+    char path[2048];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", dirpath, name);
+    return stat(path, &st) == 0;
+}
+
+static mode_t mode_of(const char *dirpath, const char *name)
+{
+    char path[2048];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", dirpath, name);
+    ck_assert_msg(stat(path, &st) == 0, "no %s", path);
+    return st.st_mode & 07777;
+}
+
+/* Does any name in `d` contain `part`? */
+static int any_named(const char *d, const char *part)
+{
+    DIR *dd = opendir(d);
+    struct dirent *e;
+    int found = 0;
+    if (dd == NULL)
+        return 0;
+    while ((e = readdir(dd)) != NULL)
+        found |= strstr(e->d_name, part) != NULL;
+    closedir(dd);
+    return found;
+}
+
+static void read_stderr(const char *d, char *buf, size_t len)
+{
+    char path[256];
+    FILE *f;
+    size_t got;
+    snprintf(path, sizeof path, "%s/stderr.txt", d);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    got = fread(buf, 1, len - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+}
+
+/* A valid recording d/good.csv: a header and GOOD_ROWS samples. */
+static void write_good(const char *d)
+{
+    char path[128];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/good.csv", d);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs("t,mx,my,mz\n", f);
+    write_rows(f, GOOD_ROWS, 0, 0, 0.0);
+    fclose(f);
+}
+
+/* A synthetic pair r.csv, s.csv of `rows` rows in `d`. */
+static void make_pair(const char *d, const char *rows)
+{
+    const char *args[] = {"synth", "--effect", "quadratic_drag", "--rows", rows,
+                          "--real", "r.csv", "--sim", "s.csv", NULL};
+    ck_assert_int_eq(run_argv(d, 022, NULL, args), 0);
+}
+
+static void remove_tree(const char *d)
+{
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", d);
+    ck_assert_int_eq(system(cmd), 0);
+}
+
+#define DISCOVER_ARGS(report)                                                             \
+    {"discover", "--real", "r.csv", "--sim", "s.csv", "--channel", "acceleration", "--time", \
+     "time", "--role", "position=position", "--role", "velocity=velocity", "--role",         \
+     "input=input", "--base", "bias,gain", "--holdout", "0.3", "--report", report, NULL}
+
+/* A report folder named with shell and gnuplot metacharacters is a folder:
+   the report and its plots are written there and nothing is run (before,
+   gnuplot started through sh ran `touch PWNED` in the working directory). */
+static const char *const hostile_folders[] = {"x';touch PWNED;'", "bob's run",
+                                              "x'\n!touch PWNED\n'", "$(touch PWNED)"};
+
+START_TEST(report_folder_names_run_nothing)
+{
+    char d[64], rep[1200], err[4096];
+    const char *args[] = DISCOVER_ARGS(hostile_folders[_i]);
+    int status;
+    snprintf(d, sizeof d, "/tmp/foldest-shell-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    make_pair(d, "3000");
+    status = run_argv(d, 022, NULL, args);
+    read_stderr(d, err, sizeof err);
+    ck_assert_msg(status == 0, "--report '%s': status %d\n%s", hostile_folders[_i], status, err);
+    snprintf(rep, sizeof rep, "%s/%s", d, hostile_folders[_i]);
+    ck_assert_msg(!exists(d, "PWNED") && !exists(rep, "PWNED"),
+                  "--report '%s' ran a command", hostile_folders[_i]);
+    ck_assert_msg(exists(rep, "report.md"), "no report.md in '%s'", rep);
+    ck_assert_msg(exists(rep, "residual_time.png"), "no plot in '%s'\n%s", rep, err);
+    remove_tree(d);
+}
+END_TEST
+
+/* Output files have the mode the umask gives (not mkstemp's 0600). */
+START_TEST(outputs_take_the_umask_mode)
+{
+    static const mode_t masks[] = {022, 027};
+    char d[64];
+    mode_t mask = masks[_i], want = 0666 & ~mask;
+    const char *apply[] = {"calibrate", "--columns", "mx,my,mz", "--apply", "cal.csv",
+                           "good.csv", NULL};
+    const char *report[] = DISCOVER_ARGS("rep");
+    snprintf(d, sizeof d, "/tmp/foldest-mode-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    write_good(d);
+    {
+        const char *args[] = {"synth", "--effect", "quadratic_drag", "--rows", "2000",
+                              "--real", "r.csv", "--sim", "s.csv", NULL};
+        ck_assert_int_eq(run_argv(d, mask, NULL, args), 0);
+    }
+    ck_assert_int_eq(run_argv(d, mask, NULL, apply), 0);
+    ck_assert_int_eq(run_argv(d, mask, NULL, report), 0);
+    ck_assert_int_eq(mode_of(d, "r.csv"), want);
+    ck_assert_int_eq(mode_of(d, "s.csv"), want);
+    ck_assert_int_eq(mode_of(d, "cal.csv"), want);
+    ck_assert_int_eq(mode_of(d, "rep/report.md"), want);
+    remove_tree(d);
+}
+END_TEST
+
+/* A failed write to standard output (a full disk) is an error: a message
+   and status 4, not 0. */
+static const char *const full_commands[][8] = {
+    {"stats", "--json", "good.csv", NULL},
+    {"stats", "good.csv", NULL},
+    {"calibrate", "--columns", "mx,my,mz", "--json", "good.csv", NULL},
+    {"calibrate", "--columns", "mx,my,mz", "good.csv", NULL},
+    {"--version", NULL},
+};
+
+START_TEST(full_standard_output_is_an_error)
+{
+    char d[64], err[4096];
+    int status;
+    snprintf(d, sizeof d, "/tmp/foldest-full-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    write_good(d);
+    status = run_argv(d, 022, "/dev/full", full_commands[_i]);
+    read_stderr(d, err, sizeof err);
+    ck_assert_msg(status == 4, "foldest %s > /dev/full: status %d\n%s", full_commands[_i][0],
+                  status, err);
+    ck_assert_msg(strstr(err, "cannot write standard output: No space left on device") != NULL,
+                  "foldest %s > /dev/full: stderr:\n%s", full_commands[_i][0], err);
+    /* The same command to /dev/null succeeds: the failure is the output's. */
+    ck_assert_int_eq(run_argv(d, 022, NULL, full_commands[_i]), 0);
+    remove_tree(d);
+}
+END_TEST
+
+/* SIGTERM while the command writes: it dies of the signal and leaves no
+   partial output and no temporary file.  The test waits until the output
+   is being written (a temporary file, or the report's first data file, is
+   there), then sends the signal; the remaining work takes far longer than
+   that (two million rows of synth, about 3 s; 300 000 rows through
+   calibrate --apply or discover --report, 0.2 to 0.6 s). */
+static void wait_for(const char *d, const char *part, pid_t pid)
+{
+    struct timespec nap = {0, 200000};
+    for (int i = 0; i < 100000 && !any_named(d, part); i++) {
+        int status;
+        ck_assert_msg(waitpid(pid, &status, WNOHANG) == 0, "the command ended before writing");
+        nanosleep(&nap, NULL);
+    }
+    ck_assert_msg(any_named(d, part), "no '%s' appeared", part);
+}
+
+START_TEST(interrupted_commands_leave_nothing)
+{
+    char d[64], sub[128];
+    pid_t pid;
+    int status;
+    snprintf(d, sizeof d, "/tmp/foldest-signal-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    snprintf(sub, sizeof sub, "%s/out", d);
+    ck_assert_int_eq(mkdir(sub, 0755), 0);
+    if (_i == 0) {              /* synth: the pair */
+        const char *args[] = {"synth", "--effect", "quadratic_drag", "--rows", "2000000",
+                              "--real", "out/r.csv", "--sim", "out/s.csv", NULL};
+        pid = start(d, 022, NULL, args);
+        wait_for(sub, ".tmp.", pid);
+    } else if (_i == 1) {       /* calibrate --apply */
+        char path[128];
+        FILE *f;
+        const char *args[] = {"calibrate", "--columns", "mx,my,mz", "--apply", "out/cal.csv",
+                              "big.csv", NULL};
+        snprintf(path, sizeof path, "%s/big.csv", d);
+        f = fopen(path, "w");
+        ck_assert_ptr_nonnull(f);
+        fputs("t,mx,my,mz\n", f);
+        write_rows(f, 300000, 0, 0, 0.0);
+        fclose(f);
+        pid = start(d, 022, NULL, args);
+        wait_for(sub, ".tmp.", pid);
+    } else {                    /* discover --report */
+        const char *args[] = DISCOVER_ARGS("out/rep");
+        make_pair(d, "300000");
+        pid = start(d, 022, NULL, args);
+        wait_for(sub, "rep", pid);
+        snprintf(sub, sizeof sub, "%s/out/rep", d);
+        wait_for(sub, "residuals.dat", pid);
+        snprintf(sub, sizeof sub, "%s/out", d);
+    }
+    ck_assert_int_eq(kill(pid, SIGTERM), 0);
+    status = finish(pid);
+    ck_assert_msg(status == 1000 + SIGTERM, "case %d: status %d, not killed by SIGTERM", _i,
+                  status);
+    {
+        DIR *dd = opendir(sub);
+        struct dirent *e;
+        ck_assert_ptr_nonnull(dd);
+        while ((e = readdir(dd)) != NULL)
+            ck_assert_msg(strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0,
+                          "case %d: '%s' left behind after SIGTERM", _i, e->d_name);
+        closedir(dd);
+    }
+    remove_tree(d);
+}
+END_TEST
+
 Suite *fe_hostile_suite(void)
 {
     Suite *s = suite_create("hostile");
@@ -301,6 +585,12 @@ Suite *fe_hostile_suite(void)
     tcase_add_loop_test(t, every_command_on_every_hostile_file, 0, NCASES * NCOMMANDS);
     tcase_add_loop_test(t, synth_leaves_no_partial_pair, 0,
                         (int)(sizeof synth_cases / sizeof synth_cases[0]));
+    tcase_add_loop_test(t, report_folder_names_run_nothing, 0,
+                        (int)(sizeof hostile_folders / sizeof hostile_folders[0]));
+    tcase_add_loop_test(t, outputs_take_the_umask_mode, 0, 2);
+    tcase_add_loop_test(t, full_standard_output_is_an_error, 0,
+                        (int)(sizeof full_commands / sizeof full_commands[0]));
+    tcase_add_loop_test(t, interrupted_commands_leave_nothing, 0, 3);
     suite_add_tcase(s, t);
     return s;
 }

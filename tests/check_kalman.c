@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Kalman folding: the update against an independent long-double
    computation, the row-major dposv convention, refusal of bad packets
    (accumulation unchanged bit for bit), the tracker's coverage, the

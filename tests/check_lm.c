@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Levenberg-Marquardt: known minima (Rosenbrock, a linear model against
    the normal-equation solve), the 2-D bundle adjustment of EJML with the
    dense and Schur paths agreeing, the iteration report, failures of the

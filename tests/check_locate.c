@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Locating a mismatch from a Kalman filter's innovations: a tracker whose
    constant-velocity model misses a drag switched on for one stretch of the
    run locates that stretch; with the right model nothing is located. */

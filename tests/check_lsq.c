@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The normal-equation accumulator: streaming equals batch (LAPACK's dgels
    on the same rows), merge of every split equals the whole, sub-model
    solves equal refits, the Schur score equals the drop in RSS, refusal of

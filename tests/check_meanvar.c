@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Running mean and variance: the vectors of Kalman Folding, merge laws,
    streaming equals batch, precision, refusal of bad input. */
 #include <float.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A model as a callback: the mechanical rig of the synthetic generator
    written as a model f(t, x, v, u; theta) with three parameters (input
    gain, resonance frequency, damping ratio), its Jacobian analytic or by

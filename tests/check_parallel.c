@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Parallel folds: equal to the serial fold for every mergeable accumulator,
    for 1..8 threads and awkward sizes; deterministic; the first refusal (the
    lowest index) wins; bad arguments fold nothing.  Also run under

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Moments of a three-axis stream: step equals block, merge of any split
    equals the whole (to 1e-12), re-centring, refusal leaves the accumulation
    unchanged, empty and one-sample streams, equal-area regions, coverage. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The generator: reproducible, uniform in [0,1), normal with the right
    moments, independent streams for different seeds. */
 #include <stdint.h>

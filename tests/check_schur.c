@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Arrow-shaped least squares: the Schur elimination equals the dense solve
    (and QR) of the same rows, damped or not; merge of every split equals the
    whole; bad rows are refused and nothing changes; singular blocks are

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tail probabilities against table values and identities. */
 #define _DEFAULT_SOURCE
 #include "foldest.h"
@@ -46,6 +47,55 @@ START_TEST(bad_arguments_give_nan)
 }
 END_TEST
 
+/* The chi-square upper tail from 1 to 1e7 degrees of freedom, at the centre
+   k and about 3 and 6 standard deviations sqrt(2k) either side.  Reference
+   values: Q(k/2, x/2) computed with 50 digits by mpmath 1.3.0
+   (mp.gammainc(k/2, x/2, mp.inf, regularized=True), mp.dps = 50) at the
+   decimal x written here; printed to 17 digits.  Before the fix,
+   fe_chi2_upper(1e6, 1e6) was 0.739 (0.512 at 1e5, 0.911 at 1e7). */
+static const double chi2_reference[][3] = {
+    {1.0, 1, 0.3173105078629141},
+    {5.24264, 1, 0.022039803985687299},
+    {9.48528, 1, 0.0020712700053132128},
+    {2.0, 2, 0.36787944117144232},
+    {8.0, 2, 0.01831563888873418},
+    {14.0, 2, 0.00091188196555451621},
+    {10.0, 10, 0.44049328506521241},
+    {23.4164, 10, 0.0093096597023318951},
+    {36.8328, 10, 6.0488691009749309e-5},
+    {58.0, 100, 0.99975171267393628},
+    {100.0, 100, 0.48119168452795672},
+    {142.0, 100, 0.0036920523542641519},
+    {185.0, 100, 5.0356524578869303e-7},
+    {866.0, 1000, 0.999115897219802},
+    {1000.0, 1000, 0.49405285382923964},
+    {1134.0, 1000, 0.0019457873514089116},
+    {1268.0, 1000, 1.4897902491933098e-8},
+    {9576.0, 10000, 0.99880469938725861},
+    {10000.0, 10000, 0.49811936596618264},
+    {10424.0, 10000, 0.0015308473426415609},
+    {10849.0, 10000, 2.5165951253542926e-9},
+    {98658.0, 100000, 0.99870592549374574},
+    {100000.0, 100000, 0.49940529189520669},
+    {101342.0, 100000, 0.0013995852512145796},
+    {102683.0, 100000, 1.3569624985612368e-9},
+    {995757.0, 1000000, 0.99866788273472658},
+    {1000000.0, 1000000, 0.4998119368033945},
+    {1004243.0, 1000000, 0.0013655251244366811},
+    {1008485.0, 1000000, 1.0927289165248974e-9},
+    {9986584.0, 10000000, 0.99865497921736377},
+    {10000000.0, 10000000, 0.49994052919606216},
+    {10013416.0, 10000000, 0.0013555935230733283},
+    {10026833.0, 10000000, 1.018479628954806e-9},
+};
+
+START_TEST(chi2_upper_large_degrees_of_freedom)
+{
+    const double *c = chi2_reference[_i];
+    FE_ASSERT_REL(fe_chi2_upper(c[0], c[1]), c[2], 1e-10);
+}
+END_TEST
+
 Suite *fe_special_suite(void)
 {
     Suite *s = suite_create("special");
@@ -53,6 +103,8 @@ Suite *fe_special_suite(void)
     tcase_add_test(t, student_t_table_values);
     tcase_add_test(t, f_and_chi_square);
     tcase_add_test(t, bad_arguments_give_nan);
+    tcase_add_loop_test(t, chi2_upper_large_degrees_of_freedom, 0,
+                        (int)(sizeof chi2_reference / sizeof chi2_reference[0]));
     suite_add_tcase(s, t);
     return s;
 }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Sphere and ellipsoid fits: the three algorithms agree, the streaming fit
    keeps its precision with a large offset, refusals with their reasons, the
    trace, and the real recordings of ../shared/data. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Streams: array, generator and file descriptor sources; folding them;
    rewinding; truncated records and pipes. */
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Numerical stress: ill-conditioned and degenerate data.  Planar and
    collinear samples, a sphere of radius 1 at 1e8 from the origin, radii
    1e-8 and 1e8, denormal values, near-singular Kalman denominators,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The one test runner: every tests/check_<module>.c defines
    `Suite *fe_<module>_suite(void)`; the Makefile lists them in suites.h. */
 #include <check.h>

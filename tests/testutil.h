@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Helpers shared by the test suites. */
 #ifndef FE_TESTUTIL_H
 #define FE_TESTUTIL_H

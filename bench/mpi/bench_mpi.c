@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Folds of data in memory, in one run, for each accumulator of the table:
      - serially, on rank 0 alone (fe_fold over the whole array);
      - distributed, every rank folding its shard (the cut of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A magnetometer calibration from a stream folded in shards by the ranks of
    an MPI job: each rank folds its shard into the calibration moments
    (fe_quadric, 760 flat bytes), MPI_Reduce merges them with fe_quadric_merge

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: MIT
 # make check-mpi: run the MPI examples; each one compares its distributed
 # result with the serial fold of the same data and exits nonzero if they
 # disagree.  Usage: check.sh BUILD_DIR "MPIRUN COMMAND"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Discovery from a recording folded in shards by the ranks of an MPI job:
    each rank folds its rows into discovery's block Gram matrices
    (fe_discover_acc, bound to the storage inside its cell), MPI_Reduce merges

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A least-squares fit from rows folded in shards by the ranks of an MPI job:
    each rank folds its shard into normal equations (fe_lsq), which point into
    storage, so the storage travels inside the cell

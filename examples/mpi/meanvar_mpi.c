@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The mean and variance of one stream, folded in shards by the ranks of an
    MPI job and combined with MPI_Reduce and MPI_Allreduce, using the merge of
    fe_meanvar as a (non-commutative) MPI operation.  The root checks the

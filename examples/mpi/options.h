@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The MPI examples' options: -n N, the number of observations of the
    whole stream, and -nan I, a NaN planted at global index I, to watch a
    refusal travel through the reduction to the root. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/catalog.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/catalog.org::Catalog Declarations][Catalog Declarations]] */
 #ifndef FOLDEST_CATALOG_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/discover.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* Roles of the simulation's state columns, as bits. */
 enum fe_role {
@@ -84,6 +89,10 @@ void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups);
    Writes at most len bytes (NUL-terminated); returns FE_OK. */
 int fe_catalog_explain(const char *name, double coef, double stderr_,
                        char *buf, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_CATALOG_H */
 /* Catalog Declarations ends here */

@@ -1,9 +1,14 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/csv.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/csv.org::CSV Reader Declarations][CSV Reader Declarations]] */
 #ifndef FOLDEST_CSV_H
 #define FOLDEST_CSV_H
 
 #include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* A line reader over a file descriptor, through a caller buffer. */
 typedef struct fe_csv_reader {
@@ -52,6 +57,10 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
    FE_EPARSE when it is empty or not entirely a number; FE_ENONFINITE
    for "nan", "inf" and values that overflow. */
 int fe_csv_number(const fe_csv_field *field, double *value);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_CSV_H */
 /* CSV Field Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/discover.org::Discovery Accumulation Declarations][Discovery Accumulation Declarations]] */
 #ifndef FOLDEST_DISCOVER_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 enum {
     FE_DISCOVER_MAX_COLUMNS = 64,   /* term columns m */
@@ -348,6 +353,10 @@ int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
                           double *stderr_, fe_discover_fit *fit,
                           fe_discover_noise *noise, double *work,
                           size_t work_doubles);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_DISCOVER_H */
 /* Discovery Selection Declarations ends here */

@@ -1,7 +1,12 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/error.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/error.org::Error Codes][Error Codes]] */
 #ifndef FOLDEST_ERROR_H
 #define FOLDEST_ERROR_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* Status codes returned by every foldest function that can fail. */
 enum fe_status {
@@ -29,6 +34,10 @@ enum fe_status {
    Returns a pointer to a constant string, never NULL; an unknown code gives
    "unknown foldest status".  Thread-safe. */
 const char *fe_strerror(int status);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_ERROR_H */
 /* Error Codes ends here */

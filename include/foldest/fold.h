@@ -1,9 +1,14 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/fold.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/fold.org::Fold Declarations][Fold Declarations]] */
 #ifndef FOLDEST_FOLD_H
 #define FOLDEST_FOLD_H
 
 #include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The functions an accumulator is made of.  `ctx` is the accumulator's
    context; none of these functions may modify it.  Each returns FE_OK or an
@@ -99,6 +104,10 @@ typedef struct fe_product_acc {
    unusable or does not fit inside obs_size. */
 int fe_product_accumulator(fe_accumulator *out, const fe_product *spec,
                            size_t obs_size);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_FOLD_H */
 /* Product Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/kalman.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/kalman.org::Kalman Filter Declarations][Kalman Filter Declarations]] */
 #ifndef FOLDEST_KALMAN_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* Largest state or packet dimension accepted (keeps sizes and LAPACK's
    int arguments far from overflow). */
@@ -278,6 +283,10 @@ fe_accumulator fe_kalman_info_accumulator(void);
 /* fe_kalman_monitor_accumulator: the monitor over fe_kalman_report
    observations; `p` (NULL: defaults) must outlive it.  Flat, no merge. */
 fe_accumulator fe_kalman_monitor_accumulator(const fe_kalman_monitor_params *p);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_KALMAN_H */
 /* Kalman Accumulator Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/lm.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/lm.org::Levenberg-Marquardt Declarations][Levenberg-Marquardt Declarations]] */
 #ifndef FOLDEST_LM_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/schur.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* Where a model sends its residuals; owned by the solver. */
 typedef struct fe_lm_sink fe_lm_sink;
@@ -108,6 +113,10 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
                 const fe_lm_params *params, double *x, double *work,
                 fe_lm_report_fn *report, void *report_ctx,
                 fe_lm_result *result);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_LM_H */
 /* Levenberg-Marquardt Declarations ends here */

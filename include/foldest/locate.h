@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/locate.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/locate.org::Locate Declarations][Locate Declarations]] */
 #ifndef FOLDEST_LOCATE_H
@@ -8,6 +9,10 @@
 
 #include "foldest/discover.h"
 #include "foldest/kalman.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* One located time window.  The statistics are on the standard normal
    scale. */
@@ -85,6 +90,10 @@ int fe_innovations_merge(fe_innovations *a, const fe_innovations *b);
    Errors: FE_EINVAL. */
 int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out,
                           size_t max, size_t *nout);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_LOCATE_H */
 /* Locate Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/lsq.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/lsq.org::Least Squares Declarations][Least Squares Declarations]] */
 #ifndef FOLDEST_LSQ_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* A sub-model column whose pivot ratio 1 - R^2 (its unexplained part,
    relative to its norm) is at or below this is treated as dependent. */
@@ -123,6 +128,10 @@ int fe_lsq_scores(const fe_lsq *a, const size_t *base, size_t qb,
    by fe_lsq_init first: fe_init resets, fe_copy copies contents, fe_merge
    adds).  fe_scan is not supported (the accumulation points to storage). */
 fe_accumulator fe_lsq_accumulator(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_LSQ_H */
 /* Least Squares Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/meanvar.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/meanvar.org::Mean and Variance Declarations][Mean and Variance Declarations]] */
 #ifndef FOLDEST_MEANVAR_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The running mean and variance of a stream of doubles: count, mean and
    the sum of squared deviations from the mean.  A plain value: copy it,
@@ -44,6 +49,10 @@ double fe_meanvar_stddev(const fe_meanvar *a);              /* sqrt of sample */
 /* fe_meanvar_accumulator: the accumulator for fe_fold and friends, over
    observations of type double and accumulations of type fe_meanvar. */
 fe_accumulator fe_meanvar_accumulator(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_MEANVAR_H */
 /* Mean and Variance Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/model.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/model.org::Model Declarations][Model Declarations]] */
 #ifndef FOLDEST_MODEL_H
@@ -8,6 +9,10 @@
 
 #include "foldest/catalog.h"
 #include "foldest/discover.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 enum {
     FE_MODEL_MAX_PARAMS = 16    /* parameters theta of one model */
@@ -119,6 +124,10 @@ int fe_model_group_is_term(const fe_model_acc *a, size_t g, size_t *term);
    se 0, the others are filled as usual.  Every number written is finite. */
 int fe_model_theta(const fe_model_acc *a, const fe_discover_result *r,
                    double *theta, double *se);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_MODEL_H */
 /* Model Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/mpi.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/mpi.org::MPI Helper Declarations][MPI Helper Declarations]] */
 #ifndef FOLDEST_MPI_H
@@ -10,6 +11,10 @@
 #include <string.h>
 
 #include "foldest.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The MPI handles of one reduction: the datatype of one cell and the
    (non-commutative) operation merging two cells.  Create with the
@@ -255,6 +260,10 @@ static inline int fe_mpi_allreduce(const fe_mpi_reduction *r,
                ? FE_OK
                : FE_EIO;
 }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_MPI_H */
 /* Reduce cells across ranks ends here */

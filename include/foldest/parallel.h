@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/parallel.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/parallel.org::Parallel Fold Declarations][Parallel Fold Declarations]] */
 #ifndef FOLDEST_PARALLEL_H
@@ -7,6 +8,10 @@
 
 #include "foldest/fold.h"
 #include "foldest/stream.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The largest thread count the parallel folds accept (their bookkeeping
    lives on the caller's stack). */
@@ -95,6 +100,10 @@ int fe_parallel_fold_source(const fe_accumulator *f, void *acc,
                             fe_source *src, unsigned workers, size_t batch,
                             const fe_parallel_slot *slots, unsigned nslots,
                             size_t *done);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_PARALLEL_H */
 /* Parallel Fold Declarations ends here */

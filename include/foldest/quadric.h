@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/quadric.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/quadric.org::Quadric Moment Declarations][Quadric Moment Declarations]] */
 #ifndef FOLDEST_QUADRIC_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 enum {
     FE_QUADRIC_MOMENTS = 35,    /* monomials of degree <= 4 in 3 variables */
@@ -97,6 +102,10 @@ void fe_quadric_exponents(int k, int e[3]);
    `centre` (NULL, or 3 doubles that must outlive the descriptor) is given
    to fe_quadric_init by fe_init. */
 fe_accumulator fe_quadric_accumulator(const double *centre);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_QUADRIC_H */
 /* Quadric Moment Declarations ends here */

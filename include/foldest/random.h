@@ -1,9 +1,14 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/random.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/random.org::Random Declarations][Random Declarations]] */
 #ifndef FOLDEST_RANDOM_H
 #define FOLDEST_RANDOM_H
 
 #include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* A xoshiro256** generator; the caller owns it, one per thread. */
 typedef struct fe_rng {
@@ -28,6 +33,10 @@ double fe_rng_normal(fe_rng *r);
 /* fe_rng_unit_vector: u[0..2] uniform on the unit sphere (three normal
    deviates, normalised). */
 void fe_rng_unit_vector(fe_rng *r, double u[3]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_RANDOM_H */
 /* Random Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/schur.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/schur.org::Schur Declarations][Schur Declarations]] */
 #ifndef FOLDEST_SCHUR_H
@@ -8,6 +9,10 @@
 
 #include "foldest/fold.h"
 #include "foldest/lsq.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The block index of a row that touches no local block. */
 #define FE_SCHUR_NONE ((size_t)-1)
@@ -85,6 +90,10 @@ int fe_schur_solve(const fe_schur *a, double lambda, double *x, double *rss,
    fe_schur_row observations and fe_schur accumulations (bound first with
    fe_schur_init).  Merges; fe_scan is not supported. */
 fe_accumulator fe_schur_accumulator(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SCHUR_H */
 /* Schur Declarations ends here */

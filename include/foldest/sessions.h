@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/sessions.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/sessions.org::Session Calibration Declarations][Session Calibration Declarations]] */
 #ifndef FOLDEST_SESSIONS_H
@@ -6,6 +7,10 @@
 #include <stddef.h>
 
 #include "foldest/lm.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 enum { FE_SESSIONS_MAX = 64 };
 
@@ -48,6 +53,10 @@ size_t fe_sessions_work(const fe_sessions *c);
    Errors as fe_lm_solve; FE_EINVAL for no sessions or too many. */
 int fe_sessions_fit(const fe_sessions *c, double *x, double *work,
                     fe_lm_result *result);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SESSIONS_H */
 /* Session Calibration Declarations ends here */

@@ -1,7 +1,12 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/special.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/special.org::Tail Probability Declarations][Tail Probability Declarations]] */
 #ifndef FOLDEST_SPECIAL_H
 #define FOLDEST_SPECIAL_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* fe_beta_inc: the regularised incomplete beta function I_x(a, b) for
    a, b > 0 and 0 <= x <= 1; NaN for other arguments. */
@@ -40,6 +45,10 @@ double fe_normal_quantile(double p);
    refined by Newton's method on P(dof/2, x/2) inside a kept bracket.
    NaN for other arguments. */
 double fe_chi2_quantile(double q, double dof);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SPECIAL_H */
 /* Tail Probability Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/sphere.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/sphere.org::Sphere Fit Declarations][Sphere Fit Declarations]] */
 #ifndef FOLDEST_SPHERE_H
@@ -7,6 +8,10 @@
 #include <stdint.h>
 
 #include "foldest/quadric.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* The models. */
 typedef enum fe_sphere_model {
@@ -141,6 +146,10 @@ int fe_sphere_model_parse(const char *name, fe_sphere_model *model);
 
 /* fe_sphere_refusal_string: a sentence for fit->refusal. */
 const char *fe_sphere_refusal_string(int refusal);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SPHERE_H */
 /* Sphere Fit Declarations ends here */

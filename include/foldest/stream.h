@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/stream.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/stream.org::Stream Declarations][Stream Declarations]] */
 #ifndef FOLDEST_STREAM_H
@@ -6,6 +7,10 @@
 #include <stddef.h>
 
 #include "foldest/fold.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* A pull-based stream of observations of obs_size bytes each. */
 typedef struct fe_source {
@@ -82,6 +87,10 @@ typedef struct fe_fd_source {
    FE_EPARSE; a read error FE_EIO. */
 int fe_source_from_fd(fe_source *src, fe_fd_source *state, int fd,
                       size_t obs_size, void *buffer, size_t buffer_size);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_STREAM_H */
 /* File Descriptor Source Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/synth.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/synth.org::Synthetic Experiment Declarations][Synthetic Experiment Declarations]] */
 #ifndef FOLDEST_SYNTH_H
@@ -8,6 +9,10 @@
 
 #include "foldest/catalog.h"
 #include "foldest/random.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 typedef struct fe_synth_spec {
     const char *effect;         /* a built-in term's name, or "none" */
@@ -57,6 +62,10 @@ size_t fe_synth_base(const fe_synth *g, const fe_catalog *c, size_t *base);
 /* fe_synth_effects: the effect names with a rig, in catalog order, then
    "none" twice (one null case per rig: "none" and "none_thermal"). */
 const char *const *fe_synth_effects(size_t *count);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* FOLDEST_SYNTH_H */
 /* Synthetic Experiment Declarations ends here */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/calibrate.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/calibrate.org::Calibrate Includes and Help][Calibrate Includes and Help]] */
 #include "cli.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli.org::Command Line Declarations][Command Line Declarations]] */
 #ifndef FOLDEST_CLI_H
@@ -76,6 +77,7 @@ void fe_cli_table_close(fe_cli_table *t);
 typedef struct fe_cli_output {
     FILE *file;
     char *path, *tmp;
+    int pending;                /* slot of tmp among the pending paths */
 } fe_cli_output;
 
 /* Create a temporary file beside `path`; FE_CLI_IO with a message. */
@@ -85,6 +87,31 @@ int fe_cli_output_open(fe_cli_output *o, const char *path, char *err,
 int fe_cli_output_commit(fe_cli_output *o, char *err, size_t errlen);
 /* Close and delete: nothing is left behind. */
 void fe_cli_output_abort(fe_cli_output *o);
+
+/* Interruption.  fe_cli_signals_install: on SIGINT and SIGTERM, unlink
+   every pending path (rmdir for a directory) and die of the signal.
+   fe_cli_pending_add: register a path (copied); its slot, or -1 when the
+   table is full or the path too long (then it is simply not removed).
+   fe_cli_pending_drop: forget a slot (-1: nothing).  fe_cli_pending_clear:
+   forget all.  fe_cli_signals_hold(1) blocks SIGINT and SIGTERM until
+   fe_cli_signals_hold(0). */
+void fe_cli_signals_install(void);
+int fe_cli_pending_add(const char *path, int is_dir);
+void fe_cli_pending_drop(int slot);
+void fe_cli_pending_clear(void);
+void fe_cli_signals_hold(int hold);
+
+/* Flush and close standard output at the end of a command; when that or
+   an earlier write failed, print why on stderr and return FE_CLI_IO if rc
+   was FE_CLI_OK.  Otherwise return rc. */
+int fe_cli_finish(const char *command, int rc);
+
+/* Run the program argv[0] (looked up on PATH) with the arguments argv,
+   NULL-terminated, and wait for it: no shell, so nothing in an argument
+   is interpreted.  Its standard output and error go to /dev/null.
+   Returns its exit status, or -1 when it could not be started or was
+   killed by a signal. */
+int fe_cli_spawn(char *const argv[]);
 
 /* Progress of a table on stderr, when stderr is a terminal and the input
    is large; call once per row, cheap; fe_cli_progress_done clears it. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli.org::Command Table][Command Table]] */
 #ifndef FOLDEST_CLI_COMMANDS_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli_discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli_discover.org::Discover Command Includes][Discover Command Includes]] */
 #include "cli.h"
@@ -198,10 +199,14 @@ typedef struct fe__located {
 } fe__located;
 
 /* What one row is worth in independent rows under a noise model: n_eff / n,
-   at most 1, so that a block of n_k rows weighs n_k times it. */
+   at most 1, so that a block of n_k rows weighs n_k times it; divided by
+   the block ratio R when slow variation beyond the autoregression was
+   found (the blocks' means then vary R times more). */
 static double fe__row_worth(const fe_discover_noise *nz, double n)
 {
     double w = n > 0 ? nz->n_eff / n : 1.0;
+    if (nz->long_range)
+        w /= nz->block_ratio;
     return w > 1.0 ? 1.0 : w < 1e-6 ? 1e-6 : w;
 }
 
@@ -861,7 +866,49 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
 /* [[file:../../literate/cli_discover.org::Write the report][Write the report]] */
 static int fe__have_gnuplot(void)
 {
-    return system("gnuplot --version >/dev/null 2>&1") == 0;
+    char *const argv[] = {"gnuplot", "--version", NULL};
+    return fe_cli_spawn(argv) == 0;
+}
+
+/* Run gnuplot on a script in the report folder `dir`, given as the
+   script's argument ARG1 (a string gnuplot never parses); 0 when it
+   succeeded. */
+static int fe__run_gnuplot(const char *script, const char *dir)
+{
+    char *const argv[] = {"gnuplot", "-c", (char *)script, (char *)dir, NULL};
+    return fe_cli_spawn(argv);
+}
+
+/* `s` as the inside of a single-quoted gnuplot string: ' doubled, control
+   characters as '?'.  1 when it did not fit. */
+static int fe__gnuplot_quote(char *out, size_t len, const char *s)
+{
+    size_t k = 0;
+    for (; *s != '\0'; s++) {
+        if (k + 3 > len)
+            return 1;
+        if (*s == '\'')
+            out[k++] = '\'';
+        out[k++] = (unsigned char)*s < 0x20 || *s == 0x7f ? '?' : *s;
+    }
+    out[k] = '\0';
+    return 0;
+}
+
+/* Register the report's files (and its folder, when this run made it) as
+   pending: removed if the command is interrupted before the end. */
+static void fe__report_pending(const char *dir, int made)
+{
+    static const char *const names[] = {"residuals.dat", "blocks.dat", "bins.dat",
+                                        "report.md", "plots.gp", "residual_time.png",
+                                        "residual_state.png"};
+    char path[4200];
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        fe_cli_pending_add(path, 0);
+    }
+    if (made)
+        fe_cli_pending_add(dir, 1);
 }
 
 /* Write per-block and per-bin means: what the eye needs to see a concealed
@@ -883,10 +930,14 @@ static int fe__write_means(const char *path, const fe__stat *s, size_t n, int us
 static int fe__write_report(const char *dir, const fe__outcome *o, const char *points,
                             const char *state_var, int state_col, char *err, size_t errlen)
 {
-    char path[4096], script[4096];
+    char path[4096], script[4096], qvar[512] = "";
     fe_cli_output out;
     FILE *f;
     int plots = fe__have_gnuplot(), rc;
+    if (state_var != NULL && fe__gnuplot_quote(qvar, sizeof qvar, state_var)) {
+        snprintf(err, errlen, "%.200s: column name too long for the plot script", state_var);
+        return FE_CLI_USAGE;
+    }
     snprintf(path, sizeof path, "%s/report.md", dir);
     if ((rc = fe_cli_output_open(&out, path, err, errlen)) != FE_CLI_OK)
         return rc;
@@ -917,29 +968,25 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const char *p
     }
     fprintf(f, "set terminal pngcairo size 1000,500 noenhanced\n"
                "set datafile separator ' '\nset grid\nset key outside\n"
-               "set output '%s/residual_time.png'\n"
+               "if (ARGC > 0) cd ARG1\n"
+               "set output 'residual_time.png'\n"
                "set xlabel 'time block (fitted blocks, then the held-out rows)'\n"
                "set ylabel 'RMS of recording - model'\n"
                "set title 'Residual RMS per time block, before and after the discovered terms'\n"
-               "plot '%s/blocks.dat' using 1:5 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
-               "'' using 1:6 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n",
-            dir, dir);
+               "plot 'blocks.dat' using 1:5 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
+               "'' using 1:6 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n");
     (void)points;
     (void)state_col;
     if (state_var != NULL)
-        fprintf(f, "set output '%s/residual_state.png'\nset xlabel '%s'\n"
+        fprintf(f, "set output 'residual_state.png'\nset xlabel '%s'\n"
                    "set title 'Residual mean against %s (40 bins)'\n"
-                   "plot '%s/bins.dat' using 1:2 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
+                   "plot 'bins.dat' using 1:2 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
                    "'' using 1:3 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n",
-                dir, state_var, state_var, dir);
+                qvar, qvar);
     fclose(f);
-    {
-        char cmd[8300];
-        snprintf(cmd, sizeof cmd, "gnuplot '%s' 2>/dev/null", script);
-        if (system(cmd) != 0) {
-            snprintf(err, errlen, "%.1000s: gnuplot failed", script);
-            return FE_CLI_IO;
-        }
+    if (fe__run_gnuplot(script, dir) != 0) {
+        snprintf(err, errlen, "%.1000s: gnuplot failed", script);
+        return FE_CLI_IO;
     }
     return FE_CLI_OK;
 }
@@ -1140,11 +1187,13 @@ int fe_cli_discover(int argc, char **argv)
 
     /* Pass 3: residuals before and after, by block and by region. */
     if (a.report != NULL) {
-        if (mkdir(a.report, 0777) != 0 && errno != EEXIST) {
+        int made = mkdir(a.report, 0777) == 0;
+        if (!made && errno != EEXIST) {
             snprintf(err, sizeof err, "%.1000s: cannot create: %s", a.report, strerror(errno));
             rc = FE_CLI_IO;
             goto fail;
         }
+        fe__report_pending(a.report, made);
         snprintf(points, sizeof points, "%s/residuals.dat", a.report);
         pts = fopen(points, "w");
         if (pts == NULL) {
@@ -1389,6 +1438,7 @@ int fe_cli_discover(int argc, char **argv)
         rc = fe__write_report(a.report, &out, points, var, col, err, sizeof err);
         if (rc != FE_CLI_OK)
             goto fail;
+        fe_cli_pending_clear();
         if (!a.json)
             printf("report: %s/report.md\n", a.report);
     }

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli.org::Dispatch a subcommand][Dispatch a subcommand]] */
 #include "cli.h"
@@ -20,18 +21,19 @@ static void fe__cli_overview(FILE *out)
 
 int main(int argc, char **argv)
 {
+    fe_cli_signals_install();
     if (argc < 2 || strcmp(argv[1], "help") == 0 || strcmp(argv[1], "--help") == 0
         || strcmp(argv[1], "-h") == 0) {
         fe__cli_overview(argc < 2 ? stderr : stdout);
-        return argc < 2 ? FE_CLI_USAGE : FE_CLI_OK;
+        return fe_cli_finish(NULL, argc < 2 ? FE_CLI_USAGE : FE_CLI_OK);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("foldest %s\n", FE_VERSION);
-        return FE_CLI_OK;
+        return fe_cli_finish(NULL, FE_CLI_OK);
     }
     for (size_t i = 0; i < sizeof fe_cli_commands / sizeof fe_cli_commands[0]; i++)
         if (strcmp(argv[1], fe_cli_commands[i].name) == 0)
-            return fe_cli_commands[i].run(argc - 1, argv + 1);
+            return fe_cli_finish(argv[1], fe_cli_commands[i].run(argc - 1, argv + 1));
     fprintf(stderr, "foldest: unknown command '%s'\n\n", argv[1]);
     fe__cli_overview(stderr);
     return FE_CLI_USAGE;

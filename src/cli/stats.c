@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli.org::Summarise columns][Summarise columns]] */
 #include "cli.h"

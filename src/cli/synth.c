@@ -1,9 +1,11 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli_discover.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli_discover.org::Write a synthetic pair][Write a synthetic pair]] */
 #include "cli.h"
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char fe__synth_help[] =
     "usage: foldest synth --effect NAME [--seed S] [--rows N] --real REAL.csv --sim SIM.csv\n"
@@ -23,6 +25,7 @@ int fe_cli_synth(int argc, char **argv)
     fe_synth_spec spec;
     fe_sample s;
     fe_cli_output ro, so;
+    int pending_real;
     int rc;
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -99,15 +102,21 @@ int fe_cli_synth(int argc, char **argv)
             fprintf(so.file, "%.6f,%.10g,%.10g,%.10g,%.10g\n", s.t, s.sim, s.position,
                     s.velocity, s.input);
     }
+    /* The pair appears whole or not at all: the recording stays pending
+       until the simulation is in place, and goes if it cannot be. */
     if ((rc = fe_cli_output_commit(&ro, err, sizeof err)) != FE_CLI_OK) {
         fe_cli_output_abort(&so);
         fprintf(stderr, "foldest synth: %s\n", err);
         return rc;
     }
+    pending_real = fe_cli_pending_add(real, 0);
     if ((rc = fe_cli_output_commit(&so, err, sizeof err)) != FE_CLI_OK) {
+        unlink(real);
+        fe_cli_pending_drop(pending_real);
         fprintf(stderr, "foldest synth: %s\n", err);
         return rc;
     }
+    fe_cli_pending_drop(pending_real);
     fprintf(stderr, "synth: %zu rows; hidden effect %s, coefficient %.6g; noise sd %g, "
                     "lag-one correlation %g\n",
             spec.rows, effect, g.coefficient, spec.noise_sd, spec.noise_rho);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tangled from literate/cli.org: do not edit; edit the .org and run make tangle. */
 /* [[file:../../literate/cli.org::Table Includes][Table Includes]] */
 #include "cli.h"
@@ -8,9 +9,14 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <spawn.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
 /* Table Includes ends here */
 /* [[file:../../literate/cli.org::Format a located message][Format a located message]] */
 static int fe__cli_at(const fe_cli_table *t, size_t line, size_t column,
@@ -359,12 +365,21 @@ void fe_cli_table_close(fe_cli_table *t)
 }
 /* Read the next row ends here */
 /* [[file:../../literate/cli.org::Write output atomically][Write output atomically]] */
+/* The mode a file created with 0666 gets under the current umask. */
+static mode_t fe__cli_umask_mode(void)
+{
+    mode_t mask = umask(0);
+    umask(mask);
+    return (mode_t)(0666 & ~mask);
+}
+
 int fe_cli_output_open(fe_cli_output *o, const char *path, char *err,
                        size_t errlen)
 {
     size_t n = strlen(path) + 16;
-    int fd;
+    int fd, saved;
     o->file = NULL;
+    o->pending = -1;
     o->path = fe__cli_strdup(path);
     o->tmp = calloc(n, 1);
     if (o->path == NULL || o->tmp == NULL) {
@@ -375,18 +390,26 @@ int fe_cli_output_open(fe_cli_output *o, const char *path, char *err,
         return FE_CLI_IO;
     }
     snprintf(o->tmp, n, "%s.tmp.XXXXXX", path);
+    fe_cli_signals_hold(1);
     fd = mkstemp(o->tmp);
-    if (fd >= 0)
-        o->file = fdopen(fd, "w");
+    if (fd >= 0) {
+        o->pending = fe_cli_pending_add(o->tmp, 0);
+        if (fchmod(fd, fe__cli_umask_mode()) == 0)
+            o->file = fdopen(fd, "w");
+    }
+    saved = errno;
+    fe_cli_signals_hold(0);
     if (o->file == NULL) {
-        snprintf(err, errlen, "%s: cannot create: %s", path, strerror(errno));
+        snprintf(err, errlen, "%s: cannot create: %s", path, strerror(saved));
         if (fd >= 0) {
             close(fd);
             unlink(o->tmp);
         }
+        fe_cli_pending_drop(o->pending);
         free(o->path);
         free(o->tmp);
         o->path = o->tmp = NULL;
+        o->pending = -1;
         return FE_CLI_IO;
     }
     return FE_CLI_OK;
@@ -397,14 +420,19 @@ int fe_cli_output_commit(fe_cli_output *o, char *err, size_t errlen)
     int bad = ferror(o->file) != 0;
     bad |= fclose(o->file) != 0;
     o->file = NULL;
+    fe_cli_signals_hold(1);
     if (bad || rename(o->tmp, o->path) != 0) {
+        fe_cli_signals_hold(0);
         snprintf(err, errlen, "%s: cannot write: %s", o->path, strerror(errno));
         fe_cli_output_abort(o);
         return FE_CLI_IO;
     }
+    fe_cli_pending_drop(o->pending);
+    fe_cli_signals_hold(0);
     free(o->tmp);
     free(o->path);
     o->tmp = o->path = NULL;
+    o->pending = -1;
     return FE_CLI_OK;
 }
 
@@ -414,12 +442,129 @@ void fe_cli_output_abort(fe_cli_output *o)
         fclose(o->file);
     if (o->tmp != NULL)
         unlink(o->tmp);
+    fe_cli_pending_drop(o->pending);
     free(o->tmp);
     free(o->path);
     o->file = NULL;
     o->tmp = o->path = NULL;
+    o->pending = -1;
+}
+/* Write output atomically ends here */
+/* [[file:../../literate/cli.org::Remove pending files when interrupted][Remove pending files when interrupted]] */
+enum { FE__CLI_PENDING = 16, FE__CLI_PENDING_PATH = 4200 };
+static char fe__cli_pending_path[FE__CLI_PENDING][FE__CLI_PENDING_PATH];
+static volatile sig_atomic_t fe__cli_pending_used[FE__CLI_PENDING];
+
+int fe_cli_pending_add(const char *path, int is_dir)
+{
+    size_t n = strlen(path);
+    if (n >= FE__CLI_PENDING_PATH)
+        return -1;
+    for (int i = 0; i < FE__CLI_PENDING; i++)
+        if (!fe__cli_pending_used[i]) {
+            memcpy(fe__cli_pending_path[i], path, n + 1);
+            fe__cli_pending_used[i] = is_dir ? 2 : 1;
+            return i;
+        }
+    return -1;
 }
 
+void fe_cli_pending_drop(int slot)
+{
+    if (slot >= 0 && slot < FE__CLI_PENDING)
+        fe__cli_pending_used[slot] = 0;
+}
+
+void fe_cli_pending_clear(void)
+{
+    for (int i = 0; i < FE__CLI_PENDING; i++)
+        fe__cli_pending_used[i] = 0;
+}
+
+/* Files first, then directories (which are then empty, if they were
+   ours); only async-signal-safe calls. */
+static void fe__cli_on_signal(int sig)
+{
+    for (int pass = 1; pass <= 2; pass++)
+        for (int i = 0; i < FE__CLI_PENDING; i++)
+            if (fe__cli_pending_used[i] == pass) {
+                if (pass == 1)
+                    unlink(fe__cli_pending_path[i]);
+                else
+                    rmdir(fe__cli_pending_path[i]);
+            }
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+void fe_cli_signals_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = fe__cli_on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaddset(&sa.sa_mask, SIGINT);
+    sigaddset(&sa.sa_mask, SIGTERM);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+void fe_cli_signals_hold(int hold)
+{
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigprocmask(hold ? SIG_BLOCK : SIG_UNBLOCK, &set, NULL);
+}
+/* Remove pending files when interrupted ends here */
+/* [[file:../../literate/cli.org::Check standard output at the end][Check standard output at the end]] */
+int fe_cli_finish(const char *command, int rc)
+{
+    int bad = 0, why = 0;
+    if (fflush(stdout) != 0) {
+        bad = 1;
+        why = errno;
+    }
+    if (ferror(stdout))
+        bad = 1;
+#ifndef FE_CLI_KEEP_STDOUT
+    if (fclose(stdout) != 0 && !bad) {
+        bad = 1;
+        why = errno;
+    }
+#endif
+    if (!bad)
+        return rc;
+    fprintf(stderr, "foldest%s%s: cannot write standard output: %s\n",
+            command != NULL ? " " : "", command != NULL ? command : "",
+            why != 0 ? strerror(why) : "write error");
+    return rc == FE_CLI_OK ? FE_CLI_IO : rc;
+}
+/* Check standard output at the end ends here */
+/* [[file:../../literate/cli.org::Start a program without a shell][Start a program without a shell]] */
+int fe_cli_spawn(char *const argv[])
+{
+    posix_spawn_file_actions_t fa;
+    pid_t pid;
+    int status, rc;
+    if (posix_spawn_file_actions_init(&fa) != 0)
+        return -1;
+    rc = posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+    if (rc == 0)
+        rc = posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    if (rc == 0)
+        rc = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0)
+        return -1;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+/* Start a program without a shell ends here */
+/* [[file:../../literate/cli.org::Show progress][Show progress]] */
 void fe_cli_progress(fe_cli_table *t)
 {
     off_t at;
@@ -497,4 +642,4 @@ void fe_cli_json_string(FILE *out, const char *s)
     }
     fputc('"', out);
 }
-/* Write output atomically ends here */
+/* Show progress ends here */

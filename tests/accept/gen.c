@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* gen: one case of the acceptance suite of `foldest discover`, drawn
    independently of foldest.
 

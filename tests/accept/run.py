@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """The acceptance suite of `foldest discover` (make accept).
 
 Every case of tests/accept/gen.c (an independent generator) over SEEDS seeds,

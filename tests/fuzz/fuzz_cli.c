@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the command line's arguments and file handling.  The
    input is a list of arguments, one per line, then a line "--" and the
    content of a file; the argument "@" names that file (written to a

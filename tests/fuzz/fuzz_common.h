@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared by the command-line harnesses: the foldest main (renamed
    fe_cli_main when the CLI is built for fuzzing), running it with its
    standard output captured and its standard error silenced, and a strict

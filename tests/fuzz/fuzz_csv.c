@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the CSV reader.  The input is written to a memory
    file and read back line by line through a buffer whose size the first
    byte chooses (2 to 257 bytes, so long lines and refills are common);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the JSON output.  The input is a recording (CSV
    text); `foldest stats --json`, `foldest calibrate --json` (each model)
    and `foldest discover --json` (the file as recording and simulation) run

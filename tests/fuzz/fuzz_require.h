@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared by the fuzz harnesses: a broken promise aborts, naming the
    condition (libFuzzer saves the input). */
 #ifndef FE_FUZZ_REQUIRE_H

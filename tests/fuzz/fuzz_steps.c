@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: every public step function fed arbitrary bytes as
    observations.  The first byte picks the estimator and its shape; the rest
    is decoded into doubles (raw IEEE bits, small integers, or scaled values,
