@@ -19,6 +19,38 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
 }
 /* Discovery Includes ends here */
 /* [[file:../literate/discover.org::Fold the lagged products][Fold the lagged products]] */
+/* S += x x^T for x the `count` rows at `rows` stacked (M each), S of
+   side E M. */
+static void fe__discover_edge_add(double *S, size_t dim, const double *rows, size_t count,
+                                  double sign)
+{
+    size_t n = FE_DISCOVER_EDGE * dim, c = count * dim;
+    for (size_t i = 0; i < c; i++)
+        for (size_t j = 0; j < c; j++)
+            S[i * n + j] += sign * rows[i] * rows[j];
+}
+
+static size_t fe__discover_min(size_t x, size_t y)
+{
+    return x < y ? x : y;
+}
+
+/* The open recording ends (a break, or the part is merged before one):
+   its last rows, and its first rows if still pending, into the edges. */
+static void fe__discover_edges_close(fe_discover_acc *a)
+{
+    size_t dim = a->m + 1;
+    if (a->lags == 0)
+        return;
+    if (a->nhist > 0)
+        fe__discover_edge_add(a->edge_end, dim, a->hist,
+                              fe__discover_min(a->nhist, FE_DISCOVER_EDGE), 1.0);
+    if (a->shead_pending && a->nshead > 0)
+        fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
+    a->shead_pending = 0;
+    a->nshead = 0;
+}
+
 /* Forget the rows that the next row would pair with: a break or a
    held-out row. */
 static void fe__discover_lags_cut(fe_discover_acc *a)
@@ -31,13 +63,8 @@ static void fe__discover_lags_cut(fe_discover_acc *a)
 static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitted)
 {
     size_t dim = a->m + 1, P = a->lags;
-    if (P == 0)
-        return;
-    if (!fitted) {
-        fe__discover_lags_cut(a);
-        a->head_open = 0;
-        return;
-    }
+    if (P == 0 || !fitted)
+        return;                 /* held-out rows (the last) pair with none */
     for (size_t l = 1; l <= a->nhist; l++) {
         const double *p = a->hist + (l - 1) * dim;
         double *zl = a->zlag + (l - 1) * dim * dim;
@@ -54,6 +81,13 @@ static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitte
     memset(a->hist + a->nhist * dim, 0, (P - a->nhist) * dim * sizeof *a->hist);
     if (a->head_open && a->nhead < P)
         memcpy(a->head + a->nhead++ * dim, z, dim * sizeof *z);
+    if (a->shead_pending) {
+        memcpy(a->shead + a->nshead++ * dim, z, dim * sizeof *z);
+        if (a->nshead == FE_DISCOVER_EDGE) {
+            fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
+            a->shead_pending = 0;
+        }
+    }
 }
 
 /* Fold q rows of block k given by columns (value c of row t at
@@ -102,6 +136,49 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         return;
     for (size_t i = 0; i < P * dim * dim; i++)
         a->zlag[i] += b->zlag[i];
+    {
+        size_t E = FE_DISCOVER_EDGE, ne = 2 * E * dim * E * dim;
+        for (size_t i = 0; i < ne; i++)
+            a->edge_start[i] += b->edge_start[i];  /* edge_end follows edge_start */
+        if (a->n > 0 && !b->first_linked) {
+            fe__discover_edges_close(a);
+            if (b->nhead >= E || !b->head_open) {       /* b's first recording's start is known */
+                fe__discover_edge_add(a->edge_start, dim, b->head,
+                                      fe__discover_min(b->nhead, E), 1.0);
+            } else {                                     /* it goes on past b: pending */
+                memcpy(a->shead, b->head, b->nhead * dim * sizeof *a->shead);
+                a->nshead = b->nhead;
+                a->shead_pending = 1;
+            }
+        } else if (a->n > 0) {
+            if (a->shead_pending) {
+                size_t take = fe__discover_min(E - a->nshead, b->nhead);
+                memcpy(a->shead + a->nshead * dim, b->head, take * dim * sizeof *a->shead);
+                a->nshead += take;
+                if (a->nshead == E || !b->head_open) {
+                    fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
+                    a->shead_pending = 0;
+                    a->nshead = 0;
+                }
+            }
+            if (!b->head_open && b->nhead < E && a->nhist > 0) {
+                double part[FE_DISCOVER_EDGE * (FE_DISCOVER_MAX_COLUMNS + 1)];
+                size_t whole = fe__discover_min(E, b->nhead + a->nhist);
+                for (size_t j = 0; j < b->nhead; j++)       /* newest first */
+                    memcpy(part + j * dim, b->head + (b->nhead - 1 - j) * dim, dim * sizeof *part);
+                fe__discover_edge_add(a->edge_end, dim, part, b->nhead, -1.0);
+                memcpy(part + b->nhead * dim, a->hist, (whole - b->nhead) * dim * sizeof *part);
+                fe__discover_edge_add(a->edge_end, dim, part, whole, 1.0);
+            }
+        }
+        /* From here on the open recording is b's, unless b's first one is
+           the open one (continuing a's, or pending above). */
+        if (a->n == 0 || !b->head_open) {
+            memcpy(a->shead, b->shead, E * dim * sizeof *a->shead);
+            a->nshead = b->nshead;
+            a->shead_pending = b->shead_pending;
+        }
+    }
     if (a->n > 0 && b->first_linked)      /* products across the cut */
         for (size_t j = 0; j < b->nhead; j++)
             for (size_t d = 1; d <= a->nhist && j + d <= P; d++) {
@@ -124,7 +201,10 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         a->nhead += add;
         a->head_open = a->head_open && b->first_linked && b->head_open;
     }
-    /* The newest rows: b's, then a's when b is short and continues a. */
+    /* The newest fitted rows: b's, then a's when b is short and continues
+       a; all a's when b has none (held-out rows only). */
+    if (b->row0 >= a->fit_rows)
+        return;
     {
         size_t keep = 0;
         if (a->n > 0 && b->first_linked && b->head_open && b->nhist < P)
@@ -169,7 +249,10 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->hist = a->zlag + FE_DISCOVER_LAGS * dim * dim;
     a->head = a->hist + FE_DISCOVER_LAGS * dim;
     a->bsum = a->head + FE_DISCOVER_LAGS * dim;
-    a->work = a->bsum + a->blocks * dim;
+    a->edge_start = a->bsum + a->blocks * dim;
+    a->edge_end = a->edge_start + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
+    a->shead = a->edge_end + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
+    a->work = a->shead + FE_DISCOVER_EDGE * dim;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -208,6 +291,8 @@ int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
     a->nhist = 0;
     a->nhead = 0;
     a->head_open = 1;
+    a->nshead = 0;
+    a->shead_pending = 0;
     fe__discover_layout(a, storage);
     return FE_OK;
 }
@@ -337,11 +422,16 @@ void fe_discover_break(fe_discover_acc *a)
     if (a == NULL)
         return;
     a->have_prev = 0;
-    fe__discover_lags_cut(a);
-    if (a->n == 0)
+    if (a->n == 0) {
         a->first_linked = 0;
-    else
+    } else if (a->nhist > 0 || a->shead_pending) {
+        fe__discover_edges_close(a);
+        a->shead_pending = a->lags > 0;
         a->head_open = 0;
+    } else {
+        a->head_open = 0;
+    }
+    fe__discover_lags_cut(a);
 }
 /* Fold a row into its block ends here */
 /* [[file:../literate/discover.org::Merge consecutive accumulations][Merge consecutive accumulations]] */
@@ -914,7 +1004,8 @@ int fe_discover_rebind(fe_discover_acc *a, double *storage)
         return FE_EINVAL;
     if (a->m == 0 || a->m > FE_DISCOVER_MAX_COLUMNS || a->blocks < 2
         || a->blocks > FE_DISCOVER_MAX_BLOCKS || a->base_cols > a->m
-        || a->lags > FE_DISCOVER_LAGS || a->nhist > a->lags || a->nhead > a->lags)
+        || a->lags > FE_DISCOVER_LAGS || a->nhist > a->lags || a->nhead > a->lags
+        || a->nshead > FE_DISCOVER_EDGE)
         return FE_ESIZE;
     fe__discover_layout(a, storage);
     return FE_OK;
@@ -932,6 +1023,8 @@ int fe_discover_reset(fe_discover_acc *a)
     a->nhist = 0;
     a->nhead = 0;
     a->head_open = 1;
+    a->nshead = 0;
+    a->shead_pending = 0;
     return FE_OK;
 }
 
@@ -1454,21 +1547,100 @@ static void fe__lagged_sums(const fe_discover_acc *a, const double *g,
     }
 }
 
-/* The prewhitened Gram matrix gt = c_0 g + sum_l c_l (Z_l + Z_l^T). */
+/* gt -= v v^T. */
+static void fe__drop_row(double *gt, size_t dim, const double *v)
+{
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = 0; j < dim; j++)
+            gt[i * dim + j] -= v[i] * v[j];
+}
+
+/* The transient rows of a recording's start, sum_{i <= t} alpha_i z_{t-i}
+   for t < p, from its first `count` rows (zeros past them), out of gt. */
+static void fe__drop_start(double *gt, size_t dim, const double *alpha, size_t p,
+                           const double *rows, size_t count)
+{
+    double v[FE_DISCOVER_MAX_COLUMNS + 1];
+    for (size_t t = 0; t < p; t++) {
+        for (size_t k = 0; k < dim; k++) {
+            v[k] = 0.0;
+            for (size_t i = 0; i <= t; i++)
+                if (t - i < count)
+                    v[k] += alpha[i] * rows[(t - i) * dim + k];
+        }
+        fe__drop_row(gt, dim, v);
+    }
+}
+
+/* The transient rows past a recording's end, sum_{i >= u} alpha_i
+   z_{n-1+u-i} for u = 1 .. p, from its last `count` rows newest first
+   (rows[j] = z_{n-1-j}), out of gt. */
+static void fe__drop_end(double *gt, size_t dim, const double *alpha, size_t p,
+                         const double *rows, size_t count)
+{
+    double v[FE_DISCOVER_MAX_COLUMNS + 1];
+    for (size_t u = 1; u <= p; u++) {
+        for (size_t k = 0; k < dim; k++) {
+            v[k] = 0.0;
+            for (size_t i = u; i <= p; i++)
+                if (i - u < count)
+                    v[k] += alpha[i] * rows[(i - u) * dim + k];
+        }
+        fe__drop_row(gt, dim, v);
+    }
+}
+
+/* gt -= every recording's 2p transient rows: those of recordings closed
+   in the fold from the stacked sums (block (x, y) of edge_start is
+   sum z_x z_y^T over recordings), the first recording's start from head
+   (when the accumulation begins it), the open one's from shead and hist. */
+static void fe__drop_transients(const fe_discover_acc *a, const double *alpha, size_t p,
+                                double *gt)
+{
+    size_t dim = a->m + 1, ne = FE_DISCOVER_EDGE * dim;
+    if (p == 0)
+        return;
+    for (size_t t = 0; t < p; t++)
+        for (size_t i = 0; i <= t; i++)
+            for (size_t j = 0; j <= t; j++) {
+                const double *S = a->edge_start + (t - i) * dim * ne + (t - j) * dim;
+                for (size_t x = 0; x < dim; x++)
+                    for (size_t y = 0; y < dim; y++)
+                        gt[x * dim + y] -= alpha[i] * alpha[j] * S[x * ne + y];
+            }
+    for (size_t u = 1; u <= p; u++)
+        for (size_t i = u; i <= p; i++)
+            for (size_t j = u; j <= p; j++) {
+                const double *S = a->edge_end + (i - u) * dim * ne + (j - u) * dim;
+                for (size_t x = 0; x < dim; x++)
+                    for (size_t y = 0; y < dim; y++)
+                        gt[x * dim + y] -= alpha[i] * alpha[j] * S[x * ne + y];
+            }
+    if (a->nhead > 0 && (a->row0 == 0 || !a->first_linked))
+        fe__drop_start(gt, dim, alpha, p, a->head, fe__discover_min(a->nhead, p));
+    if (a->shead_pending && a->nshead > 0)
+        fe__drop_start(gt, dim, alpha, p, a->shead, a->nshead);
+    if (a->nhist > 0)
+        fe__drop_end(gt, dim, alpha, p, a->hist, fe__discover_min(a->nhist, p));
+}
+
+/* The prewhitened Gram matrix gt = c_0 g + sum_l c_l (Z_l + Z_l^T), less
+   the 2p transient rows at every recording's two ends (see the text). */
 static void fe__whiten_gram(const fe_discover_acc *a, const double *g,
                             const fe_discover_noise *nz, double *gt)
 {
-    size_t dim = a->m + 1;
+    size_t dim = a->m + 1, p = nz->order;
     double alpha[FE_DISCOVER_LAGS + 1], c[FE_DISCOVER_LAGS + 1];
     fe__whitening(nz, alpha, c);
     for (size_t i = 0; i < dim * dim; i++)
         gt[i] = c[0] * g[i];
-    for (size_t l = 1; l <= nz->order; l++) {
+    for (size_t l = 1; l <= p; l++) {
         const double *z = a->zlag + (l - 1) * dim * dim;
         for (size_t i = 0; i < dim; i++)
             for (size_t j = 0; j < dim; j++)
                 gt[i * dim + j] += c[l] * (z[i * dim + j] + z[j * dim + i]);
     }
+    fe__drop_transients(a, alpha, p, gt);
 }
 
 /* The whitened series' autocovariances (unnormalised) at lags h = 0 ..
@@ -1742,7 +1914,7 @@ int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
     int rc;
     if (a == NULL || fit == NULL || noise == NULL
         || (ncols > 0 && (cols == NULL || coef == NULL)) || ncols > a->m
-        || a->lags == 0 || max_order >= a->lags)
+        || a->lags == 0 || max_order >= a->lags || max_order > FE_DISCOVER_EDGE)
         return FE_EINVAL;
     for (size_t i = 0; i < ncols; i++)
         if (cols[i] >= a->m)
@@ -1974,7 +2146,7 @@ int fe_discover_select(const fe_discover_acc *a,
         o.max_steps = FE_DISCOVER_MAX_STEPS;
     /* The noise model needs the lagged products: a screen has none. */
     ar = o.noise == FE_DISCOVER_NOISE_AR && a->lags > 0;
-    if (ar && o.max_order >= a->lags)
+    if (ar && (o.max_order >= a->lags || o.max_order > FE_DISCOVER_EDGE))
         return FE_EINVAL;
     rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
     if (rc != FE_OK)

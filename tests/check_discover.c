@@ -884,10 +884,11 @@ START_TEST(gls_matches_prewhitened_least_squares)
     ck_assert_double_eq_tol(nz.phi[0], 1.2, 0.1);
     {
         /* Whitened rows of each recording [0, NBREAK) and [NBREAK, NFIT),
-           with p rows of transient past each end. */
+           without the first p rows of each (conditional GLS). */
         size_t seg[2][2] = {{0, NBREAK}, {NBREAK, NFIT}}, p = nz.order;
+        size_t from[2] = {p, NBREAK + p}, to[2] = {NBREAK, NFIT};
         for (int g = 0; g < 2; g++)
-            for (size_t t = seg[g][0]; t < seg[g][1] + p; t++) {
+            for (size_t t = from[g]; t < to[g]; t++) {
                 long double x[3] = {0}, y = 0;
                 for (size_t i = 0; i <= p; i++) {
                     double al = i == 0 ? 1.0 : -nz.phi[i - 1];
@@ -929,13 +930,12 @@ START_TEST(gls_matches_prewhitened_least_squares)
             {
                 long double yy = 0;
                 /* RSS = y'y - b'X'y, with y'y accumulated again. */
-                size_t segs[2][2] = {{0, NBREAK}, {NBREAK, NFIT}};
                 for (int g = 0; g < 2; g++)
-                    for (size_t t = segs[g][0]; t < segs[g][1] + p; t++) {
+                    for (size_t t = from[g]; t < to[g]; t++) {
                         long double y = 0;
                         for (size_t i = 0; i <= p; i++) {
                             double al = i == 0 ? 1.0 : -nz.phi[i - 1];
-                            if (t < segs[g][0] + i || t - i >= segs[g][1])
+                            if (t < seg[g][0] + i || t - i >= seg[g][1])
                                 continue;
                             y += al * nr[t - i];
                         }
@@ -961,6 +961,62 @@ START_TEST(gls_matches_prewhitened_least_squares)
     ck_assert_int_eq(fe_discover_screen_init(&a, NM, 2, NK, NFIT, 0, st, nst), FE_OK);
     ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, 4, coef, se, &fit, &nz, w, nw), FE_EINVAL);
     free(st);
+    free(w);
+}
+END_TEST
+
+
+START_TEST(merged_parts_fit_as_the_whole_near_breaks)
+{
+    /* Parts cut anywhere, also within FE_DISCOVER_EDGE rows of the break
+       and of each other: the merged accumulation gives the same GLS fit
+       (its edge rows are the whole fold's). */
+    size_t nst = fe_discover_acc_doubles(NM, NK), nw = fe_discover_workspace_doubles(NM, NK);
+    double *sw = malloc(nst * sizeof *sw), *sm = malloc(nst * sizeof *sm),
+           *sp = malloc(nst * sizeof *sp), *w = malloc(nw * sizeof *w);
+    static const size_t cuts[][3] = {{700, 1103, 0}, {1098, 1101, 0}, {1100, 1102, 0},
+                                     {1099, 1100, 1101}, {2, 1097, 1104}, {1101, 1103, 2399}};
+    size_t cols[3] = {0, 1, 2};
+    double cw[3], cm[3], sew[3], sem[3];
+    fe_discover_fit fw, fm;
+    fe_discover_noise nw_, nm;
+    fe_discover_acc whole, merged, part;
+    noise_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&whole, NM, NK, NFIT, 0, sw, nst), FE_OK);
+    for (size_t t = 0; t < NN; t++) {
+        if (t == NBREAK)
+            fe_discover_break(&whole);
+        ck_assert_int_eq(fe_discover_add(&whole, nphi[t], nr[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_noise(&whole, cols, 3, 4, cw, sew, &fw, &nw_, w, nw), FE_OK);
+    ck_assert_uint_ge(nw_.order, 2);
+    for (size_t c = 0; c < sizeof cuts / sizeof cuts[0]; c++) {
+        size_t bounds[5] = {0}, nb = 1;
+        for (int k = 0; k < 3 && cuts[c][k] > 0; k++)
+            bounds[nb++] = cuts[c][k];
+        bounds[nb] = NN;
+        ck_assert_int_eq(fe_discover_acc_init(&merged, NM, NK, NFIT, 0, sm, nst), FE_OK);
+        for (size_t k = 0; k < nb; k++) {
+            ck_assert_int_eq(fe_discover_acc_init(&part, NM, NK, NFIT, bounds[k], sp, nst), FE_OK);
+            for (size_t t = bounds[k]; t < bounds[k + 1]; t++) {
+                if (t == NBREAK)
+                    fe_discover_break(&part);
+                ck_assert_int_eq(fe_discover_add(&part, nphi[t], nr[t]), FE_OK);
+            }
+            ck_assert_int_eq(fe_discover_merge(&merged, &part), FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_fit_noise(&merged, cols, 3, 4, cm, sem, &fm, &nm, w, nw),
+                         FE_OK);
+        ck_assert_uint_eq(nm.order, nw_.order);
+        for (int k = 0; k < 3; k++) {
+            FE_ASSERT_REL(cm[k], cw[k], 1e-9);
+            FE_ASSERT_REL(sem[k], sew[k], 1e-9);
+        }
+        FE_ASSERT_REL(fm.bic, fw.bic, 1e-12);
+    }
+    free(sw);
+    free(sm);
+    free(sp);
     free(w);
 }
 END_TEST
@@ -1044,6 +1100,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
+    tcase_add_test(t, merged_parts_fit_as_the_whole_near_breaks);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

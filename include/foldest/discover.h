@@ -19,9 +19,11 @@ enum {
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
-    FE_DISCOVER_LAGS = 16           /* lagged products Z_1 .. Z_P kept by a
-                                       full accumulation: P, the highest
-                                       order of the noise model */
+    FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P kept by a
+                                       full accumulation */
+    FE_DISCOVER_EDGE = 4            /* rows kept at each end of every
+                                       recording: the highest order of the
+                                       noise model */
 };
 
 /* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
@@ -36,7 +38,9 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
 #define FE_DISCOVER_ACC_VALUES(m, blocks)                                   \
     (((blocks) + 2) * ((m) + 1) * ((m) + 1) + 2 * ((m) + 1) + (blocks) + 1  \
      + FE_DISCOVER_LAGS * (((m) + 1) * ((m) + 1) + 2 * ((m) + 1))           \
-     + (blocks) * ((m) + 1))
+     + (blocks) * ((m) + 1)                                                 \
+     + 2 * (FE_DISCOVER_EDGE * ((m) + 1)) * (FE_DISCOVER_EDGE * ((m) + 1))    \
+     + FE_DISCOVER_EDGE * ((m) + 1))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
      + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
@@ -75,6 +79,15 @@ typedef struct fe_discover_acc {
                                    first (rows past nhist are zero) */
     double *head;               /* P x M: the part's first rows */
     double *bsum;               /* K x M: each fitted block's sum of rows */
+    size_t nshead;              /* rows in shead */
+    int shead_pending;          /* the open recording began after a break
+                                   in this part: its first rows go to
+                                   edge_start once known */
+    double *edge_start;         /* (E M) x (E M): sum over recordings of
+                                   x x^T, x = the first E = FE_DISCOVER_EDGE
+                                   fitted rows stacked (zeros past the end) */
+    double *edge_end;           /* the same for the last E, newest first */
+    double *shead;              /* E x M: the open recording's first rows */
     double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
@@ -215,7 +228,7 @@ typedef struct fe_discover_options {
     size_t nbase;
     int noise;                  /* FE_DISCOVER_NOISE_AR (default) or _BATCH */
     size_t max_order;           /* highest AR order tried: 4, at most
-                                   FE_DISCOVER_LAGS - 1 */
+                                   FE_DISCOVER_EDGE */
 } fe_discover_options;
 
 /* fe_discover_default_options: alpha 0.05, 8 steps, no base terms, the AR
@@ -342,8 +355,8 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
                             size_t work_doubles);
 
 /* fe_discover_fit_noise: the same fit by feasible generalised least
-   squares under an AR noise model of order at most max_order (<
-   FE_DISCOVER_LAGS), re-estimated from the fit's own residual:
+   squares under an AR noise model of order at most max_order (<=
+   FE_DISCOVER_EDGE), re-estimated from the fit's own residual:
    coefficients, their standard errors (stderr_ may be NULL), the summary
    and the noise model (with the portmanteau test of the whitened
    residual).  A full accumulation only (FE_EINVAL for a screen); other
