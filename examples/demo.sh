@@ -5,7 +5,7 @@
 #      0.3 noise standard deviations per sample, coloured noise), generated
 #      here, and a negative control with nothing hidden;
 #   2. the phone free-fall recordings (../shared/data/freefall-drag, or
-#      $FOLDEST_DATA), against a vacuum free-fall simulation of each drop;
+#      $FOLDEST_DATA), each drop against a vacuum free-fall simulation of it;
 #   3. magnetometer recordings against the best sphere through them;
 # each with a report (Markdown and plots) under $OUT.
 set -e
@@ -27,14 +27,25 @@ say "1b. The negative control: the same rig with nothing hidden"
   --role position=position --role velocity=velocity --role input=input \
   --base bias,gain --holdout 0.3 | tail -n 4
 
-say "2. Real recordings: a phone in free fall against a vacuum simulation"
+say "2. Real recordings: a phone in free fall against a vacuum simulation, drop by drop"
 DATA=${FOLDEST_DATA:-../shared/data}
 if [ -f "$DATA/freefall-drag/csv/fall_1.csv" ]; then
   FOLDEST_OUT=$OUT "$B/examples/freefall_sim" "$DATA/freefall-drag/csv" "$OUT/freefall_sim" > "$OUT/freefall_sim.txt"
-  head -n 12 "$OUT/freefall_sim.txt"
-  args=$(tail -n 1 "$OUT/freefall_sim.txt" | sed 's/^foldest discover//')
+  head -n 3 "$OUT/freefall_sim.txt"
+  echo "..."
+  common="--channel Absolute --time Time --role velocity=velocity --base bias --holdout 0"
+  for k in 1 2 3 4 5 6 7 8 9 10 11 12; do
+    sim="$OUT/freefall_sim/fall_${k}_sim.csv"
+    [ -f "$sim" ] || continue
+    # shellcheck disable=SC2086
+    found=$("$FOLDEST" discover --real "$DATA/freefall-drag/csv/fall_$k.csv" --sim "$sim" $common |
+            sed -n 's/^  [0-9]*\. \([a-z_]*\) .*coefficient \([^ ]*\) +\/- \([^ ]*\) .*/\1 \2 +\/- \3/p' | tr '\n' ';')
+    printf '  fall_%-2s %s\n' "$k" "${found:-nothing named}"
+  done
+  echo "the first drop in full:"
   # shellcheck disable=SC2086
-  "$FOLDEST" discover $args --report "$OUT/freefall"
+  "$FOLDEST" discover --real "$DATA/freefall-drag/csv/fall_1.csv" --sim "$OUT/freefall_sim/fall_1_sim.csv" \
+    $common --report "$OUT/freefall"
 else
   echo "no recordings at $DATA (set FOLDEST_DATA): skipped"
 fi

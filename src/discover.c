@@ -36,17 +36,16 @@ static size_t fe__discover_min(size_t x, size_t y)
 }
 
 /* The open recording ends (a break, or the part is merged before one):
-   its last rows, and its first rows if still pending, into the edges. */
+   its last rows into the edges, if it has at least E fitted rows (a
+   shorter one keeps its transient rows: its start and end would overlap).
+   Its first rows went in when the E-th arrived. */
 static void fe__discover_edges_close(fe_discover_acc *a)
 {
     size_t dim = a->m + 1;
     if (a->lags == 0)
         return;
-    if (a->nhist > 0)
-        fe__discover_edge_add(a->edge_end, dim, a->hist,
-                              fe__discover_min(a->nhist, FE_DISCOVER_EDGE), 1.0);
-    if (a->shead_pending && a->nshead > 0)
-        fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
+    if (a->nhist >= FE_DISCOVER_EDGE)
+        fe__discover_edge_add(a->edge_end, dim, a->hist, FE_DISCOVER_EDGE, 1.0);
     a->shead_pending = 0;
     a->nshead = 0;
 }
@@ -142,10 +141,9 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
             a->edge_start[i] += b->edge_start[i];  /* edge_end follows edge_start */
         if (a->n > 0 && !b->first_linked) {
             fe__discover_edges_close(a);
-            if (b->nhead >= E || !b->head_open) {       /* b's first recording's start is known */
-                fe__discover_edge_add(a->edge_start, dim, b->head,
-                                      fe__discover_min(b->nhead, E), 1.0);
-            } else {                                     /* it goes on past b: pending */
+            if (b->nhead >= E) {                         /* b's first recording's start */
+                fe__discover_edge_add(a->edge_start, dim, b->head, E, 1.0);
+            } else if (b->head_open) {                   /* it goes on past b: pending */
                 memcpy(a->shead, b->head, b->nhead * dim * sizeof *a->shead);
                 a->nshead = b->nhead;
                 a->shead_pending = 1;
@@ -155,20 +153,22 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
                 size_t take = fe__discover_min(E - a->nshead, b->nhead);
                 memcpy(a->shead + a->nshead * dim, b->head, take * dim * sizeof *a->shead);
                 a->nshead += take;
+                if (a->nshead == E)
+                    fe__discover_edge_add(a->edge_start, dim, a->shead, E, 1.0);
                 if (a->nshead == E || !b->head_open) {
-                    fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
                     a->shead_pending = 0;
                     a->nshead = 0;
                 }
             }
-            if (!b->head_open && b->nhead < E && a->nhist > 0) {
+            /* a's recording ends inside b after fewer than E of b's rows: b
+               did not close it (too short for b); it is closed here, if long
+               enough, with a's last rows. */
+            if (!b->head_open && b->nhead < E && b->nhead + a->nhist >= E) {
                 double part[FE_DISCOVER_EDGE * (FE_DISCOVER_MAX_COLUMNS + 1)];
-                size_t whole = fe__discover_min(E, b->nhead + a->nhist);
                 for (size_t j = 0; j < b->nhead; j++)       /* newest first */
                     memcpy(part + j * dim, b->head + (b->nhead - 1 - j) * dim, dim * sizeof *part);
-                fe__discover_edge_add(a->edge_end, dim, part, b->nhead, -1.0);
-                memcpy(part + b->nhead * dim, a->hist, (whole - b->nhead) * dim * sizeof *part);
-                fe__discover_edge_add(a->edge_end, dim, part, whole, 1.0);
+                memcpy(part + b->nhead * dim, a->hist, (E - b->nhead) * dim * sizeof *part);
+                fe__discover_edge_add(a->edge_end, dim, part, E, 1.0);
             }
         }
         /* From here on the open recording is b's, unless b's first one is
@@ -1616,12 +1616,10 @@ static void fe__drop_transients(const fe_discover_acc *a, const double *alpha, s
                     for (size_t y = 0; y < dim; y++)
                         gt[x * dim + y] -= alpha[i] * alpha[j] * S[x * ne + y];
             }
-    if (a->nhead > 0 && (a->row0 == 0 || !a->first_linked))
-        fe__drop_start(gt, dim, alpha, p, a->head, fe__discover_min(a->nhead, p));
-    if (a->shead_pending && a->nshead > 0)
-        fe__drop_start(gt, dim, alpha, p, a->shead, a->nshead);
-    if (a->nhist > 0)
-        fe__drop_end(gt, dim, alpha, p, a->hist, fe__discover_min(a->nhist, p));
+    if (a->nhead >= FE_DISCOVER_EDGE && (a->row0 == 0 || !a->first_linked))
+        fe__drop_start(gt, dim, alpha, p, a->head, p);
+    if (a->nhist >= FE_DISCOVER_EDGE)
+        fe__drop_end(gt, dim, alpha, p, a->hist, p);
 }
 
 /* The prewhitened Gram matrix gt = c_0 g + sum_l c_l (Z_l + Z_l^T), less
@@ -1816,6 +1814,9 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
             break;
         }
         fe__whiten_gram(a, w->g, nz, w->gt);
+        for (size_t i = 0; i < dim * dim; i++)
+            if (!isfinite(w->gt[i]))
+                return FE_ENONFINITE;   /* sums too large to whiten */
         rc = fe__factor(&mo, w->gt, dim);
         if (rc != FE_OK)
             return rc;
@@ -1843,7 +1844,8 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     } else {
         fit->heldout_rms = NAN;
     }
-    /* Whiteness of the whitened residual. */
+    /* Whiteness of the whitened residual, from the zero-padded lagged
+       sums (see the text for what that costs under red noise). */
     nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
     for (size_t h = 1; h <= nz->lags_tested && w->acov_e[0] > 0.0; h++) {
         double rho = w->acov_e[h] / w->acov_e[0];

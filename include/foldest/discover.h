@@ -336,8 +336,10 @@ size_t fe_discover_workspace_doubles(size_t m, size_t blocks);
    all from the accumulation.  From a screen (fe_discover_screen_init) it
    ranks only: max_steps must be 0 and the base groups must lie in the
    screen's base columns.  Errors: FE_EINVAL (also for a screen asked for
-   more); FE_ETOOFEW (a block is empty); FE_ESINGULAR (the base terms are
-   collinear); FE_ESIZE (workspace too small). */
+   more, or max_order out of range); FE_ETOOFEW (a block is empty);
+   FE_ESINGULAR (the base terms are collinear, also in the metric of the
+   noise model); FE_ENONFINITE (sums too large to whiten); FE_ESIZE
+   (workspace too small). */
 int fe_discover_select(const fe_discover_acc *a,
                        const fe_discover_group *groups, size_t ngroups,
                        const fe_discover_options *options,

@@ -765,8 +765,10 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     fprintf(f, "baseline (simulation");
     for (size_t i = 0; i < o->nbase; i++)
         fprintf(f, " + %s", o->c->terms[o->base[i]].name);
-    fprintf(f, "): RMS %.5g, held-out RMS %.5g, lag-1 autocorrelation %.2f\n",
-            r->baseline.rms, r->baseline.heldout_rms, r->baseline.lag1);
+    fprintf(f, "): RMS %.5g", r->baseline.rms);
+    if (o->heldout > 0)
+        fprintf(f, ", held-out RMS %.5g", r->baseline.heldout_rms);
+    fprintf(f, ", lag-1 autocorrelation %.2f\n", r->baseline.lag1);
     fprintf(f, "\nwhere they differ:\n");
     if (o->nlocated == 0)
         fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
