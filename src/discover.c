@@ -35,6 +35,15 @@ static size_t fe__discover_min(size_t x, size_t y)
     return x < y ? x : y;
 }
 
+/* No first rows are pending (the stored ones zeroed: the accumulation's
+   bytes do not depend on the path that led to it). */
+static void fe__discover_shead_clear(fe_discover_acc *a)
+{
+    memset(a->shead, 0, a->nshead * (a->m + 1) * sizeof *a->shead);
+    a->nshead = 0;
+    a->shead_pending = 0;
+}
+
 /* The open recording ends (a break, or the part is merged before one):
    its last rows into the edges, if it has at least E fitted rows (a
    shorter one keeps its transient rows: its start and end would overlap).
@@ -46,8 +55,7 @@ static void fe__discover_edges_close(fe_discover_acc *a)
         return;
     if (a->nhist >= FE_DISCOVER_EDGE)
         fe__discover_edge_add(a->edge_end, dim, a->hist, FE_DISCOVER_EDGE, 1.0);
-    a->shead_pending = 0;
-    a->nshead = 0;
+    fe__discover_shead_clear(a);
 }
 
 /* Forget the rows that the next row would pair with: a break or a
@@ -84,9 +92,41 @@ static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitte
         memcpy(a->shead + a->nshead++ * dim, z, dim * sizeof *z);
         if (a->nshead == FE_DISCOVER_EDGE) {
             fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
-            a->shead_pending = 0;
+            fe__discover_shead_clear(a);
         }
     }
+}
+
+/* Fold q fitted rows at once, with level-3 BLAS: the panel is laid out
+   after the last P rows (oldest first, zeros where there are none), so
+   that Z_l += X^T X_{-l} is one matrix product per lag; then the rows
+   kept (hist, head, shead) are taken from the same buffer. */
+static void fe__discover_lags_panel(fe_discover_acc *a, const double *const *col,
+                                    size_t ts, size_t q)
+{
+    size_t dim = a->m + 1, P = a->lags, E = FE_DISCOVER_EDGE;
+    double *buf = a->work + dim * dim + (FE_DISCOVER_PANEL_ROWS + 1) * dim;
+    for (size_t j = 0; j < P; j++)
+        memcpy(buf + (P - 1 - j) * dim, a->hist + j * dim, dim * sizeof *buf);
+    for (size_t t = 0; t < q; t++)
+        for (size_t c = 0; c < dim; c++)
+            buf[(P + t) * dim + c] = col[c][t * ts];
+    for (size_t l = 1; l <= P; l++)
+        cblas_dgemm(CblasRowMajor, CblasTrans, CblasNoTrans, (int)dim, (int)dim, (int)q, 1.0,
+                    buf + P * dim, (int)dim, buf + (P - l) * dim, (int)dim, 1.0,
+                    a->zlag + (l - 1) * dim * dim, (int)dim);
+    for (size_t t = 0; t < q && a->head_open && a->nhead < P; t++)
+        memcpy(a->head + a->nhead++ * dim, buf + (P + t) * dim, dim * sizeof *buf);
+    for (size_t t = 0; t < q && a->shead_pending; t++) {
+        memcpy(a->shead + a->nshead++ * dim, buf + (P + t) * dim, dim * sizeof *buf);
+        if (a->nshead == E) {
+            fe__discover_edge_add(a->edge_start, dim, a->shead, E, 1.0);
+            fe__discover_shead_clear(a);
+        }
+    }
+    for (size_t j = 0; j < P; j++)
+        memcpy(a->hist + j * dim, buf + (P + q - 1 - j) * dim, dim * sizeof *buf);
+    a->nhist = a->nhist + q < P ? a->nhist + q : P;
 }
 
 /* Fold q rows of block k given by columns (value c of row t at
@@ -102,8 +142,12 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
             s += col[c][t * ts];
         a->bsum[k * (a->m + 1) + c] += s;
     }
-    if (a->lags == 0)
+    if (a->lags == 0 || !fitted)
         return;
+    if (q >= 8) {
+        fe__discover_lags_panel(a, col, ts, q);
+        return;
+    }
     for (size_t t = 0; t < q; t++) {
         for (size_t c = 0; c <= a->m; c++)
             z[c] = col[c][t * ts];
@@ -155,10 +199,8 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
                 a->nshead += take;
                 if (a->nshead == E)
                     fe__discover_edge_add(a->edge_start, dim, a->shead, E, 1.0);
-                if (a->nshead == E || !b->head_open) {
-                    a->shead_pending = 0;
-                    a->nshead = 0;
-                }
+                if (a->nshead == E || !b->head_open)
+                    fe__discover_shead_clear(a);
             }
             /* a's recording ends inside b after fewer than E of b's rows: b
                did not close it (too short for b); it is closed here, if long
@@ -201,10 +243,8 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         a->nhead += add;
         a->head_open = a->head_open && b->first_linked && b->head_open;
     }
-    /* The newest fitted rows: b's, then a's when b is short and continues
-       a; all a's when b has none (held-out rows only). */
-    if (b->row0 >= a->fit_rows)
-        return;
+    /* The newest fitted rows: b's, then a's when b has fewer than P and
+       continues a (all a's when b has none: held-out rows only). */
     {
         size_t keep = 0;
         if (a->n > 0 && b->first_linked && b->head_open && b->nhist < P)
@@ -287,13 +327,23 @@ int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
     a->n = 0;
     a->have_prev = 0;
     a->first_linked = 1;
-    a->lags = base_cols == m ? FE_DISCOVER_LAGS : 0;
+    a->lags = base_cols == m ? FE_DISCOVER_DEFAULT_LAGS : 0;
     a->nhist = 0;
     a->nhead = 0;
     a->head_open = 1;
     a->nshead = 0;
     a->shead_pending = 0;
     fe__discover_layout(a, storage);
+    return FE_OK;
+}
+
+int fe_discover_set_lags(fe_discover_acc *a, size_t lags)
+{
+    if (a == NULL || a->n > 0 || (lags > 0 && a->base_cols < a->m))
+        return FE_EINVAL;
+    if (lags > FE_DISCOVER_LAGS)
+        return FE_ESIZE;
+    a->lags = lags;
     return FE_OK;
 }
 
@@ -441,7 +491,7 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     if (a == NULL || b == NULL)
         return FE_EINVAL;
     if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
-        || a->base_cols != b->base_cols)
+        || a->base_cols != b->base_cols || a->lags != b->lags)
         return FE_EMISMATCH;
     if (b->n == 0) {            /* the identity, carrying b's break if any */
         if (!b->first_linked)
@@ -1028,35 +1078,55 @@ int fe_discover_reset(fe_discover_acc *a)
     return FE_OK;
 }
 
+/* Whether fe_discover_add would accept the row right after a break
+   (then no lag product is formed: only the block's sums can overflow). */
+static int fe__discover_ok_after_break(const fe_discover_acc *a, const double *phi, double r)
+{
+    size_t dim = a->m + 1, k;
+    double z[FE_DISCOVER_MAX_COLUMNS + 1];
+    const double *g;
+    for (size_t i = 0; i < a->m; i++)
+        z[i] = phi[i];
+    z[a->m] = r;
+    for (size_t i = 0; i < dim; i++)
+        if (!isfinite(z[i]))
+            return FE_ENONFINITE;
+    if (!fe__discover_large(z, dim))
+        return FE_OK;
+    k = fe__discover_block(a, a->row0 + a->n);
+    g = a->gram + k * dim * dim;
+    for (size_t i = 0; i < dim; i++)
+        for (size_t j = i; j < dim; j++)
+            if (fe__discover_kept(a, i, j) && !isfinite(g[i * dim + j] + z[i] * z[j]))
+                return FE_ENONFINITE;
+    return FE_OK;
+}
+
 int fe_discover_add_row(fe_discover_acc *a, const fe_discover_row *row)
 {
     uint64_t row0;
-    size_t nhist;
-    int have_prev, first_linked, head_open, rc;
-    double hist[FE_DISCOVER_LAGS * (FE_DISCOVER_MAX_COLUMNS + 1)];
-    if (a == NULL || row == NULL || row->index == FE_DISCOVER_ROW_UNKNOWN)
+    int rc;
+    if (a == NULL || row == NULL || row->index == FE_DISCOVER_ROW_UNKNOWN || row->phi == NULL)
         return FE_EINVAL;
     row0 = a->row0;
-    have_prev = a->have_prev;
-    first_linked = a->first_linked;
-    nhist = a->nhist;
-    head_open = a->head_open;
-    memcpy(hist, a->hist, nhist * (a->m + 1) * sizeof *hist);
     if (a->n == 0 && a->row0 == FE_DISCOVER_ROW_UNKNOWN)
         a->row0 = row->index;
     else if (row->index != a->row0 + a->n)
         return FE_EINVAL;
-    if (row->starts_recording)
+    /* A break closes the recording's edges, which cannot be undone bit for
+       bit: the row is checked first, and the break made only for a row that
+       will be folded. */
+    if (row->starts_recording) {
+        rc = fe__discover_ok_after_break(a, row->phi, row->r);
+        if (rc != FE_OK) {
+            a->row0 = row0;
+            return rc;
+        }
         fe_discover_break(a);
-    rc = fe_discover_add(a, row->phi, row->r);
-    if (rc != FE_OK) {          /* undo the place and the break */
-        a->row0 = row0;
-        a->have_prev = have_prev;
-        a->first_linked = first_linked;
-        a->nhist = nhist;
-        memcpy(a->hist, hist, nhist * (a->m + 1) * sizeof *hist);
-        a->head_open = head_open;
     }
+    rc = fe_discover_add(a, row->phi, row->r);
+    if (rc != FE_OK)            /* without a break: add changed nothing */
+        a->row0 = row0;
     return rc;
 }
 
@@ -1066,7 +1136,8 @@ int fe_discover_copy(fe_discover_acc *dst, const fe_discover_acc *src)
     if (dst == NULL || src == NULL || dst->gram == NULL || src->gram == NULL)
         return FE_EINVAL;
     if (dst->m != src->m || dst->blocks != src->blocks
-        || dst->fit_rows != src->fit_rows || dst->base_cols != src->base_cols)
+        || dst->fit_rows != src->fit_rows || dst->base_cols != src->base_cols
+        || dst->lags != src->lags)
         return FE_EMISMATCH;
     if (dst == src)
         return FE_OK;
@@ -2148,8 +2219,10 @@ int fe_discover_select(const fe_discover_acc *a,
         o.max_steps = FE_DISCOVER_MAX_STEPS;
     /* The noise model needs the lagged products: a screen has none. */
     ar = o.noise == FE_DISCOVER_NOISE_AR && a->lags > 0;
-    if (ar && (o.max_order >= a->lags || o.max_order > FE_DISCOVER_EDGE))
+    if (ar && o.max_order > FE_DISCOVER_EDGE)
         return FE_EINVAL;
+    if (ar && o.max_order >= a->lags)
+        o.max_order = a->lags - 1;      /* the portmanteau needs a lag more */
     rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
     if (rc != FE_OK)
         return rc;

@@ -812,7 +812,7 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
             }
             ck_assert_int_eq(fe_discover_merge(&merged, &part), FE_OK);
         }
-        for (size_t l = 1; l <= FE_DISCOVER_LAGS; l++)
+        for (size_t l = 1; l <= FE_DISCOVER_DEFAULT_LAGS; l++)
             for (size_t i = 0; i < dim; i++)
                 for (size_t j = 0; j < dim; j++) {
                     double want = brute_lag(l, i, j);
@@ -1021,6 +1021,59 @@ START_TEST(merged_parts_fit_as_the_whole_near_breaks)
 }
 END_TEST
 
+
+START_TEST(lags_are_an_option_of_an_empty_accumulation)
+{
+    size_t nst = fe_discover_acc_doubles(NM, NK), nw = fe_discover_workspace_doubles(NM, NK);
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2),
+           *w = malloc(nw * sizeof *w);
+    fe_discover_acc a, b;
+    fe_discover_group g[4] = {{"one", 0, 1}, {"ramp", 1, 1}, {"sine", 2, 1}, {"white", 3, 1}};
+    size_t base[1] = {0};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    noise_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, s1, nst), FE_OK);
+    ck_assert_uint_eq(a.lags, FE_DISCOVER_DEFAULT_LAGS);
+    ck_assert_int_eq(fe_discover_set_lags(&a, FE_DISCOVER_LAGS + 1), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_set_lags(NULL, 2), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_set_lags(&a, 2), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&a, nphi[0], nr[0]), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&a, 3), FE_EINVAL);      /* not empty */
+    for (size_t t = 1; t < NN; t++)
+        ck_assert_int_eq(fe_discover_add(&a, nphi[t], nr[t]), FE_OK);
+    /* Parts with other lags do not merge. */
+    ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, NN, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&b, nphi[0], nr[0]), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_EMISMATCH);
+    /* Two lags: the AR order is at most 1 (a lag is left for the test). */
+    o.base = base;
+    o.nbase = 1;
+    ck_assert_int_eq(fe_discover_select(&a, g, 4, &o, r, w, nw), FE_OK);
+    ck_assert_int_eq(r->noise.kind, FE_DISCOVER_NOISE_AR);
+    ck_assert_uint_le(r->path[0].noise.order, 1);
+    ck_assert_uint_eq(r->path[0].noise.lags_tested, 2 - r->path[0].noise.order);
+    /* No lags: batch means, and the result says so. */
+    ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&b, 0), FE_OK);
+    for (size_t t = 0; t < NN; t++)
+        ck_assert_int_eq(fe_discover_add(&b, nphi[t], nr[t]), FE_OK);
+    ck_assert_int_eq(fe_discover_select(&b, g, 4, &o, r, w, nw), FE_OK);
+    ck_assert_int_eq(r->noise.kind, FE_DISCOVER_NOISE_BATCH);
+    /* A screen keeps none. */
+    ck_assert_int_eq(fe_discover_screen_init(&b, NM, 2, NK, NFIT, 0, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&b, 1), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_set_lags(&b, 0), FE_OK);
+    /* Orders above FE_DISCOVER_EDGE are refused. */
+    o.max_order = FE_DISCOVER_EDGE + 1;
+    ck_assert_int_eq(fe_discover_select(&a, g, 4, &o, r, w, nw), FE_EINVAL);
+    free(s1);
+    free(s2);
+    free(w);
+    free(r);
+}
+END_TEST
+
 /* The acceptance suite of the discovery issue. */
 START_TEST(concealed_effects_are_found_and_nulls_are_not)
 {
@@ -1101,6 +1154,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
     tcase_add_test(t, merged_parts_fit_as_the_whole_near_breaks);
+    tcase_add_test(t, lags_are_an_option_of_an_empty_accumulation);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

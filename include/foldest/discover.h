@@ -19,8 +19,9 @@ enum {
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
-    FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P kept by a
-                                       full accumulation */
+    FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P a full
+                                       accumulation can keep */
+    FE_DISCOVER_DEFAULT_LAGS = 8,   /* ... and keeps unless told otherwise */
     FE_DISCOVER_EDGE = 4            /* rows kept at each end of every
                                        recording: the highest order of the
                                        noise model */
@@ -43,7 +44,8 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
      + FE_DISCOVER_EDGE * ((m) + 1))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
-     + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1))
+     + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1)                             \
+     + (FE_DISCOVER_LAGS + FE_DISCOVER_PANEL_ROWS) * ((m) + 1))
 
 /* The accumulation: K block Gram matrices of the rows (phi, r), one for
    held-out rows, the lag-one cross product, and the first and last rows;
@@ -119,6 +121,13 @@ int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
 int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
                             size_t blocks, uint64_t fit_rows, uint64_t row0,
                             double *storage, size_t storage_doubles);
+
+/* fe_discover_set_lags: keep lags Z_1 .. Z_P, P = lags <= FE_DISCOVER_LAGS
+   (16 by default; 0: no noise model, selection then uses batch means and
+   says so).  The cost of a row grows as P M^2.  Only on an empty full
+   accumulation (FE_EINVAL otherwise, or for lags > 0 on a screen; FE_ESIZE
+   for lags > FE_DISCOVER_LAGS).  Parts to be merged must agree. */
+int fe_discover_set_lags(fe_discover_acc *a, size_t lags);
 
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
@@ -228,7 +237,7 @@ typedef struct fe_discover_options {
     size_t nbase;
     int noise;                  /* FE_DISCOVER_NOISE_AR (default) or _BATCH */
     size_t max_order;           /* highest AR order tried: 4, at most
-                                   FE_DISCOVER_EDGE */
+                                   FE_DISCOVER_EDGE (and lags - 1) */
 } fe_discover_options;
 
 /* fe_discover_default_options: alpha 0.05, 8 steps, no base terms, the AR

@@ -198,6 +198,27 @@ typedef struct fe__located {
     double n, z, t, mean_before, mean_after, ms_ratio_before, ms_ratio_after;
 } fe__located;
 
+/* Rows waiting to be folded, with where each came from. */
+typedef struct fe__panel {
+    size_t n;
+    double phi[FE_DISCOVER_PANEL_ROWS][FE_DISCOVER_MAX_COLUMNS];
+    double r[FE_DISCOVER_PANEL_ROWS], t[FE_DISCOVER_PANEL_ROWS];
+    size_t line[FE_DISCOVER_PANEL_ROWS];
+    const char *file[FE_DISCOVER_PANEL_ROWS];
+} fe__panel;
+
+/* Fold the panel's rows; on a refusal, p->n is the refused row's index
+   (the rows before it are folded). */
+static int fe__flush_panel(fe_discover_acc *acc, fe__panel *p)
+{
+    size_t done = 0;
+    int rc = p->n > 0 ? fe_discover_add_rows(acc, p->phi[0], FE_DISCOVER_MAX_COLUMNS, p->r,
+                                             p->n, &done)
+                      : FE_OK;
+    p->n = rc == FE_OK ? 0 : done;
+    return rc;
+}
+
 /* What one row is worth in independent rows under a noise model: n_eff / n,
    at most 1, so that a block of n_k rows weighs n_k times it; divided by
    the block ratio R when slow variation beyond the autoregression was
@@ -261,6 +282,8 @@ static const char fe__discover_help[] =
     "                         an autoregression re-estimated as terms enter, with\n"
     "                         generalised least squares; 'batch', batch means over\n"
     "                         the time blocks\n"
+    "  --lags P               lagged products kept for the noise model (default 8,\n"
+    "                         at most 16; 0: none, batch means); each costs M^2 a row\n"
     "  --blocks K             time blocks for locating (and batch means) (default 20)\n"
     "  --alpha A              family-wise false discovery level (default 0.05)\n"
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
@@ -281,7 +304,7 @@ typedef struct fe__discover_args {
     const char *channel, *time, *report, *base;
     const char *role_column[FE__ROLES];
     double holdout, alpha;
-    long blocks;
+    long blocks, lags;
     int json;
     int noise;                  /* FE_DISCOVER_NOISE_AR or _BATCH */
 } fe__discover_args;
@@ -307,6 +330,7 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
     a->holdout = 0.2;
     a->alpha = 0.05;
     a->blocks = 20;
+    a->lags = FE_DISCOVER_DEFAULT_LAGS;
     if (a->pairs == NULL) {
         snprintf(err, errlen, "out of memory");
         return FE_CLI_IO;
@@ -363,6 +387,12 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
                 a->noise = FE_DISCOVER_NOISE_BATCH;
             else {
                 snprintf(err, errlen, "--noise: '%s' is not 'ar' or 'batch'", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--lags") == 0) {
+            rc = fe_cli_parse_long(o, v, &a->lags, err, errlen);
+            if (rc == FE_CLI_OK && (a->lags < 0 || a->lags > FE_DISCOVER_LAGS)) {
+                snprintf(err, errlen, "--lags: %s is not in [0, %d]", v, FE_DISCOVER_LAGS);
                 rc = FE_CLI_USAGE;
             }
         } else if (strcmp(o, "--blocks") == 0) {
@@ -1023,6 +1053,7 @@ int fe_cli_discover(int argc, char **argv)
     FILE *pts = NULL;
     fe_lsq *per = NULL;
     double *per_g = NULL;
+    fe__panel *panel = NULL;
 
     memset(&out, 0, sizeof out);
     for (int i = 1; i < argc; i++)
@@ -1124,20 +1155,39 @@ int fe_cli_discover(int argc, char **argv)
     blocks = calloc((size_t)a.blocks + 1, sizeof *blocks);
     if (storage == NULL || work == NULL || res == NULL || blocks == NULL)
         goto internal;
-    if (fe_discover_acc_init(&acc, cat.count, (size_t)a.blocks, out.fit, 0, storage, nst) != FE_OK)
+    if (fe_discover_acc_init(&acc, cat.count, (size_t)a.blocks, out.fit, 0, storage, nst) != FE_OK
+        || fe_discover_set_lags(&acc, (size_t)a.lags) != FE_OK)
         goto internal;
     if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
         goto fail;
+    /* Rows are folded a panel at a time (fe_discover_add_rows: the lagged
+       products by matrix products), the panel flushed before a break. */
+    panel = malloc(sizeof *panel);
+    if (panel == NULL)
+        goto internal;
+    panel->n = 0;
     while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
+        size_t k = panel->n;
+        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS)
+            && fe__flush_panel(&acc, panel) != FE_OK)
+            break;                              /* panel->n: the refused row */
         if (new_pair)
             fe_discover_break(&acc);
-        if (fe_catalog_eval(&cat, &s, phi) != FE_OK
-            || fe_discover_add(&acc, phi, s.real - s.sim) != FE_OK) {
-            fprintf(stderr, "foldest discover: %s:%zu: a term is not finite at t = %g\n",
-                    a.pairs[st.cur].real.name, a.pairs[st.cur].real.line, s.t);
-            rc = FE_CLI_INPUT;
-            goto cleanup;
-        }
+        k = panel->n;
+        panel->r[k] = s.real - s.sim;
+        panel->line[k] = a.pairs[st.cur].real.line;
+        panel->file[k] = a.pairs[st.cur].real.name;
+        panel->t[k] = s.t;
+        if (fe_catalog_eval(&cat, &s, panel->phi[k]) != FE_OK)
+            break;
+        panel->n++;
+    }
+    if (rc == FE_OK || (rc == FE_END && fe__flush_panel(&acc, panel) != FE_OK)) {
+        size_t k = panel->n;
+        fprintf(stderr, "foldest discover: %s:%zu: a term is not finite at t = %g\n",
+                panel->file[k], panel->line[k], panel->t[k]);
+        rc = FE_CLI_INPUT;
+        goto cleanup;
     }
     if (rc != FE_END)
         goto fail;
@@ -1469,6 +1519,7 @@ cleanup:
     free(out.per_se);
     free(out.per_rows);
     free(out.per_held);
+    free(panel);
     return rc;
 }
 /* Run discovery on recordings ends here */
