@@ -1323,6 +1323,27 @@ static double fe__quad_resid(const double *m, size_t dim, const size_t *cols,
     return s;
 }
 
+/* What a fit of chosen columns needs: the columns below `limit`, the
+   workspace carved, every block with rows, the total Gram matrix. */
+static int fe__fit_prepare(const fe_discover_acc *a, const size_t *cols, size_t ncols,
+                           size_t limit, fe__ws *w, double *work, size_t work_doubles)
+{
+    int rc;
+    if (ncols > a->m)
+        return FE_EINVAL;
+    for (size_t i = 0; i < ncols; i++)
+        if (cols[i] >= limit)
+            return FE_EINVAL;
+    rc = fe__ws_carve(w, work, work_doubles, a->m, a->blocks);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t k = 0; k < a->blocks; k++)
+        if (a->counts[k] < 1.0)
+            return FE_ETOOFEW;
+    fe__total_gram(a, w->g);
+    return FE_OK;
+}
+
 static int fe__fit(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
                    size_t ncols, double *coef, double *se, fe_discover_fit *fit)
 {
@@ -1401,20 +1422,12 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
 {
     fe__ws w;
     int rc;
-    if (a == NULL || fit == NULL || (ncols > 0 && (cols == NULL || coef == NULL))
-        || ncols > a->m)
+    if (a == NULL || fit == NULL || (ncols > 0 && (cols == NULL || coef == NULL)))
         return FE_EINVAL;
-    for (size_t i = 0; i < ncols; i++)
-        if (cols[i] >= a->base_cols)    /* a->m for a full accumulation */
-            return FE_EINVAL;
-    rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
-    if (rc != FE_OK)
-        return rc;
-    for (size_t k = 0; k < a->blocks; k++)
-        if (a->counts[k] < 1.0)
-            return FE_ETOOFEW;
-    fe__total_gram(a, w.g);
-    return fe__fit(a, &w, cols, ncols, coef, stderr_, fit);
+    /* From a screen, only its base columns (a->base_cols is a->m in a full
+       accumulation). */
+    rc = fe__fit_prepare(a, cols, ncols, a->base_cols, &w, work, work_doubles);
+    return rc != FE_OK ? rc : fe__fit(a, &w, cols, ncols, coef, stderr_, fit);
 }
 /* Fit a set of columns ends here */
 /* [[file:../literate/discover.org::Score a candidate against the model][Score a candidate against the model]] */
@@ -1986,19 +1999,12 @@ int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
     fe__ws w;
     int rc;
     if (a == NULL || fit == NULL || noise == NULL
-        || (ncols > 0 && (cols == NULL || coef == NULL)) || ncols > a->m
+        || (ncols > 0 && (cols == NULL || coef == NULL))
         || a->lags == 0 || max_order >= a->lags || max_order > FE_DISCOVER_EDGE)
         return FE_EINVAL;
-    for (size_t i = 0; i < ncols; i++)
-        if (cols[i] >= a->m)
-            return FE_EINVAL;
-    rc = fe__ws_carve(&w, work, work_doubles, a->m, a->blocks);
+    rc = fe__fit_prepare(a, cols, ncols, a->m, &w, work, work_doubles);
     if (rc != FE_OK)
         return rc;
-    for (size_t k = 0; k < a->blocks; k++)
-        if (a->counts[k] < 1.0)
-            return FE_ETOOFEW;
-    fe__total_gram(a, w.g);
     rc = fe__gls(a, &w, cols, ncols, max_order, coef, fit, noise);
     if (rc == FE_OK && ncols > 0)
         fe__gls_cov(a, &w, cols, ncols, fit, noise, stderr_, NULL);
