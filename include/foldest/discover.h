@@ -70,21 +70,23 @@ typedef struct fe_discover_acc {
                                    that w^T lag w = w^T L w */
     double *first, *last;       /* M each */
     double *counts;             /* K + 1 row counts */
-    size_t lags;                /* P: FE_DISCOVER_LAGS, 0 in a screen */
+    size_t lags;                /* P: FE_DISCOVER_DEFAULT_LAGS unless set
+                                   (fe_discover_set_lags), 0 in a screen */
     size_t nhist;               /* fitted rows in hist, <= P */
     size_t nhead;               /* rows in head, <= P */
-    int head_open;              /* no break or held-out row since the
-                                   part's first row */
+    size_t nshead;              /* rows in shead */
+    int head_open;              /* no break since the part's first row */
+    int shead_pending;          /* the open recording began after a break
+                                   in this part: its first rows go to
+                                   edge_start once known (two ints side
+                                   by side: the struct has no padding, so
+                                   that copies compare byte for byte) */
     double *zlag;               /* P x M x M, Z_l = sum z_t z_{t-l}^T over
                                    fitted rows of one recording, full */
     double *hist;               /* P x M: the last fitted rows, newest
                                    first (rows past nhist are zero) */
     double *head;               /* P x M: the part's first rows */
     double *bsum;               /* K x M: each fitted block's sum of rows */
-    size_t nshead;              /* rows in shead */
-    int shead_pending;          /* the open recording began after a break
-                                   in this part: its first rows go to
-                                   edge_start once known */
     double *edge_start;         /* (E M) x (E M): sum over recordings of
                                    x x^T, x = the first E = FE_DISCOVER_EDGE
                                    fitted rows stacked (zeros past the end) */
