@@ -85,6 +85,23 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     ck_assert_int_eq(run(cmd, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"verdict\": \"no significant mismatch\"") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"discovered\": []") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"path\": [{\"step\": 0, \"added\": null") != NULL, "%s", out);
+    /* Batch means on request, and when no lagged products are kept. */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --noise batch",
+             FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"batch\"") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --lags 0",
+             FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"batch\"") != NULL, "%s", out);
+    /* Two lags: an autoregression of order at most 1. */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --lags 2",
+             FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 1") != NULL
+                  || strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 0") != NULL, "%s", out);
     remove_dir();
 }
 END_TEST
@@ -117,6 +134,12 @@ static const struct bad_case bad_cases[] = {
     {"bad holdout", "time,y\n0,1\n", "time,y\n0,1\n", "--channel y --holdout 1.5", 2,
      "--holdout: 1.5 is not in"},
     {"unknown base term", "time,y\n0,1\n", "time,y\n0,1\n", "--channel y --base drag", 2, NULL},
+    {"unknown noise model", "time,y\n0,1\n", "time,y\n0,1\n", "--channel y --noise white", 2,
+     "--noise: 'white' is not 'ar' or 'batch'"},
+    {"too many lags", "time,y\n0,1\n", "time,y\n0,1\n", "--channel y --lags 17", 2,
+     "--lags: 17 is not in [0, 16]"},
+    {"negative lags", "time,y\n0,1\n", "time,y\n0,1\n", "--channel y --lags -1", 2,
+     "--lags: -1 is not in [0, 16]"},
 };
 
 START_TEST(bad_inputs)
