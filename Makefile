@@ -55,7 +55,7 @@ export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
         check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
-        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept
+        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept mutate
 
 all: lib cli examples
 
@@ -240,6 +240,25 @@ $(B)/accept/gen: tests/accept/gen.c $(B)/.deps
 
 accept: all $(B)/accept/gen
 	FOLDEST=$(CLI) GEN=$(B)/accept/gen ACCEPT_OUT=$(B)/accept/runs python3 tests/accept/run.py
+
+# ---------------------------------------------------------------- mutation testing
+# `make mutate`: single-point mutants generated from src/*.c by
+# tests/mutate/mutate.py (operators, constants, dropped factors, skipped
+# checks; in proportion to each module's size, from SEED), each built into
+# the plain test binary and the command and run against the fast suites of
+# its module (FE_TEST_QUICK); kill rate per module, survivors listed, report
+# in $(B)/mutate/report.txt.  MUTANTS=20 draws a random sample instead of the
+# full set; MUTATE_MIN fails below that overall rate (percent).  One core.
+# See tests/mutate/README.md.
+MUTANTS        ?= 0
+SEED           ?= 1
+MUTATE_EXCLUDE ?= discover
+MUTATE_MIN     ?= 0
+mutate: lib cli $(B)/tests/suites.h
+	python3 tests/mutate/mutate.py --mutants $(MUTANTS) --seed $(SEED) --exclude '$(MUTATE_EXCLUDE)' \
+	  --min-rate $(MUTATE_MIN) $(if $(MUTANT_IDS),--ids '$(MUTANT_IDS)') --build $(B) --cc '$(CC)' \
+	  --cflags '$(filter-out -Werror,$(WARN)) $(CFLAGS)' --ext-cflags '$(EXT_CFLAGS)' \
+	  --ext-libs '$(EXT_LIBS)' --check-cflags '$(CHECK_CFLAGS)' --check-libs '$(CHECK_LIBS)'
 
 # ---------------------------------------------------------------- fuzzing
 # libFuzzer harnesses (tests/fuzz/fuzz_*.c), clang with ASan and UBSan; the

@@ -102,6 +102,8 @@ START_TEST(every_coefficient_in_words)
         {"linear_stiffness", -4, "kappa = 4"},
         {"cubic_stiffness", -2, "hardening"},
         {"cubic_stiffness", 2, "softening"},
+        {"cubic_stiffness", -0.5, "hardening"}, /* either side of 0, within 1 of it */
+        {"cubic_stiffness", 0.5, "softening"},
         {"thermal_sensitivity", 0.7, "0.7 +/- 0.1 channel units per degree"},
         {"newton_cooling", -0.05, "convective loss: -0.05"},
         {"radiative_cooling", -1e-9, "per K^4"},

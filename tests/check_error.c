@@ -13,6 +13,9 @@ START_TEST(every_code_has_a_distinct_message)
             ck_assert_str_ne(m, fe_strerror(j));
     }
     ck_assert_int_eq(FE_OK, 0);
+    /* The first and last codes are inside the table's bounds. */
+    ck_assert_str_eq(fe_strerror(FE_OK), "success");
+    ck_assert_str_eq(fe_strerror(FE_STATUS_COUNT - 1), fe_strerror(FE_EINTERNAL));
 }
 END_TEST
 

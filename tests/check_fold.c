@@ -215,6 +215,21 @@ START_TEST(product_rejects_bad_layout)
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 8), FE_EINVAL);
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 12), FE_OK);
     ck_assert_int_eq(fe_product_accumulator(NULL, &spec, 12), FE_EINVAL);
+    /* Every part is checked, not only the first: the second one ending
+       exactly at the end of the observation fits, one byte further not. */
+    {
+        fe_accumulator t = toy(), nomerge = toy();
+        const fe_product_part two[2] = {{&mv, 0}, {&t, 8}};
+        const fe_product s2 = {two, 2};
+        const fe_product_part late[2] = {{&t, 0}, {&nomerge, 8}};
+        const fe_product s3 = {late, 2};
+        ck_assert_int_eq(fe_product_accumulator(&prod, &s2, 16), FE_OK);
+        ck_assert(prod.merge != NULL);
+        ck_assert_int_eq(fe_product_accumulator(&prod, &s2, 15), FE_EINVAL);
+        nomerge.merge = NULL;
+        ck_assert_int_eq(fe_product_accumulator(&prod, &s3, 16), FE_OK);
+        ck_assert(prod.merge == NULL);
+    }
 }
 END_TEST
 

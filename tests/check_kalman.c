@@ -522,6 +522,20 @@ START_TEST(bad_packets_are_refused_and_nothing_changes)
             ck_assert_int_eq(upd(&f.k, &ov, NULL), FE_ENONFINITE);
             ASSERT_UNCHANGED(f, snap, desc);
         }
+        if (fast) {   /* Z singular (D is not): refused at the boundary, */
+            const double Zsing[4] = {1, 1, 1, 1}, Znear[4] = {1, 1 - 1e-6, 1 - 1e-6, 1};
+            fe_kalman_obs sing = {2, A2, z2, Zsing}, near = {2, A2, z2, Znear};
+            kf g;
+            ck_assert_int_eq(upd(&f.k, &sing, NULL), FE_ENOTPD);
+            ASSERT_UNCHANGED(f, snap, desc);
+            /* and just inside it the packet is accepted, as the reference takes it. */
+            kf_make(&g, 3, 2);
+            ck_assert_int_eq(fe_kalman_copy(&g.k, &f.k), FE_OK);
+            ck_assert_int_eq(upd(&g.k, &near, NULL), FE_OK);
+            ck_assert_int_eq(fe_kalman_copy(&g.k, &f.k), FE_OK);
+            ck_assert_int_eq(fe_kalman_update(&g.k, &sing, NULL), FE_OK);
+            kf_free(&g);
+        }
         ck_assert_int_eq(upd(&f.k, &zero, NULL), FE_EINVAL);
         ck_assert_int_eq(upd(&f.k, &null, NULL), FE_EINVAL);
         ck_assert_int_eq(upd(&f.k, NULL, NULL), FE_EINVAL);
@@ -576,6 +590,23 @@ START_TEST(sizes_and_arguments)
     ck_assert_double_eq(k.x[0], 0.0);
     ck_assert_int_eq(fe_kalman_set_prior_scaled(&k, NULL, -1.0), FE_ENOTPD);
     ck_assert_int_eq(fe_kalman_set_prior_scaled(&k, NULL, NAN), FE_ENONFINITE);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(NULL, NULL, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&k, NULL, 0.0), FE_OK); /* the edge: P = 0 */
+    {   /* The prior in information form writes nothing past its memory. */
+        enum { N = 3, PAD = 16 };
+        size_t len = fe_kalman_info_doubles(N, 1);
+        double *m = malloc((len + PAD) * sizeof *m), P0[N * N] = {4, 1, 0, 1, 3, 1, 0, 1, 2};
+        const double x0[N] = {1, -2, 3};
+        fe_kalman_info si;
+        ck_assert_ptr_nonnull(m);
+        for (size_t i = 0; i < len + PAD; i++)
+            m[i] = -7.0;
+        ck_assert_int_eq(fe_kalman_info_init(&si, N, 1, m, len), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_set_prior(&si, x0, P0), FE_OK);
+        for (size_t i = len; i < len + PAD; i++)
+            ck_assert_double_eq(m[i], -7.0);
+        free(m);
+    }
     ck_assert_int_eq(fe_kalman_info_init(&s, 4, 3, mem, fe_kalman_info_doubles(4, 3) - 1), FE_ESIZE);
     ck_assert_int_eq(fe_kalman_info_init(&s, 2, 2, mem, 64), FE_OK);
     {
@@ -921,6 +952,22 @@ START_TEST(information_shards_merge_by_addition)
         ck_assert_int_eq(fe_merge(&acc, &whole.s, &e.s), FE_OK);
         ck_assert_mem_eq(whole.mem, before, sizeof before);
         free(e.mem);
+    }
+    {   /* Merged with itself, an accumulation doubles: as merged with a copy. */
+        kinfo self, copy;
+        kinfo_make(&self, N, 3);
+        kinfo_make(&copy, N, 3);
+        ck_assert_int_eq(fe_copy(&acc, &self.s, &whole.s), FE_OK);
+        ck_assert_int_eq(fe_copy(&acc, &copy.s, &whole.s), FE_OK);
+        ck_assert_int_eq(fe_merge(&acc, &copy.s, &whole.s), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_merge(&self.s, &self.s), FE_OK);
+        ck_assert_mem_eq(self.s.Lambda, copy.s.Lambda, N * N * sizeof(double));
+        ck_assert_mem_eq(self.s.eta, copy.s.eta, N * sizeof(double));
+        ck_assert_uint_eq(self.s.count, 2 * whole.s.count);
+        for (size_t i = 0; i < N * N; i++)
+            ck_assert_double_eq(self.s.Lambda[i], 2.0 * whole.s.Lambda[i]);
+        free(self.mem);
+        free(copy.mem);
     }
     {   /* Different dimensions do not merge, and nothing changes. */
         kinfo other;

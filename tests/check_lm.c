@@ -369,6 +369,21 @@ static int magcal_fit(const fe_sessions *c, double *x, fe_lm_result *res)
     return rc;
 }
 
+START_TEST(sessions_count_their_parameters)
+{
+    /* Six entries of the symmetric S, then three per offset: one offset
+       per session, or one for all. */
+    fe_sessions c = {0};
+    for (size_t k = 1; k <= 5; k++) {
+        c.count = k;
+        c.one_offset = 0;
+        ck_assert_uint_eq(fe_sessions_params(&c), 6 + 3 * k);
+        c.one_offset = 1;
+        ck_assert_uint_eq(fe_sessions_params(&c), 9);
+    }
+}
+END_TEST
+
 START_TEST(magnetometer_sessions_synthetic)
 {
     enum { NS = 4, PER = 500 };
@@ -547,6 +562,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, bundle_adjustment_dense_and_schur_agree);
     tcase_add_test(t, report_table_and_stop);
     tcase_add_test(t, model_failures_are_handled);
+    tcase_add_test(t, sessions_count_their_parameters);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     suite_add_tcase(s, t);

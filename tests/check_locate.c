@@ -212,6 +212,63 @@ START_TEST(merge_of_consecutive_parts_equals_whole)
 }
 END_TEST
 
+START_TEST(merge_into_an_empty_part_is_the_other_part)
+{
+    /* An empty first part (nothing folded) merged with a part that starts
+       with a recording break: the same recordings and blocks as the part. */
+    enum { N = 40, K = 4 };
+    fe_innovations a, b;
+    fe_rng rng = fe_rng_seed(5);
+    ck_assert_int_eq(fe_innovations_init(&a, K, N, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&b, K, N, 0), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        double w = fe_rng_normal(&rng);
+        fe_kalman_report r = {1, w * w, 0, NULL, &w, NULL};
+        if (i == 0 || i == 25)
+            fe_innovations_break(&b);
+        ck_assert_int_eq(fe_innovations_add(&b, (double)i, &r), FE_OK);
+    }
+    ck_assert_int_eq(fe_innovations_merge(&a, &b), FE_OK);
+    ck_assert_uint_eq(a.n, b.n);
+    ck_assert_int_eq(a.recording, b.recording);
+    for (size_t k = 0; k < K; k++) {
+        ck_assert_int_eq(a.block[k].pair, b.block[k].pair);
+        ck_assert_int_eq(a.block[k].pair1, b.block[k].pair1);
+        ck_assert_double_eq(a.block[k].nis, b.block[k].nis);
+    }
+}
+END_TEST
+
+START_TEST(json_of_every_length_is_whole_or_refused)
+{
+    /* Every buffer shorter than the document is refused with FE_ESIZE and
+       nothing written past it; the exact length (with its NUL) is enough. */
+    fe_located l = {0};
+    char full[1024], buf[1024 + 8];
+    size_t need;
+    l.pair = 0;
+    l.pair1 = 1;
+    l.t0 = 1.5;
+    l.t1 = 2.5;
+    l.n = 10;
+    l.z = 3.25;
+    l.t = -1.5;
+    l.test = "nis";
+    l.p_value = 0.001;
+    l.mean_nis = 2.0;
+    l.lag1 = 0.25;
+    ck_assert_int_eq(fe_located_json(&l, full, sizeof full), FE_OK);
+    need = strlen(full) + 1;
+    for (size_t len = 1; len <= need; len++) {
+        memset(buf, 'X', sizeof buf);
+        ck_assert_int_eq(fe_located_json(&l, buf, len), len < need ? FE_ESIZE : FE_OK);
+        for (size_t i = len; i < sizeof buf; i++)
+            ck_assert_int_eq(buf[i], 'X');
+    }
+    ck_assert_str_eq(buf, full);
+}
+END_TEST
+
 START_TEST(refusals_leave_the_accumulation_unchanged)
 {
     fe_innovations inn, before;
@@ -348,6 +405,8 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
     tcase_add_test(t, arguments_merges_that_do_not_fit_and_json);
+    tcase_add_test(t, merge_into_an_empty_part_is_the_other_part);
+    tcase_add_test(t, json_of_every_length_is_whole_or_refused);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);
     suite_add_tcase(s, t);

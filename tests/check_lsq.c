@@ -419,6 +419,45 @@ START_TEST(bad_rows_are_refused_and_nothing_changes)
 }
 END_TEST
 
+/* The sparse step refuses what the dense one refuses, with the same codes,
+   and both refuse a total weight beyond DBL_MAX / 4 at its edge. */
+START_TEST(sparse_rows_are_refused_like_dense_rows)
+{
+    double g[3 * 3], gbefore[3 * 3];
+    const double bad[3] = {NAN, INFINITY, -INFINITY}, zero[2] = {0, 0};
+    const size_t idx[2] = {0, 1};
+    const double val[2] = {1.0, 2.0};
+    fe_lsq a, before;
+    fe_lsq_init(&a, 2, g);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, idx, val, 2, 1.0, 1.0), FE_OK);
+    before = a;
+    memcpy(gbefore, g, sizeof g);
+    for (int b = 0; b < 3; b++) {
+        double v[2] = {1.0, bad[b]};
+        ck_assert_int_eq(fe_lsq_add_sparse(&a, idx, val, 2, 1.0, bad[b]), FE_ENONFINITE);
+        ck_assert_int_eq(fe_lsq_add(&a, val, 1.0, bad[b]), FE_ENONFINITE);
+        ck_assert_int_eq(fe_lsq_add_sparse(&a, idx, val, 2, bad[b], 1.0), FE_ENONFINITE);
+        ck_assert_int_eq(fe_lsq_add_sparse(&a, idx, v, 2, 1.0, 1.0), FE_ENONFINITE);
+    }
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, idx, val, 2, 1.0, -1.0), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(g, gbefore, sizeof g);
+    /* Rows of zeros weigh only in wsum: two of DBL_MAX / 8 reach the edge
+       exactly and are taken; a third goes past it, by either step. */
+    for (int sparse = 0; sparse < 2; sparse++) {
+        fe_lsq_init(&a, 2, g);
+        for (int k = 0; k < 2; k++)
+            ck_assert_int_eq(sparse ? fe_lsq_add_sparse(&a, idx, zero, 2, 0.0, DBL_MAX / 8)
+                                    : fe_lsq_add(&a, zero, 0.0, DBL_MAX / 8), FE_OK);
+        ck_assert_double_eq(a.wsum, DBL_MAX / 4);
+        before = a;
+        ck_assert_int_eq(sparse ? fe_lsq_add_sparse(&a, idx, zero, 2, 0.0, DBL_MAX / 8)
+                                : fe_lsq_add(&a, zero, 0.0, DBL_MAX / 8), FE_ENONFINITE);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+    }
+}
+END_TEST
+
 START_TEST(empty_single_and_bad_arguments)
 {
     double g[4], work[16], x = 0, rss = 1, cov = 0;
@@ -566,6 +605,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, covariance_is_sigma2_times_inverse);
     tcase_add_test(t, dependent_columns_are_singular_never_nan);
     tcase_add_test(t, bad_rows_are_refused_and_nothing_changes);
+    tcase_add_test(t, sparse_rows_are_refused_like_dense_rows);
     tcase_add_test(t, empty_single_and_bad_arguments);
     tcase_add_test(t, exact_fit_has_zero_rss);
     tcase_add_test(t, sparse_rows_equal_dense_rows);

@@ -1012,6 +1012,18 @@ START_TEST(sources_fold_their_concatenation)
     src[2].obs_size = 4;
     ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
     ck_assert_uint_eq(a.n, 0);
+    /* Nor does a missing source, or one without a next function. */
+    src[2].obs_size = src[1].obs_size;
+    sp[3] = NULL;
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    {
+        fe_source nonext = src[3];
+        nonext.next = NULL;
+        sp[3] = &nonext;
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    }
+    sp[3] = &src[3];
+    ck_assert_uint_eq(a.n, 0);
 }
 END_TEST
 

@@ -35,11 +35,44 @@ START_TEST(f_and_chi_square)
 }
 END_TEST
 
+START_TEST(normal_quantile_within_its_promised_error)
+{
+    /* References: Python's statistics.NormalDist().inv_cdf (Wichura's
+       AS 241, about 1e-16), across the tails, the two switch points
+       p = 0.02425 and 1 - 0.02425 (just below, at, just above) and the
+       centre; the promise is a relative error below 1.2e-9. */
+    static const double ref[][2] = {
+        {1e-300, -37.047096299361201},
+        {1e-10, -6.3613409024040557},
+        {0.0001, -3.71901648545568},
+        {0.01, -2.3263478740408408},
+        {0.0242, -1.9738394633131993},
+        {0.02425, -1.9729610513118845},
+        {0.0243, -1.9720841590292884},
+        {0.1, -1.2815515655446008},
+        {0.3, -0.52440051270804067},
+        {0.5, 0},
+        {0.7, 0.52440051270804067},
+        {0.9, 1.2815515655446008},
+        {0.9757, 1.9720841590292884},
+        {0.97575, 1.9729610513118847},
+        {0.9758, 1.9738394633131993},
+        {0.99, 2.3263478740408408},
+        {0.9999, 3.7190164854557084},
+        {0.9999999999, 6.3613408896974208},
+    };
+    for (size_t i = 0; i < sizeof ref / sizeof ref[0]; i++)
+        FE_ASSERT_REL(fe_normal_quantile(ref[i][0]), ref[i][1], 1.2e-9);
+}
+END_TEST
+
 START_TEST(bad_arguments_give_nan)
 {
     ck_assert(isnan(fe_beta_inc(-1, 1, 0.5)));
     ck_assert(isnan(fe_beta_inc(1, 1, 1.5)));
     ck_assert(isnan(fe_gamma_q(0, 1)));
+    ck_assert(isnan(fe_chi2_upper(1.0, 0.0)));      /* k > 0 is the edge */
+    ck_assert(isnan(fe_chi2_upper(1.0, -1.0)));
     ck_assert(isnan(fe_student_t_two_sided(1, 0)));
     ck_assert(isnan(fe_student_t_quantile(0, 3)));
     ck_assert_double_eq(fe_student_t_two_sided(INFINITY, 3), 0.0);
@@ -102,6 +135,7 @@ Suite *fe_special_suite(void)
     TCase *t = tcase_create("core");
     tcase_add_test(t, student_t_table_values);
     tcase_add_test(t, f_and_chi_square);
+    tcase_add_test(t, normal_quantile_within_its_promised_error);
     tcase_add_test(t, bad_arguments_give_nan);
     tcase_add_loop_test(t, chi2_upper_large_degrees_of_freedom, 0,
                         (int)(sizeof chi2_reference / sizeof chi2_reference[0]));

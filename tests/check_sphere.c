@@ -38,6 +38,45 @@ static fe_sphere_fit fit_moments(const double *x, size_t n, fe_sphere_model mode
 
 static const double C0[3] = {100, -50, 30}, R0[3] = {400, 380, 420};
 
+/* The extents of the samples, in half-widths of the fitted ellipsoid along
+   each axis: the half-width along axis j is sqrt(((M^T M)^{-1})_jj), from
+   the reported matrix M by cofactors, independent of the fit's own
+   eigen-decomposition. */
+START_TEST(extents_are_in_half_widths_of_the_fitted_ellipsoid)
+{
+    enum { N = 4000 };
+    static double x[3 * N];
+    const double c[3] = {10, -20, 5}, r[3] = {30, 45, 60};
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    double A[9], cof[9], det;
+    /* A tilted ellipsoid: the axis-aligned one rotated about z by 30 degrees. */
+    fe_test_ellipsoid_points(x, N, c, r, 0.01, 77);
+    for (size_t i = 0; i < N; i++) {
+        double u = x[3 * i] - c[0], v = x[3 * i + 1] - c[1];
+        x[3 * i] = c[0] + cos(0.5236) * u - sin(0.5236) * v;
+        x[3 * i + 1] = c[1] + sin(0.5236) * u + cos(0.5236) * v;
+    }
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_ELLIPSOID, NULL, &f), FE_OK);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            A[i * 3 + j] = 0.0;
+            for (int k = 0; k < 3; k++)
+                A[i * 3 + j] += f.matrix[k * 3 + i] * f.matrix[k * 3 + j];
+        }
+    for (int i = 0; i < 3; i++)
+        cof[i] = A[((i + 1) % 3) * 3 + (i + 1) % 3] * A[((i + 2) % 3) * 3 + (i + 2) % 3]
+               - A[((i + 1) % 3) * 3 + (i + 2) % 3] * A[((i + 2) % 3) * 3 + (i + 1) % 3];
+    det = A[0] * cof[0] + A[1] * (A[5] * A[6] - A[3] * A[8]) + A[2] * (A[3] * A[7] - A[4] * A[6]);
+    for (int j = 0; j < 3; j++) {
+        double h = sqrt(cof[j] / det);
+        FE_ASSERT_REL(f.extent_lo[j], (q.lo[j] - f.offset[j]) / h, 1e-9);
+        FE_ASSERT_REL(f.extent_hi[j], (q.hi[j] - f.offset[j]) / h, 1e-9);
+    }
+}
+END_TEST
+
 START_TEST(three_algorithms_agree)
 {
     fe_sphere_model model = (fe_sphere_model)_i;
@@ -380,6 +419,9 @@ START_TEST(refuse_too_few_and_bad_arguments)
     ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)7, NULL, &f), FE_EINVAL);
     ck_assert_int_eq(fe_sphere_fit_naive(x, 6, FE_FIT_SPHERE, NULL, w, 10, &f), FE_ESIZE);
     ck_assert_str_eq(fe_sphere_model_name(FE_FIT_AXIAL), "axial");
+    ck_assert_str_eq(fe_sphere_model_name(FE_FIT_ELLIPSOID), "ellipsoid"); /* the last */
+    ck_assert_ptr_null(fe_sphere_model_name(FE_FIT_ELLIPSOID + 1));         /* one past */
+    ck_assert_ptr_null(fe_sphere_model_name(-1));
     {
         fe_sphere_model m;
         ck_assert_int_eq(fe_sphere_model_parse("ellipsoid", &m), FE_OK);
@@ -769,6 +811,7 @@ Suite *fe_sphere_suite(void)
     tcase_set_timeout(t, 120);
     tcase_set_timeout(r, 120);
     tcase_add_loop_test(t, three_algorithms_agree, 0, 3);
+    tcase_add_test(t, extents_are_in_half_widths_of_the_fitted_ellipsoid);
     tcase_add_test(t, calibration_maps_to_the_unit_sphere);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
