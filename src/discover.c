@@ -1865,6 +1865,8 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
     return f;
 }
 
+enum { FE__GLS_ROUNDS = 4 };    /* noise model, then GLS, four times */
+
 /* Feasible GLS of the columns `cols`: the coefficients, the summary and
    the noise model, leaving the prewhitened Gram matrix in w->gt, the
    factor of its model block in w->css and the whitened residual's
@@ -1883,20 +1885,13 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
         coef[i] = w->g[cols[i] * dim + r];
     fe__solve(&mo, coef, 1);
     memset(nz, 0, sizeof *nz);
-    for (int round = 0; round < 8; round++) {
-        fe_discover_noise prev = *nz;
-        int same = 1;
+    /* A fixed number of rounds, not a tolerance: the answer then depends
+       smoothly on the sums, and a fold merged in another order (threads,
+       MPI) gives it to rounding, not to the tolerance. */
+    for (int round = 0; round < FE__GLS_ROUNDS; round++) {
         fe__residual_weights(dim, cols, ncols, coef, w->uv);
         fe__lagged_sums(a, w->g, w->uv, w->q);
         fe_discover_noise_fit(w->q, n, maxp, nz);
-        if (round == 0 || nz->order != prev.order)
-            same = 0;
-        for (size_t i = 0; i < nz->order && same; i++)
-            same = fabs(nz->phi[i] - prev.phi[i]) < 1e-6;
-        if (round > 0 && same) {
-            *nz = prev;         /* gt, css and coef are this model's */
-            break;
-        }
         fe__whiten_gram(a, w->g, nz, w->gt);
         for (size_t i = 0; i < dim * dim; i++)
             if (!isfinite(w->gt[i]))
