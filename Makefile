@@ -30,6 +30,8 @@ EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm -pthread
 BENCH_LIBS    = $(shell pkg-config --libs gsl)
 CHECK_CFLAGS  = $(shell pkg-config --cflags check)
 CHECK_LIBS    = $(shell pkg-config --libs check)
+# The command (never the library) reads gzip-compressed tables with zlib.
+CLI_LIBS     := -lz
 
 ORG          := $(wildcard literate/*.org)
 LIB_SRC      := $(wildcard src/*.c)
@@ -95,7 +97,7 @@ $(B)/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(CC) $(WARN) $(CFLAGS) -Iinclude -Isrc/cli -c $< -o $@
 $(CLI): $(CLI_OBJ) $(STATIC)
 	@mkdir -p $(@D)
-	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
+	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS) $(CLI_LIBS),@true)
 
 # ---------------------------------------------------------------- examples, bench
 examples: $(EXAMPLES)
@@ -265,7 +267,7 @@ $(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -DFE_CLI_KEEP_STDOUT -Iinclude -Isrc/cli -c $< -o $@
 $(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
-	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
+	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS) $(CLI_LIBS)
 
 # Keep the instrumented objects (make would delete them as intermediates).
 .SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)

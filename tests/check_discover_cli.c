@@ -4,6 +4,7 @@
    recordings (skipped without them). */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -89,6 +90,51 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* One input from standard input or a pipe, or compressed: the same
+   answer as from the files; the copy of standard input leaves nothing in
+   TMPDIR; two inputs from standard input are refused. */
+START_TEST(inputs_from_a_pipe_and_compressed)
+{
+    static char want[65536], out[65536];
+    char cmd[4096], tmp[256];
+    const char *roles = "--channel acceleration --role position=position "
+                        "--role velocity=velocity --role input=input --base bias,gain --json";
+    make_dir();
+    snprintf(tmp, sizeof tmp, "%s/tmp", dir);
+    ck_assert_int_eq(mkdir(tmp, 0700), 0);
+    snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 3 --rows 20000 --real %s/r.csv --sim %s/s.csv",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s", FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, want, sizeof want), 0);
+    ck_assert_msg(strstr(want, "\"bad_rows\": {\"total\": 0,") != NULL, "%s", want);
+    /* The recording from a pipe. */
+    snprintf(cmd, sizeof cmd, "cat %s/r.csv | TMPDIR=%s %s discover --real - --sim %s/s.csv %s",
+             dir, tmp, FE_TEST_CLI, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* The simulation from standard input, compressed. */
+    snprintf(cmd, sizeof cmd, "gzip -c %s/s.csv | TMPDIR=%s %s discover --real %s/r.csv --sim - %s",
+             dir, tmp, FE_TEST_CLI, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* A compressed file. */
+    snprintf(cmd, sizeof cmd, "gzip -c %s/r.csv > %s/r.csv.gz && %s discover --real %s/r.csv.gz --sim %s/s.csv %s",
+             dir, dir, FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* Nothing left in TMPDIR. */
+    snprintf(cmd, sizeof cmd, "ls -A %s", tmp);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(out[0] == '\0', "left in TMPDIR: %s", out);
+    /* Standard input once only. */
+    snprintf(cmd, sizeof cmd, "%s discover --real - --sim - %s < %s/r.csv", FE_TEST_CLI, roles, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "standard input can be read only once") != NULL, "%s", out);
+    remove_dir();
+}
+END_TEST
+
 /* Bad inputs: each gives its exit status and a message naming the problem. */
 struct bad_case {
     const char *what, *real, *sim, *args;
@@ -106,6 +152,8 @@ static const struct bad_case bad_cases[] = {
      "no column 'v'"},
     {"NaN in the recording", "time,y\n0,1\n1,nan\n", "time,y\n0,1\n1,2\n", "--channel y", 3,
      "real.csv:3:3: 'nan' in column 'y' is not a finite number"},
+    {"empty cell in the simulation", "time,y\n0,1\n1,2\n", "time,y\n0,1\n1,\n", "--channel y", 3,
+     "sim.csv:3:3: empty cell in column 'y'"},
     {"time going backwards", "time,y\n0,1\n2,1\n1,1\n", "time,y\n0,1\n1,2\n2,3\n", "--channel y", 3,
      "real.csv:4: time does not increase"},
     {"simulation time going backwards", "time,y\n0,1\n1,1\n2,1\n", "time,y\n0,1\n2,2\n1,3\n",
@@ -246,6 +294,7 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, inputs_from_a_pipe_and_compressed);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));
     tcase_add_test(t, free_fall_recordings_show_quadratic_drag);
     tcase_add_test(t, magnetometers_show_axis_gain_and_cross_axis);

@@ -50,7 +50,23 @@ typedef struct fe_cli_table {
     size_t rows;                /* rows returned so far */
     off_t size;                 /* file size for progress; 0: unknown */
     int progress;               /* show progress on stderr */
+    void *gz;                   /* the zlib stream everything is read through */
+    int decimal_comma;          /* 1: forced; 2: a semicolon table */
+    size_t bad[4];              /* rows skipped in this pass, by reason */
 } fe_cli_table;
+
+/* Why a row was bad (the index of fe_cli_table.bad). */
+enum { FE_CLI_BAD_EMPTY, FE_CLI_BAD_NONFINITE, FE_CLI_BAD_TEXT,
+       FE_CLI_BAD_FIELDS, FE_CLI_BAD_REASONS };
+
+/* The reader's options, for every table the process opens (set by the
+   dispatcher from --decimal-comma and --skip-bad-rows). */
+void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows);
+
+/* Rows skipped by --skip-bad-rows in the last pass over every table,
+   by reason; and the same as a JSON object. */
+void fe_cli_bad_rows(size_t counts[FE_CLI_BAD_REASONS]);
+void fe_cli_json_bad_rows(FILE *out);
 
 /* Open `path` ("-": standard input).  skip < 0 guesses where the data
    start; skip >= 0 skips that many lines.  On failure `err` holds the
@@ -68,7 +84,13 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen);
 
-/* Rewind to the first data row (files only: FE_CLI_IO for a pipe). */
+/* fe_cli_table_open_rewindable: the same, for a command that rewinds: an
+   input that is not a regular file (standard input, a pipe) is first
+   copied to an unlinked temporary file. */
+int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
+                                 char *err, size_t errlen);
+
+/* Rewind to the first data row (FE_CLI_IO when the input cannot seek). */
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen);
 
 void fe_cli_table_close(fe_cli_table *t);

@@ -247,7 +247,9 @@ static const char fe__discover_help[] =
     "and show the fit improve, also on held-out rows.\n"
     "\n"
     "  --real FILE, --sim FILE  a recording and its simulation (CSV, with a time\n"
-    "                         column each); repeat the pair for several recordings\n"
+    "                         column each); repeat the pair for several recordings;\n"
+    "                         one input may be '-' (standard input) or a pipe: it is\n"
+    "                         copied once to a temporary file, removed at exit\n"
     "  --channel NAME         the measured channel, a column of both files\n"
     "  --time NAME            the time column (default: 'time', else the first)\n"
     "  --role COLUMN=ROLE     a simulation column's role: position, velocity,\n"
@@ -423,14 +425,12 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
 {
     int rc;
     size_t k = 2;
-    if (strcmp(p->real_path, "-") == 0 || strcmp(p->sim_path, "-") == 0) {
-        snprintf(err, errlen, "discover reads each file three times: give files, not '-'");
-        return FE_CLI_USAGE;
-    }
-    rc = fe_cli_table_open(&p->real, p->real_path, -1, err, errlen);
+    /* Three passes: an input that cannot seek (standard input, a pipe) is
+       copied once to an unlinked temporary file (cli.org). */
+    rc = fe_cli_table_open_rewindable(&p->real, p->real_path, -1, err, errlen);
     if (rc != FE_CLI_OK)
         return rc;
-    rc = fe_cli_table_open(&p->sim, p->sim_path, -1, err, errlen);
+    rc = fe_cli_table_open_rewindable(&p->sim, p->sim_path, -1, err, errlen);
     if (rc != FE_CLI_OK)
         return rc;
     if ((rc = fe__time_column(&p->real, a->time, &p->real_cols[0], err, errlen)) != FE_CLI_OK
@@ -616,7 +616,9 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     const fe_discover_result *r = o->r;
     fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
     fprintf(f, "\"rows\": {\"compared\": %zu, \"outside_simulation\": %zu, \"fit\": %zu, "
-               "\"heldout\": %zu}, ", o->rows, o->skipped, o->fit, o->heldout);
+               "\"heldout\": %zu}, \"bad_rows\": ", o->rows, o->skipped, o->fit, o->heldout);
+    fe_cli_json_bad_rows(f);
+    fprintf(f, ", ");
     fprintf(f, "\"base\": [");
     for (size_t i = 0; i < o->nbase; i++) {
         fprintf(f, "%s", i ? ", " : "");
@@ -1533,15 +1535,10 @@ static int fe__discover_sphere(fe__sphere_args *a)
     int rc, has_time = 0, has_temp = a->temperature != NULL;
     double oct_n[8] = {0}, oct_s0[8] = {0}, oct_s1[8] = {0}, ms_all = 0;
 
-    rc = fe_cli_table_open(&t, a->path, -1, err, sizeof err);
+    rc = fe_cli_table_open_rewindable(&t, a->path, -1, err, sizeof err);
     if (rc != FE_CLI_OK) {
         fprintf(stderr, "foldest discover: %s\n", err);
         return rc;
-    }
-    if (strcmp(a->path, "-") == 0) {
-        fprintf(stderr, "foldest discover: --sphere reads the file three times: give a file\n");
-        fe_cli_table_close(&t);
-        return FE_CLI_USAGE;
     }
     /* Columns: three axes, then time and temperature when given. */
     if (a->columns != NULL) {

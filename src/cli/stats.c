@@ -117,7 +117,9 @@ int fe_cli_stats(int argc, char **argv)
     if (json) {
         printf("{\"file\": ");
         fe_cli_json_string(stdout, t.name);
-        printf(", \"rows\": %zu, \"columns\": [", t.rows);
+        printf(", \"rows\": %zu, \"bad_rows\": ", t.rows);
+        fe_cli_json_bad_rows(stdout);
+        printf(", \"columns\": [");
         for (size_t j = 0; j < k; j++) {
             printf("%s{\"name\": ", j ? ", " : "");
             fe_cli_json_string(stdout, t.names[cols[j]]);

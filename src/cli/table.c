@@ -16,7 +16,36 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <zlib.h>
+
 extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
+
+/* The reader's options (fe_cli_reader_configure) and the rows skipped in
+   the current pass of every table, by reason. */
+static int fe__cli_force_comma, fe__cli_skip_bad, fe__cli_stdin_used;
+static size_t fe__cli_bad_total[FE_CLI_BAD_REASONS];
+
+void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows)
+{
+    fe__cli_force_comma = decimal_comma;
+    fe__cli_skip_bad = skip_bad_rows;
+    fe__cli_stdin_used = 0;
+    memset(fe__cli_bad_total, 0, sizeof fe__cli_bad_total);
+}
+
+void fe_cli_bad_rows(size_t counts[FE_CLI_BAD_REASONS])
+{
+    memcpy(counts, fe__cli_bad_total, sizeof fe__cli_bad_total);
+}
+
+void fe_cli_json_bad_rows(FILE *out)
+{
+    size_t *b = fe__cli_bad_total;
+    fprintf(out, "{\"total\": %zu, \"empty_cell\": %zu, \"not_finite\": %zu, "
+                 "\"not_a_number\": %zu, \"field_count\": %zu}",
+            b[0] + b[1] + b[2] + b[3], b[FE_CLI_BAD_EMPTY], b[FE_CLI_BAD_NONFINITE],
+            b[FE_CLI_BAD_TEXT], b[FE_CLI_BAD_FIELDS]);
+}
 /* Table Includes ends here */
 /* [[file:../../literate/cli.org::Format a located message][Format a located message]] */
 static int fe__cli_at(const fe_cli_table *t, size_t line, size_t column,
@@ -45,6 +74,15 @@ static int fe__cli_line_error(const fe_cli_table *t, int rc, char *err,
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
                           "NUL byte: this is not a text file");
     default:
+        if (t->gz != NULL) {
+            int zerr = Z_OK;
+            const char *msg = gzerror((gzFile)t->gz, &zerr), *colon = strstr(msg, ": ");
+            if (colon != NULL)          /* zlib's "<fd:N>: " prefix */
+                msg = colon + 2;
+            if (zerr != Z_OK && zerr != Z_ERRNO)
+                return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
+                                  "corrupt or truncated gzip data (%s)", msg);
+        }
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_IO, err, errlen,
                           "read error: %s", strerror(errno));
     }
@@ -57,11 +95,105 @@ static int fe__cli_ignorable(const char *line)
     return *line == '\0' || *line == '#';
 }
 
-static int fe__cli_numeric(const fe_csv_field *f)
+/* A field as a number, by the table's convention: with a decimal comma
+   forced, only "1,5"; in a semicolon table "1,5" or "1.5". */
+static int fe__cli_number(const fe_cli_table *t, const fe_csv_field *f, double *v)
+{
+    int rc;
+    if (t->decimal_comma == 1)
+        return fe_csv_number_comma(f, v);
+    rc = fe_csv_number(f, v);
+    if (rc == FE_EPARSE && t->decimal_comma == 2 && strchr(f->text, ',') != NULL)
+        rc = fe_csv_number_comma(f, v);
+    return rc;
+}
+
+static int fe__cli_numeric(const fe_cli_table *t, const fe_csv_field *f)
 {
     double v;
-    int rc = fe_csv_number(f, &v);
+    int rc = fe__cli_number(t, f, &v);
     return rc == FE_OK || rc == FE_ENONFINITE;
+}
+
+/* Read through zlib (transparent for bytes that are not gzip). */
+static long fe__cli_gz_read(void *ctx, char *buf, size_t n)
+{
+    int got = gzread((gzFile)ctx, buf, (unsigned)(n > (1u << 30) ? (1u << 30) : n));
+    if (got < 0) {
+        int zerr;
+        gzerror((gzFile)ctx, &zerr);
+        if (zerr != Z_ERRNO)
+            errno = EIO;        /* the message comes from gzerror */
+        return -1;
+    }
+    if (got == 0) {
+        /* zlib ends a truncated stream as if it were complete (it reads
+           files still being written) and keeps Z_BUF_ERROR for gzerror. */
+        int zerr;
+        gzerror((gzFile)ctx, &zerr);
+        if (zerr == Z_BUF_ERROR) {
+            errno = EIO;
+            return -1;
+        }
+    }
+    return got;
+}
+
+/* Attach the zlib stream over a duplicate of t->fd and start the reader. */
+static int fe__cli_attach(fe_cli_table *t)
+{
+    int fd = dup(t->fd);
+    gzFile gz = fd >= 0 ? gzdopen(fd, "rb") : NULL;
+    if (gz == NULL) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    gzbuffer(gz, 1u << 16);
+    t->gz = gz;
+    return fe_csv_reader_init_read(&t->reader, fe__cli_gz_read, gz, t->buffer,
+                                   FE_CLI_LINE_MAX) == FE_OK ? 0 : -1;
+}
+
+/* Copy a non-seekable input once to an unlinked temporary file; the
+   descriptor of the copy, positioned at its start, or -1. */
+static int fe__cli_spool(int in)
+{
+    const char *dir = getenv("TMPDIR");
+    char path[4096], buf[1 << 16];
+    int fd;
+    if (dir == NULL || *dir == '\0')
+        dir = "/tmp";
+    if ((size_t)snprintf(path, sizeof path, "%s/foldest-spool-XXXXXX", dir) >= sizeof path)
+        return -1;
+    fe_cli_signals_hold(1);
+    fd = mkstemp(path);
+    if (fd >= 0)
+        unlink(path);           /* gone from the directory: nothing left behind */
+    fe_cli_signals_hold(0);
+    if (fd < 0)
+        return -1;
+    for (;;) {
+        ssize_t got = read(in, buf, sizeof buf), put = 0;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0)
+            break;
+        if (got == 0)
+            return lseek(fd, 0, SEEK_SET) == 0 ? fd : (close(fd), -1);
+        while (put < got) {
+            ssize_t w = write(fd, buf + put, (size_t)(got - put));
+            if (w < 0 && errno == EINTR)
+                continue;
+            if (w <= 0) {
+                close(fd);
+                return -1;
+            }
+            put += w;
+        }
+    }
+    close(fd);
+    return -1;
 }
 
 static char *fe__cli_strdup(const char *s)
@@ -80,8 +212,8 @@ static void fe__cli_free_lines(char **lines, size_t n)
         free(lines[i]);
 }
 
-int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
-                      char *err, size_t errlen)
+static int fe__cli_table_open(fe_cli_table *t, const char *path, long skip,
+                              int rewindable, char *err, size_t errlen)
 {
     char *look[FE_CLI_LOOKAHEAD];
     size_t look_line[FE_CLI_LOOKAHEAD], look_fields[FE_CLI_LOOKAHEAD];
@@ -92,6 +224,11 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     int rc;
 
     memset(t, 0, sizeof *t);
+    if (strcmp(path, "-") == 0 && fe__cli_stdin_used++) {
+        snprintf(err, errlen, "-: standard input can be read only once: give files for the other inputs");
+        t->fd = -1;
+        return FE_CLI_USAGE;
+    }
     t->name = strcmp(path, "-") == 0 ? "<stdin>" : path;
     t->fd = strcmp(path, "-") == 0 ? 0 : open(path, O_RDONLY);
     if (t->fd < 0) {
@@ -100,15 +237,27 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     }
     if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode))
         t->size = st.st_size;
+    else if (rewindable) {
+        int copy = fe__cli_spool(t->fd);
+        if (copy < 0) {
+            snprintf(err, errlen, "%s: cannot copy the input to a temporary file: %s",
+                     t->name, strerror(errno));
+            fe_cli_table_close(t);
+            return FE_CLI_IO;
+        }
+        if (t->fd > 0)
+            close(t->fd);
+        t->fd = copy;
+    }
     t->buffer = malloc(FE_CLI_LINE_MAX);
     t->scratch = malloc(FE_CLI_LINE_MAX);
     t->fields = malloc(FE_CLI_FIELDS_MAX * sizeof *t->fields);
-    if (t->buffer == NULL || t->scratch == NULL || t->fields == NULL) {
+    if (t->buffer == NULL || t->scratch == NULL || t->fields == NULL
+        || fe__cli_attach(t) != 0) {
         snprintf(err, errlen, "%s: out of memory", t->name);
         fe_cli_table_close(t);
         return FE_CLI_IO;
     }
-    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
 
     /* Skip what the user said to skip. */
     for (long i = 0; skip > 0 && i < skip; i++) {
@@ -135,8 +284,12 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
         }
         if (fe__cli_ignorable(line))
             continue;
-        if (nlook == 0)
+        if (nlook == 0) {
             t->delimiter = fe_csv_guess_delimiter(line);
+            if (fe__cli_force_comma && t->delimiter == ',')
+                t->delimiter = strchr(line, '\t') != NULL ? '\t' : FE_CSV_WHITESPACE;
+            t->decimal_comma = fe__cli_force_comma ? 1 : t->delimiter == ';' ? 2 : 0;
+        }
         look[nlook] = fe__cli_strdup(line);
         look_line[nlook] = t->reader.line;
         if (look[nlook] == NULL
@@ -188,8 +341,8 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
         if (copy1 != NULL && b != NULL)
             fe_csv_split(copy1, t->delimiter, b, FE_CLI_FIELDS_MAX, &nb, NULL);
         for (size_t j = 0; j < na && !is_header; j++)
-            if (!fe__cli_numeric(&a[j])
-                && (start + 1 == nlook || (j < nb && fe__cli_numeric(&b[j]))))
+            if (!fe__cli_numeric(t, &a[j])
+                && (start + 1 == nlook || (j < nb && fe__cli_numeric(t, &b[j]))))
                 is_header = 1;
         if (is_header)
             header = start;
@@ -224,6 +377,18 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     }
     t->progress = isatty(2) && t->size > (off_t)(1 << 22);
     return FE_CLI_OK;
+}
+
+int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
+                      char *err, size_t errlen)
+{
+    return fe__cli_table_open(t, path, skip, 0, err, errlen);
+}
+
+int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
+                                 char *err, size_t errlen)
+{
+    return fe__cli_table_open(t, path, skip, 1, err, errlen);
 }
 /* Open a table and find its header ends here */
 /* [[file:../../literate/cli.org::Find a column by name or number][Find a column by name or number]] */
@@ -273,6 +438,9 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 }
 /* Find a column by name or number ends here */
 /* [[file:../../literate/cli.org::Read the next row][Read the next row]] */
+static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
+                        size_t k, double *out, char *err, size_t errlen);
+
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen)
 {
@@ -301,33 +469,56 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
     if (rc == FE_EPARSE)
         return fe__cli_at(t, t->line, bad, FE_CLI_INPUT, err, errlen,
                           "unterminated or misplaced quote");
-    if (rc != FE_OK || nf != t->ncols)
+    if (rc != FE_OK || nf != t->ncols) {
+        if (fe__cli_skip_bad)
+            return fe__cli_skip(t, FE_CLI_BAD_FIELDS, cols, k, out, err, errlen);
         return fe__cli_at(t, t->line, 1, FE_CLI_INPUT, err, errlen,
                           "expected %zu fields, found %s%zu", t->ncols,
                           rc == FE_ESIZE ? "more than " : "", rc == FE_ESIZE ? (size_t)FE_CLI_FIELDS_MAX : nf);
+    }
     for (size_t i = 0; i < k; i++) {
         const fe_csv_field *f = &t->fields[cols[i]];
-        rc = fe_csv_number(f, &out[i]);
-        if (rc == FE_ENONFINITE)
+        int reason;
+        rc = fe__cli_number(t, f, &out[i]);
+        if (rc == FE_OK)
+            continue;
+        reason = f->text[0] == '\0' ? FE_CLI_BAD_EMPTY
+                 : rc == FE_ENONFINITE ? FE_CLI_BAD_NONFINITE : FE_CLI_BAD_TEXT;
+        if (fe__cli_skip_bad)
+            return fe__cli_skip(t, reason, cols, k, out, err, errlen);
+        if (reason == FE_CLI_BAD_EMPTY)
             return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
-                              "'%s' in column '%s' is not a finite number",
-                              f->text, t->names[cols[i]]);
-        if (rc != FE_OK)
-            return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
-                              "'%s' in column '%s' is not a number", f->text,
+                              "empty cell in column '%s' (--skip-bad-rows skips such rows)",
                               t->names[cols[i]]);
+        return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
+                          "'%s' in column '%s' is not a %snumber", f->text,
+                          t->names[cols[i]], reason == FE_CLI_BAD_NONFINITE ? "finite " : "");
     }
     t->rows++;
     return FE_OK;
 }
 
+/* Count a bad row and go on to the next one. */
+static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
+                        size_t k, double *out, char *err, size_t errlen)
+{
+    t->bad[reason]++;
+    fe__cli_bad_total[reason]++;
+    return fe_cli_table_next(t, cols, k, out, err, errlen);
+}
+
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
 {
-    if (t->fd == 0 || lseek(t->fd, 0, SEEK_SET) == (off_t)-1) {
+    if (lseek(t->fd, 0, SEEK_CUR) == (off_t)-1 || gzrewind((gzFile)t->gz) != 0) {
         snprintf(err, errlen, "%s: cannot read the input twice (a pipe?)", t->name);
         return FE_CLI_IO;
     }
-    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
+    fe_csv_reader_init_read(&t->reader, fe__cli_gz_read, t->gz, t->buffer, FE_CLI_LINE_MAX);
+    /* The skipped rows are counted again in the new pass. */
+    for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
+        fe__cli_bad_total[r] -= t->bad[r];
+        t->bad[r] = 0;
+    }
     /* Skip to just past the last looked-ahead line; replay the rest. */
     if (t->npending > 0) {
         size_t last = t->pending_line[t->npending - 1];
@@ -344,6 +535,16 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
 
 void fe_cli_table_close(fe_cli_table *t)
 {
+    size_t nbad = t->bad[0] + t->bad[1] + t->bad[2] + t->bad[3];
+    if (nbad > 0)
+        fprintf(stderr, "foldest: %s: skipped %zu bad rows (%zu with an empty cell, "
+                        "%zu with NaN or infinity, %zu with text, %zu with a wrong number "
+                        "of fields)\n", t->name, nbad, t->bad[FE_CLI_BAD_EMPTY],
+                t->bad[FE_CLI_BAD_NONFINITE], t->bad[FE_CLI_BAD_TEXT], t->bad[FE_CLI_BAD_FIELDS]);
+    memset(t->bad, 0, sizeof t->bad);
+    if (t->gz != NULL)
+        gzclose_r((gzFile)t->gz);
+    t->gz = NULL;
     if (t->fd > 0)
         close(t->fd);
     t->fd = -1;
@@ -481,10 +682,20 @@ void fe_cli_pending_clear(void)
         fe__cli_pending_used[i] = 0;
 }
 
+/* Set while the signals are held; a signal that a thread without the
+   main thread's mask (OpenBLAS starts its workers before main) catches
+   meanwhile is kept here and raised again when the hold ends. */
+static volatile sig_atomic_t fe__cli_held, fe__cli_deferred;
+
 /* Files first, then directories (which are then empty, if they were
    ours); only async-signal-safe calls. */
 static void fe__cli_on_signal(int sig)
 {
+    if (fe__cli_held) {
+        fe__cli_deferred = sig;
+        if (fe__cli_held)
+            return;             /* fe_cli_signals_hold(0) raises it */
+    }
     for (int pass = 1; pass <= 2; pass++)
         for (int i = 0; i < FE__CLI_PENDING; i++)
             if (fe__cli_pending_used[i] == pass) {
@@ -515,7 +726,15 @@ void fe_cli_signals_hold(int hold)
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
-    sigprocmask(hold ? SIG_BLOCK : SIG_UNBLOCK, &set, NULL);
+    if (hold) {
+        sigprocmask(SIG_BLOCK, &set, NULL);
+        fe__cli_held = 1;
+    } else {
+        fe__cli_held = 0;
+        sigprocmask(SIG_UNBLOCK, &set, NULL);
+        if (fe__cli_deferred)
+            raise(fe__cli_deferred);
+    }
 }
 /* Remove pending files when interrupted ends here */
 /* [[file:../../literate/cli.org::Check standard output at the end][Check standard output at the end]] */
@@ -570,7 +789,7 @@ void fe_cli_progress(fe_cli_table *t)
     off_t at;
     if (!t->progress || (t->rows & 0xffff) != 0)
         return;
-    at = lseek(t->fd, 0, SEEK_CUR);
+    at = t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
     if (at >= 0)
         fprintf(stderr, "\r%s: %3.0f%% (%zu rows)", t->name,
                 100.0 * (double)at / (double)t->size, t->rows);
