@@ -166,7 +166,7 @@ $(B)/tests/suites.h: $(TEST_SRC)
 	@mkdir -p $(@D)
 	sed -n 's/^Suite \*\(fe_[a-z0-9_]*_suite\)(void)$$/FE_SUITE(\1)/p' $(TEST_SRC) > $@
 
-TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"'
+TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"' -DFE_TEST_SRC='"$(abspath .)"'
 
 $(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \

@@ -186,6 +186,163 @@ START_TEST(gzip_files_read_like_plain_ones)
 }
 END_TEST
 
+/* ------------------------------------------------ JSON and its schemas */
+
+#ifndef FE_TEST_SRC
+#define FE_TEST_SRC "."
+#endif
+
+/* Run `cmd` (a shell command line writing JSON to stdout) into a file,
+   require exit status `status`, then validate the file against
+   doc/schema/SCHEMA with tests/schema/validate.py (python3, standard
+   library only).  The output is left in `out`. */
+static void json_valid(const char *cmd, int status, const char *schema, char *out, size_t outlen)
+{
+    char full[4096], file[64], msg[4096];
+    FILE *p;
+    size_t got;
+    int fd, rc;
+    snprintf(file, sizeof file, "/tmp/foldest-json-XXXXXX");
+    fd = mkstemp(file);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    snprintf(full, sizeof full, "%s > %s 2>/dev/null", cmd, file);
+    rc = system(full);
+    ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == status, "%s: status %d, want %d", cmd,
+                  WEXITSTATUS(rc), status);
+    p = fopen(file, "rb");
+    ck_assert_ptr_nonnull(p);
+    got = fread(out, 1, outlen - 1, p);
+    out[got] = '\0';
+    fclose(p);
+    snprintf(full, sizeof full, "python3 %s/tests/schema/validate.py %s/doc/schema/%s < %s 2>&1",
+             FE_TEST_SRC, FE_TEST_SRC, schema, file);
+    p = popen(full, "r");
+    ck_assert_ptr_nonnull(p);
+    got = fread(msg, 1, sizeof msg - 1, p);
+    msg[got] = '\0';
+    rc = pclose(p);
+    unlink(file);
+    ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == 0, "%s: output not valid against %s:\n%s\n%s",
+                  cmd, schema, msg, out);
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    ck_assert_ptr_nonnull(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+START_TEST(json_outputs_follow_their_schemas)
+{
+    static char out[1 << 16];
+    char dir[64], cmd[2048], path[256];
+    const char *F = FE_TEST_CLI;
+    snprintf(dir, sizeof dir, "/tmp/foldest-schema-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+
+    /* stats: a Latin-1 byte and a broken UTF-8 sequence in the header, a
+       good UTF-8 name, a tab and a quote: the JSON stays UTF-8, the bad
+       bytes become U+FFFD, the rest is escaped. */
+    snprintf(path, sizeof path, "%s/names.csv", dir);
+    write_text(path, "caf\xe9,\xe2\x82,\xce\xbcT,\"a\"\"b\tc\"\n0.1,1,2,3\n0.2,1,2,4\n,1,2,3\nNaN,1,1,1\n");
+    snprintf(cmd, sizeof cmd, "%s stats --skip-bad-rows --json %s", F, path);
+    json_valid(cmd, 0, "stats.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"name\": \"caf\\ufffd\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"\\ufffd\\ufffd\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"\xce\xbcT\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"a\\\"b\\u0009c\"") != NULL, "%s", out);
+    /* One number format: the shortest that reads back (15 to 17 digits). */
+    ck_assert_msg(strstr(out, "\"min\": 0.1, \"max\": 0.2}") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"bad_rows\": {\"total\": 2, \"empty_cell\": 1, \"not_finite\": 1") != NULL,
+                  "%s", out);
+
+    /* calibrate: a fit, and a refusal. */
+    snprintf(path, sizeof path, "%s/mag.csv", dir);
+    {
+        FILE *f = fopen(path, "w");
+        fe_rng g = fe_rng_seed(11);
+        ck_assert_ptr_nonnull(f);
+        fprintf(f, "t,mx,my,mz\n");
+        for (int i = 0; i < 2000; i++) {
+            double v[3];
+            fe_rng_unit_vector(&g, v);
+            fprintf(f, "%d,%.5f,%.5f,%.5f\n", i, 20 + 400 * v[0] + fe_rng_normal(&g),
+                    -10 + 380 * v[1] + fe_rng_normal(&g), 5 + 420 * v[2] + fe_rng_normal(&g));
+        }
+        fclose(f);
+    }
+    for (int m = 0; m < 3; m++) {
+        static const char *const model[] = {"sphere", "axial", "ellipsoid"};
+        snprintf(cmd, sizeof cmd, "%s calibrate --model %s --columns mx,my,mz --json %s", F, model[m], path);
+        json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
+    }
+    snprintf(path, sizeof path, "%s/plane.csv", dir);
+    write_text(path, "x,y,z\n1,0,0\n0,1,0\n-1,0,0\n0,-1,0\n0.7,0.7,0\n-0.7,0.7,0\n0.7,-0.7,0\n-0.7,-0.7,0\n"
+                     "0.6,0.8,0\n0.8,0.6,0\n-0.6,0.8,0\n0.8,-0.6,0\n");
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns x,y,z --json %s", F, path);
+    json_valid(cmd, 1, "calibrate.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"refusal\": \"") != NULL, "%s", out);
+
+    /* discover --sphere: an analysis, and a refusal. */
+    snprintf(cmd, sizeof cmd, "%s discover --sphere %s/mag.csv --columns mx,my,mz --json", F, dir);
+    json_valid(cmd, 0, "discover-sphere.schema.json", out, sizeof out);
+    snprintf(cmd, sizeof cmd, "%s discover --sphere %s --columns x,y,z --json", F, path);
+    json_valid(cmd, 1, "discover-sphere.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"verdict\": \"refused\"") != NULL, "%s", out);
+
+    /* discover: a concealed effect, and none. */
+    for (int e = 0; e < 2; e++) {
+        snprintf(cmd, sizeof cmd, "%s synth --effect %s --seed 5 --rows 20000 --real %s/r.csv --sim %s/s.csv "
+                 ">/dev/null 2>&1", F, e ? "none" : "quadratic_drag", dir, dir);
+        ck_assert_int_eq(system(cmd), 0);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel acceleration "
+                 "--role position=position --role velocity=velocity --role input=input --base bias,gain --json",
+                 F, dir, dir);
+        json_valid(cmd, 0, "discover.schema.json", out, sizeof out);
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
+/* The validator itself refuses what it must: invalid UTF-8, NaN, a
+   duplicate key, a missing required property, a wrong type. */
+START_TEST(schema_validator_refuses)
+{
+    static const char *const bad[] = {
+        "{\"file\": \"a\xff\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, \"not_finite\": 0, "
+        "\"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": NaN, \"bad_rows\": {}, \"columns\": []}",
+        "{\"file\": \"a\", \"file\": \"b\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, "
+        "\"not_finite\": 0, \"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": 1, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": \"1\", \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, \"not_finite\": 0, "
+        "\"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+    };
+    const char *good = "{\"file\": \"a\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, "
+                       "\"not_finite\": 0, \"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}";
+    for (size_t i = 0; i <= sizeof bad / sizeof bad[0]; i++) {
+        char path[64], cmd[1024];
+        int fd, rc;
+        const char *text = i < sizeof bad / sizeof bad[0] ? bad[i] : good;
+        snprintf(path, sizeof path, "/tmp/foldest-json-XXXXXX");
+        fd = mkstemp(path);
+        ck_assert_int_ge(fd, 0);
+        ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+        close(fd);
+        snprintf(cmd, sizeof cmd, "python3 %s/tests/schema/validate.py %s/doc/schema/stats.schema.json < %s 2>/dev/null",
+                 FE_TEST_SRC, FE_TEST_SRC, path);
+        rc = system(cmd);
+        unlink(path);
+        ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == (text == good ? 0 : 1), "case %zu: status %d", i,
+                      WEXITSTATUS(rc));
+    }
+}
+END_TEST
+
 START_TEST(binary_and_long_lines)
 {
     char out[4096], path[64], want[256];
@@ -301,6 +458,8 @@ Suite *fe_cli_suite(void)
     tcase_set_timeout(t, 60);
     tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
     tcase_add_test(t, binary_and_long_lines);
+    tcase_add_test(t, json_outputs_follow_their_schemas);
+    tcase_add_test(t, schema_validator_refuses);
     tcase_add_test(t, gzip_files_read_like_plain_ones);
     tcase_add_loop_test(t, usage_and_help, 0, (int)(sizeof usage_cases / sizeof usage_cases[0]));
     tcase_add_test(t, discover_sphere_in_words);

@@ -149,8 +149,12 @@ int fe_cli_parse_long(const char *opt, const char *text, long *value,
 /* Split "a,b,c" into at most `max` names (in place); the count or -1. */
 int fe_cli_split_list(char *text, char **items, int max);
 
-/* Print one JSON string, escaped. */
+/* Print one JSON string, escaped; bytes that are not UTF-8 become U+FFFD. */
 void fe_cli_json_string(FILE *out, const char *s);
+
+/* Print one JSON number: the shortest of 15, 16 or 17 significant digits
+   that reads back as the same double, or null when it is not finite. */
+void fe_cli_json_number(FILE *out, double x);
 
 #endif /* FOLDEST_CLI_H */
 /* Output Declarations ends here */

@@ -534,10 +534,7 @@ static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
 
 static void fe__json_number(FILE *f, double x)
 {
-    if (isfinite(x))
-        fprintf(f, "%.10g", x);
-    else
-        fprintf(f, "null");
+    fe_cli_json_number(f, x);   /* one format in every command (cli.org) */
 }
 
 /* `, "key": number`. */
@@ -1599,7 +1596,9 @@ static int fe__discover_sphere(fe__sphere_args *a)
         if (a->json) {
             printf("{\"verdict\": \"refused\", \"reason\": ");
             fe_cli_json_string(stdout, fe_sphere_refusal_string(fit.refusal));
-            printf(", \"coverage\": %.4g, \"n\": %zu}\n", fit.coverage, rows);
+            printf(", \"coverage\": ");
+            fe_cli_json_number(stdout, fit.coverage);
+            printf(", \"n\": %zu}\n", rows);
         }
         fprintf(stderr, "foldest discover: %s: the sphere is not determined by these data "
                         "(%s; coverage %.0f%% of the regions): nothing to compare against\n",
@@ -1698,31 +1697,50 @@ static int fe__discover_sphere(fe__sphere_args *a)
         const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
         const char *verdict = res->steps > 0 ? "mismatch explained" : "no significant mismatch";
         if (a->json) {
-            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu, "
-                   "\"radius\": %.10g, \"offset\": [%.10g, %.10g, %.10g], \"coverage\": %.4g, ",
-                   verdict, rows, held, fit.radius, fit.offset[0], fit.offset[1], fit.offset[2],
-                   fit.coverage);
-            printf("\"baseline\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
-                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, ", b0->rms, 100 * b0->rms / fit.radius,
-                   b0->bic, b0->heldout_rms, b0->lag1);
-            printf("\"final\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
-                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, \"discovered\": [", b1->rms,
-                   100 * b1->rms / fit.radius, b1->bic, b1->heldout_rms, b1->lag1);
+            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu",
+                   verdict, rows, held);
+            fe__json_pair(stdout, "radius", fit.radius);
+            printf(", \"offset\": [");
+            for (int c = 0; c < 3; c++) {
+                printf("%s", c ? ", " : "");
+                fe__json_number(stdout, fit.offset[c]);
+            }
+            printf("]");
+            fe__json_pair(stdout, "coverage", fit.coverage);
+            printf(", \"bad_rows\": ");
+            fe_cli_json_bad_rows(stdout);
+            for (int w = 0; w < 2; w++) {
+                const fe_discover_fit *b = w ? b1 : b0;
+                printf(", \"%s\": {\"rms\": ", w ? "final" : "baseline");
+                fe__json_number(stdout, b->rms);
+                fe__json_pair(stdout, "rms_percent", 100 * b->rms / fit.radius);
+                fe__json_pair(stdout, "bic", b->bic);
+                fe__json_pair(stdout, "heldout_rms", b->heldout_rms);
+                fe__json_pair(stdout, "lag1", b->lag1);
+                printf("}");
+            }
+            printf(", \"discovered\": [");
             for (size_t s = 0; s < res->steps; s++) {
                 const fe_discover_group *g = &groups[res->added[s]];
                 printf("%s{\"name\": \"%s\", \"description\": \"%s\", \"coefficients\": [",
                        s ? ", " : "", g->name, desc[res->added[s] < 5 ? res->added[s] : 5]);
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
-                        if (res->cols[j] == g->first + c)
-                            printf("%s%.6g", c ? ", " : "", res->coef[j]);
+                        if (res->cols[j] == g->first + c) {
+                            printf("%s", c ? ", " : "");
+                            fe__json_number(stdout, res->coef[j]);
+                        }
                 printf("], \"stderr\": [");
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
-                        if (res->cols[j] == g->first + c)
-                            printf("%s%.3g", c ? ", " : "", res->stderr_[j]);
-                printf("], \"statistic\": %.4g, \"p_value\": %.3g}", res->added_rank[s].statistic,
-                       res->added_rank[s].p_value);
+                        if (res->cols[j] == g->first + c) {
+                            printf("%s", c ? ", " : "");
+                            fe__json_number(stdout, res->stderr_[j]);
+                        }
+                printf("]");
+                fe__json_pair(stdout, "statistic", res->added_rank[s].statistic);
+                fe__json_pair(stdout, "p_value", res->added_rank[s].p_value);
+                printf("}");
             }
             printf("]}\n");
         } else {

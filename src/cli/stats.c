@@ -123,8 +123,15 @@ int fe_cli_stats(int argc, char **argv)
         for (size_t j = 0; j < k; j++) {
             printf("%s{\"name\": ", j ? ", " : "");
             fe_cli_json_string(stdout, t.names[cols[j]]);
-            printf(", \"mean\": %.17g, \"stddev\": %.17g, \"min\": %.17g, \"max\": %.17g}",
-                   fe_meanvar_mean(&mv[j]), fe_meanvar_stddev(&mv[j]), lo[j], hi[j]);
+            printf(", \"mean\": ");
+            fe_cli_json_number(stdout, fe_meanvar_mean(&mv[j]));
+            printf(", \"stddev\": ");
+            fe_cli_json_number(stdout, fe_meanvar_stddev(&mv[j]));
+            printf(", \"min\": ");
+            fe_cli_json_number(stdout, lo[j]);
+            printf(", \"max\": ");
+            fe_cli_json_number(stdout, hi[j]);
+            printf("}");
         }
         printf("]}\n");
     } else {
