@@ -45,6 +45,7 @@ typedef struct fe_cli_table {
     char **pending;             /* looked-ahead data lines, replayed first */
     size_t *pending_line;
     size_t npending, next_pending;
+    size_t look_end;            /* the last line the look-ahead read */
     fe_csv_field *fields;
     size_t line;                /* line number of the row last returned */
     size_t rows;                /* rows returned so far */

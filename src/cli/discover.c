@@ -45,7 +45,15 @@ typedef struct fe__pair {
     double min_step, last_real_t;
     int started;
     size_t skipped;
+    /* The simulation's median step (from a first scan of its times) and
+       its span; the recording's first time; rows left out, by reason. */
+    double step, sim_first, sim_last, first_real_t;
+    size_t outside[3];
+    int span_checked;
 } fe__pair;
+
+/* Why a recording row is outside the simulation. */
+enum { FE__BEFORE_START, FE__AFTER_END, FE__IN_GAP };
 
 /* Read the next simulation row into w[3], shifting the window left. */
 static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
@@ -83,9 +91,75 @@ static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
     return FE_CLI_OK;
 }
 
+/* Two simulation rows may be interpolated between when they are less
+   than five typical steps apart (the median step: bursts of fast rows do
+   not make every ordinary step a gap, as the smallest step did). */
 static int fe__linked(const fe__pair *p, const fe__simrow *a, const fe__simrow *b)
 {
-    return a->valid && b->valid && b->t - a->t <= 5.0 * p->min_step;
+    return a->valid && b->valid && b->t - a->t <= 5.0 * p->step;
+}
+
+static int fe__cmp_step(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Scan the simulation's times once: its median step and its span; then
+   rewind it.  A simulation whose time does not increase is reported by
+   the passes, with its line. */
+static int fe__sim_scan(fe__pair *p, char *err, size_t errlen)
+{
+    size_t n = 0, cap = 1024;
+    double *steps = malloc(cap * sizeof *steps), t, prev = 0.0;
+    int rc;
+    if (steps == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    p->step = 0.0;
+    while ((rc = fe_cli_table_next(&p->sim, p->sim_cols, 1, &t, err, errlen)) == FE_OK) {
+        if (p->sim.rows == 1)
+            p->sim_first = t;
+        else if (t > prev) {
+            if (n == cap) {
+                double *more = realloc(steps, 2 * cap * sizeof *steps);
+                if (more == NULL) {
+                    free(steps);
+                    snprintf(err, errlen, "out of memory");
+                    return FE_CLI_IO;
+                }
+                steps = more;
+                cap *= 2;
+            }
+            steps[n++] = t - prev;
+        }
+        prev = t;
+        p->sim_last = t;
+    }
+    if (n > 0) {
+        qsort(steps, n, sizeof *steps, fe__cmp_step);
+        p->step = steps[n / 2];
+    }
+    free(steps);
+    if (rc != FE_END)
+        return rc;
+    return fe_cli_table_rewind(&p->sim, err, errlen);
+}
+
+/* Say so when recording and simulation span times that differ a
+   hundredfold: seconds against milliseconds, say. */
+static void fe__check_spans(fe__pair *p)
+{
+    double real = p->last_real_t - p->first_real_t, sim = p->sim_last - p->sim_first;
+    if (p->span_checked || !(real > 0.0) || !(sim > 0.0))
+        return;
+    p->span_checked = 1;
+    if (real >= 100.0 * sim || sim >= 100.0 * real)
+        fprintf(stderr, "foldest discover: warning: %s spans %.6g time units but %s spans %.6g "
+                        "(%.0f times %s): do both use the same unit of time (seconds, milliseconds)?\n",
+                p->real.name, real, p->sim.name, sim, real > sim ? real / sim : sim / real,
+                real > sim ? "longer" : "shorter");
 }
 
 /* d(sim)/dt at window row i (1 or 2): central inside a segment. */
@@ -112,9 +186,13 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
     for (;;) {
         double t, lambda;
         rc = fe_cli_table_next(&p->real, p->real_cols, 2, v, err, errlen);
+        if (rc == FE_END)
+            fe__check_spans(p);
         if (rc != FE_OK)
             return rc;
         t = v[0];
+        if (p->real.rows == 1)
+            p->first_real_t = t;
         if (!(t > p->last_real_t)) {
             snprintf(err, errlen, "%s:%zu: time does not increase (%.17g after %.17g)",
                      p->real.name, p->real.line, t, p->last_real_t);
@@ -124,11 +202,29 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
         while (p->w[2].valid && p->w[2].t < t)
             if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
                 return rc;
-        if (!p->w[1].valid || t < p->w[1].t
-            || (!p->w[2].valid && t != p->w[1].t)
-            || (p->w[2].valid && !fe__linked(p, &p->w[1], &p->w[2]) && t != p->w[1].t)) {
-            p->skipped++;
-            continue;
+        /* Now w[1].t < t <= w[2].t, or the simulation has ended or not
+           begun.  A time the simulation has is always covered, whether it
+           lands on w[1] or on w[2] (the loop stops at w[2].t == t). */
+        {
+            int on1 = p->w[1].valid && t == p->w[1].t, on2 = p->w[2].valid && t == p->w[2].t;
+            if (!on1 && !on2
+                && (!p->w[1].valid || t < p->w[1].t || !p->w[2].valid
+                    || !fe__linked(p, &p->w[1], &p->w[2]))) {
+                p->skipped++;
+                p->outside[!p->w[1].valid || t < p->w[1].t ? FE__BEFORE_START
+                           : !p->w[2].valid ? FE__AFTER_END : FE__IN_GAP]++;
+                continue;
+            }
+            if (on2 && !on1) {  /* as if the window had moved one row on */
+                memset(out, 0, sizeof *out);
+                out->t = t;
+                out->real = v[1];
+                out->sim = p->w[2].s;
+                out->dsim = fe__dsim(p, 2);
+                for (int r = 0; r < FE__ROLES; r++)
+                    *fe__role(out, r) = p->w[2].role[r];
+                return FE_OK;
+            }
         }
         memset(out, 0, sizeof *out);
         out->t = t;
@@ -157,6 +253,7 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
     memset(p->w, 0, sizeof p->w);
     p->started = 0;
     p->skipped = 0;
+    memset(p->outside, 0, sizeof p->outside);
     p->min_step = 0.0;
     return rc;
 }
@@ -455,14 +552,14 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
         p->role_col[r] = (int)k++;
         *roles |= 1u << r;
     }
-    return FE_CLI_OK;
+    return fe__sim_scan(p, err, errlen);
 }
 /* Open a pair and find its columns ends here */
 /* [[file:../../literate/cli_discover.org::Read the pairs as one stream][Read the pairs as one stream]] */
 typedef struct fe__stream {
     fe__discover_args *a;
     size_t cur;
-    size_t skipped;
+    size_t skipped, outside[3];
 } fe__stream;
 
 /* Returns FE_OK, FE_END, or an exit status; *new_pair is set when the
@@ -478,6 +575,8 @@ static int fe__stream_next(fe__stream *st, fe_sample *s, int *new_pair, char *er
         if (rc != FE_END)
             return rc;
         st->skipped += p->skipped;
+        for (int k = 0; k < 3; k++)
+            st->outside[k] += p->outside[k];
         st->cur++;
         *new_pair = 1;
     }
@@ -488,6 +587,7 @@ static int fe__stream_rewind(fe__stream *st, char *err, size_t errlen)
 {
     st->cur = 0;
     st->skipped = 0;
+    memset(st->outside, 0, sizeof st->outside);
     for (size_t i = 0; i < st->a->npairs; i++) {
         int rc = fe__pair_rewind(&st->a->pairs[i], err, errlen);
         if (rc != FE_CLI_OK)
@@ -504,6 +604,7 @@ typedef struct fe__outcome {
     size_t nbase;
     double baseline_coef[FE_DISCOVER_MAX_COLUMNS];
     size_t rows, skipped, fit, heldout, blocks;
+    size_t outside[3];                          /* skipped, by reason */
     double alpha;
     fe__located located[128];
     size_t nlocated;
@@ -613,7 +714,10 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     const fe_discover_result *r = o->r;
     fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
     fprintf(f, "\"rows\": {\"compared\": %zu, \"outside_simulation\": %zu, \"fit\": %zu, "
-               "\"heldout\": %zu}, \"bad_rows\": ", o->rows, o->skipped, o->fit, o->heldout);
+               "\"heldout\": %zu, \"outside_by_reason\": {\"before_start\": %zu, "
+               "\"after_end\": %zu, \"in_gap\": %zu}}, \"bad_rows\": ", o->rows, o->skipped,
+            o->fit, o->heldout, o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END],
+            o->outside[FE__IN_GAP]);
     fe_cli_json_bad_rows(f);
     fprintf(f, ", ");
     fprintf(f, "\"base\": [");
@@ -759,8 +863,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     const fe_discover_result *r = o->r;
     fe_discover_rank sorted[FE_DISCOVER_MAX_GROUPS];
     double rel;
-    fprintf(f, "compared %zu rows (%zu outside the simulation): %zu fitted, %zu held out\n",
-            o->rows, o->skipped, o->fit, o->heldout);
+    fprintf(f, "compared %zu rows (%zu outside the simulation", o->rows, o->skipped);
+    if (o->skipped > 0)
+        fprintf(f, ": %zu before it starts, %zu after it ends, %zu in its gaps",
+                o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END], o->outside[FE__IN_GAP]);
+    fprintf(f, "): %zu fitted, %zu held out\n", o->fit, o->heldout);
     fprintf(f, "baseline (simulation");
     for (size_t i = 0; i < o->nbase; i++)
         fprintf(f, " + %s", o->c->terms[o->base[i]].name);
@@ -1048,6 +1155,7 @@ int fe_cli_discover(int argc, char **argv)
     st.a = &a;
     st.cur = 0;
     st.skipped = 0;
+    memset(st.outside, 0, sizeof st.outside);
 
     /* Pass 1: scale and ranges. */
     for (int r = 0; r < FE__ROLES; r++) {
@@ -1077,6 +1185,7 @@ int fe_cli_discover(int argc, char **argv)
         }
     }
     out.skipped = st.skipped;
+    memcpy(out.outside, st.outside, sizeof out.outside);
     scale.temperature_kelvin = kelvin[2];
     scale.ambient_kelvin = kelvin[3];
     if (fe_catalog_init(&cat, roles, &scale) != FE_OK)

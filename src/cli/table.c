@@ -300,6 +300,7 @@ static int fe__cli_table_open(fe_cli_table *t, const char *path, long skip,
         }
         look_fields[nlook++] = nf;
     }
+    t->look_end = t->reader.line;
     if (nlook == 0) {
         snprintf(err, errlen, "%s: no data: the file is empty", t->name);
         fe_cli_table_close(t);
@@ -520,12 +521,12 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
         fe__cli_bad_total[r] -= t->bad[r];
         t->bad[r] = 0;
     }
-    /* Skip to just past the last looked-ahead line; replay the rest. */
-    if (t->npending > 0) {
-        size_t last = t->pending_line[t->npending - 1];
+    /* Skip to just past the last looked-ahead line (a header with no data
+       after it too); replay the looked-ahead data lines. */
+    {
         char *line;
         size_t len;
-        while (t->reader.line < last)
+        while (t->reader.line < t->look_end)
             if (fe_csv_next_line(&t->reader, &line, &len) == FE_END)
                 break;
     }
