@@ -58,12 +58,20 @@ typedef struct fe__calibrate_args {
 
 /* Parse argv; FE_CLI_OK, or an exit status after printing why (-1 for
    --help, printed). */
+static const fe_cli_option fe__calibrate_options[] = {
+    {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
+    {"--trace", 0}, {NULL, 0}};
+
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
     char err[512];
+    int rc;
     memset(a, 0, sizeof *a);
     a->skip = -1;
     a->model = FE_FIT_AXIAL;
+    rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(fe__calibrate_help, stdout);

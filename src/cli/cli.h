@@ -63,6 +63,8 @@ enum { FE_CLI_BAD_EMPTY, FE_CLI_BAD_NONFINITE, FE_CLI_BAD_TEXT,
 /* The reader's options, for every table the process opens (set by the
    dispatcher from --decimal-comma and --skip-bad-rows). */
 void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows);
+/* Turn on one reader option by its flag (from a command's options). */
+void fe_cli_reader_option(const char *flag);
 
 /* Rows skipped by --skip-bad-rows in the last pass over every table,
    by reason; and the same as a JSON object. */
@@ -140,6 +142,26 @@ int fe_cli_spawn(char *const argv[]);
    is large; call once per row, cheap; fe_cli_progress_done clears it. */
 void fe_cli_progress(fe_cli_table *t);
 void fe_cli_progress_done(fe_cli_table *t);
+
+/* A command's option: its long form ("--real") and whether it takes a
+   value.  A table ends with {NULL, 0}. */
+typedef struct fe_cli_option {
+    const char *flag;
+    int takes_value;
+} fe_cli_option;
+
+/* fe_cli_options: parse argv (argv[0] the command's name) with
+   getopt_long against `opts`, plus --help/-h, --version/-V and the
+   reader's --decimal-comma and --skip-bad-rows, which every command
+   takes: --opt=value and --opt value, unambiguous abbreviations, options
+   and operands in any order.  On success *argcp and *argvp are replaced by
+   a canonical vector: argv[0], then each option as its full flag followed
+   by its value, then the operands; --help alone if it was asked for.
+   Returns FE_CLI_OK; -1 after printing the version; FE_CLI_USAGE after
+   printing "foldest COMMAND: unknown option '--x'; did you mean '--y'?",
+   an ambiguous abbreviation with its candidates, or a missing value. */
+int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
+                   char ***argvp);
 
 /* Parse option values; FE_CLI_USAGE with a message on error. */
 int fe_cli_parse_double(const char *opt, const char *text, double *value,

@@ -1100,6 +1100,13 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const char *p
 /* [[file:../../literate/cli_discover.org::Run discovery on recordings][Run discovery on recordings]] */
 static int fe__discover_sphere_main(int argc, char **argv);
 
+/* Every option of discover and of discover --sphere (cli.org's
+   fe_cli_options parses them; the loops below read the canonical form). */
+static const fe_cli_option fe__discover_options[] = {
+    {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
+    {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--blocks", 1}, {"--alpha", 1},
+    {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
+
 int fe_cli_discover(int argc, char **argv)
 {
     fe__discover_args a;
@@ -1129,6 +1136,9 @@ int fe_cli_discover(int argc, char **argv)
     double *per_g = NULL;
 
     memset(&out, 0, sizeof out);
+    rc = fe_cli_options("discover", fe__discover_options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc < 0 ? FE_CLI_OK : rc;
     for (int i = 1; i < argc; i++)
         if (strcmp(argv[i], "--sphere") == 0)
             return fe__discover_sphere_main(argc, argv);

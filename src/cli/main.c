@@ -55,7 +55,7 @@ int main(int argc, char **argv)
         fe__cli_overview(argc < 2 ? stderr : stdout);
         return fe_cli_finish(NULL, argc < 2 ? FE_CLI_USAGE : FE_CLI_OK);
     }
-    if (strcmp(argv[1], "--version") == 0) {
+    if (strcmp(argv[1], "--version") == 0 || strcmp(argv[1], "-V") == 0) {
         printf("foldest %s\n", FE_VERSION);
         return fe_cli_finish(NULL, FE_CLI_OK);
     }

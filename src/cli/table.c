@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <getopt.h>
 #include <zlib.h>
 
 extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
@@ -32,6 +33,14 @@ void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows)
     fe__cli_skip_bad = skip_bad_rows;
     fe__cli_stdin_used = 0;
     memset(fe__cli_bad_total, 0, sizeof fe__cli_bad_total);
+}
+
+void fe_cli_reader_option(const char *flag)
+{
+    if (strcmp(flag, "--decimal-comma") == 0)
+        fe__cli_force_comma = 1;
+    else if (strcmp(flag, "--skip-bad-rows") == 0)
+        fe__cli_skip_bad = 1;
 }
 
 void fe_cli_bad_rows(size_t counts[FE_CLI_BAD_REASONS])
@@ -801,6 +810,148 @@ void fe_cli_progress_done(fe_cli_table *t)
 {
     if (t->progress)
         fprintf(stderr, "\r%*s\r", 60, "");
+}
+
+/* Edit distance (insertions, deletions, substitutions, transpositions)
+   between a and b, up to 63 bytes each; larger when longer. */
+static size_t fe__cli_distance(const char *a, const char *b)
+{
+    size_t n = strlen(a), m = strlen(b), d[64][64];
+    if (n > 63 || m > 63)
+        return 64;
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            size_t best = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < best)
+                best = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < best)
+                best = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]
+                && d[i - 2][j - 2] + 1 < best)
+                best = d[i - 2][j - 2] + 1;
+            d[i][j] = best;
+        }
+    return d[n][m];
+}
+
+enum { FE__CLI_OPTS_MAX = 48, FE__CLI_ARGV_MAX = 4096 };
+
+/* The options every command takes, after its own. */
+static const fe_cli_option fe__cli_common[] = {
+    {"--help", 0}, {"--version", 0}, {"--decimal-comma", 0}, {"--skip-bad-rows", 0}, {NULL, 0}};
+
+/* Say what is wrong with the option argv[at] (getopt_long refused it). */
+static void fe__cli_bad_option(const char *command, const char *arg, const struct option *lo,
+                               int missing_value)
+{
+    char name[128];
+    const char *best = NULL;
+    size_t len, best_d = (size_t)-1, prefixed = 0;
+    if (missing_value) {
+        fprintf(stderr, "foldest %s: option '%s' needs a value\n", command, arg);
+        return;
+    }
+    if (arg[0] != '-' || arg[1] != '-') {
+        fprintf(stderr, "foldest %s: unknown option '%s'\n", command, arg);
+        return;
+    }
+    snprintf(name, sizeof name, "%s", arg + 2);
+    name[strcspn(name, "=")] = '\0';
+    len = strlen(name);
+    for (const struct option *o = lo; o->name != NULL; o++)
+        prefixed += len > 0 && strncmp(o->name, name, len) == 0;
+    if (prefixed > 1) {
+        fprintf(stderr, "foldest %s: ambiguous option '--%s': it could be", command, name);
+        for (const struct option *o = lo; o->name != NULL; o++)
+            if (strncmp(o->name, name, len) == 0)
+                fprintf(stderr, " --%s", o->name);
+        fputc('\n', stderr);
+        return;
+    }
+    for (const struct option *o = lo; o->name != NULL; o++) {
+        size_t d = fe__cli_distance(name, o->name);
+        if (d < best_d) {
+            best_d = d;
+            best = o->name;
+        }
+    }
+    if (best != NULL && best_d <= (len < 6 ? 1 : len < 12 ? 2 : 3))
+        fprintf(stderr, "foldest %s: unknown option '--%s'; did you mean '--%s'?\n", command,
+                name, best);
+    else
+        fprintf(stderr, "foldest %s: unknown option '--%s'\n", command, name);
+}
+
+int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
+                   char ***argvp)
+{
+    static struct option lo[FE__CLI_OPTS_MAX + 1];
+    static const char *flag_of[FE__CLI_OPTS_MAX];
+    static char *out[FE__CLI_ARGV_MAX + 1];
+    int argc = *argcp, n = 0, k = 1, c, index;
+    char **argv = *argvp;
+    const fe_cli_option *tables[2] = {opts, fe__cli_common};
+
+    /* getopt_long's table from ours, the common options after. */
+    for (int t = 0; t < 2; t++)
+        for (const fe_cli_option *o = tables[t]; o != NULL && o->flag != NULL; o++) {
+            if (n == FE__CLI_OPTS_MAX)
+                return FE_CLI_USAGE;
+            lo[n].name = o->flag + 2;
+            lo[n].has_arg = o->takes_value ? required_argument : no_argument;
+            lo[n].flag = NULL;
+            lo[n].val = 256 + n;
+            flag_of[n++] = o->flag;
+        }
+    memset(&lo[n], 0, sizeof lo[n]);
+    if (argc > FE__CLI_ARGV_MAX) {
+        fprintf(stderr, "foldest %s: more than %d arguments\n", command, FE__CLI_ARGV_MAX);
+        return FE_CLI_USAGE;
+    }
+    /* Options first, in the canonical form. */
+    out[0] = argv[0];
+    optind = 0;                 /* a fresh scan, even if main runs again */
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":hV", lo, &index)) != -1) {
+        const char *flag;
+        if (c == '?' || c == ':') {
+            const char *arg = optopt != 0 && optopt < 256 ? NULL : argv[optind - 1];
+            char shortopt[3] = {'-', (char)optopt, '\0'};
+            fe__cli_bad_option(command, arg != NULL ? arg : shortopt, lo, c == ':');
+            fprintf(stderr, "'foldest %s --help' for usage\n", command);
+            return FE_CLI_USAGE;
+        }
+        flag = c == 'h' ? "--help" : c == 'V' ? "--version" : flag_of[c - 256];
+        if (strcmp(flag, "--version") == 0) {
+            printf("foldest %s\n", FE_VERSION);
+            return -1;
+        }
+        if (strcmp(flag, "--help") == 0) {
+            out[1] = (char *)"--help";
+            out[2] = NULL;
+            *argcp = 2;
+            *argvp = out;
+            return FE_CLI_OK;
+        }
+        if (strcmp(flag, "--decimal-comma") == 0 || strcmp(flag, "--skip-bad-rows") == 0) {
+            fe_cli_reader_option(flag);
+            continue;
+        }
+        out[k++] = (char *)flag;
+        if (c >= 256 && lo[c - 256].has_arg == required_argument)
+            out[k++] = optarg;
+    }
+    /* Then the operands, which getopt_long has moved to the end. */
+    while (optind < argc)
+        out[k++] = argv[optind++];
+    out[k] = NULL;
+    *argcp = k;
+    *argvp = out;
+    return FE_CLI_OK;
 }
 
 int fe_cli_parse_double(const char *opt, const char *text, double *value,
