@@ -343,6 +343,66 @@ START_TEST(schema_validator_refuses)
 }
 END_TEST
 
+/* Every option the bash completion offers for a command is in the
+   command's man page and is accepted by the command (as --opt or
+   --opt=value, before --help), and the man pages list the common ones. */
+START_TEST(options_documented_completed_and_accepted)
+{
+    static const char *const commands[] = {"stats", "calibrate", "discover", "synth"};
+    static char completion[16384], page[16384];
+    char path[512];
+    FILE *f;
+    size_t n;
+    snprintf(path, sizeof path, "%s/doc/completion/foldest.bash", FE_TEST_SRC);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    n = fread(completion, 1, sizeof completion - 1, f);
+    completion[n] = '\0';
+    fclose(f);
+    for (size_t c = 0; c < sizeof commands / sizeof commands[0]; c++) {
+        char key[64], opts[1024], *at, *end;
+        int count = 0;
+        snprintf(path, sizeof path, "%s/doc/man/foldest-%s.1", FE_TEST_SRC, commands[c]);
+        f = fopen(path, "r");
+        ck_assert_ptr_nonnull(f);
+        n = fread(page, 1, sizeof page - 1, f);
+        page[n] = '\0';
+        fclose(f);
+        snprintf(key, sizeof key, "%s) opts=\"", commands[c]);
+        at = strstr(completion, key);
+        ck_assert_msg(at != NULL, "no options for %s in the completion", commands[c]);
+        at += strlen(key);
+        end = strchr(at, '"');
+        ck_assert_ptr_nonnull(end);
+        snprintf(opts, sizeof opts, "%.*s", (int)(end - at), at);
+        for (char *o = strtok(opts, " \n"); o != NULL; o = strtok(NULL, " \n")) {
+            char man[64], cmd[512];
+            int plain, valued;
+            snprintf(man, sizeof man, "\\-\\-%s", o + 2);
+            ck_assert_msg(strstr(page, man) != NULL, "%s: %s not in its man page", commands[c], o);
+            snprintf(cmd, sizeof cmd, "%s %s %s --help >/dev/null 2>&1", FE_TEST_CLI, commands[c], o);
+            plain = system(cmd);
+            snprintf(cmd, sizeof cmd, "%s %s %s=x --help >/dev/null 2>&1", FE_TEST_CLI, commands[c], o);
+            valued = system(cmd);
+            ck_assert_msg((WIFEXITED(plain) && WEXITSTATUS(plain) == 0)
+                          || (WIFEXITED(valued) && WEXITSTATUS(valued) == 0),
+                          "%s does not accept %s", commands[c], o);
+            count++;
+        }
+        ck_assert_int_ge(count, 3);
+    }
+    snprintf(path, sizeof path, "%s/doc/man/foldest.1", FE_TEST_SRC);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    n = fread(page, 1, sizeof page - 1, f);
+    page[n] = '\0';
+    fclose(f);
+    ck_assert(strstr(page, "\\-\\-decimal\\-comma") != NULL);
+    ck_assert(strstr(page, "\\-\\-skip\\-bad\\-rows") != NULL);
+    ck_assert(strstr(page, "\\-V") != NULL);
+}
+END_TEST
+
 START_TEST(binary_and_long_lines)
 {
     char out[4096], path[64], want[256];
@@ -479,6 +539,7 @@ Suite *fe_cli_suite(void)
     tcase_add_test(t, binary_and_long_lines);
     tcase_add_test(t, json_outputs_follow_their_schemas);
     tcase_add_test(t, schema_validator_refuses);
+    tcase_add_test(t, options_documented_completed_and_accepted);
     tcase_add_test(t, gzip_files_read_like_plain_ones);
     tcase_add_loop_test(t, usage_and_help, 0, (int)(sizeof usage_cases / sizeof usage_cases[0]));
     tcase_add_test(t, discover_sphere_in_words);
