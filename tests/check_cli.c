@@ -210,11 +210,7 @@ static void json_valid(const char *cmd, int status, const char *schema, char *ou
     rc = system(full);
     ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == status, "%s: status %d, want %d", cmd,
                   WEXITSTATUS(rc), status);
-    p = fopen(file, "rb");
-    ck_assert_ptr_nonnull(p);
-    got = fread(out, 1, outlen - 1, p);
-    out[got] = '\0';
-    fclose(p);
+    fe_test_read_file(file, out, outlen);
     snprintf(full, sizeof full, "python3 %s/tests/schema/validate.py %s/doc/schema/%s < %s 2>&1",
              FE_TEST_SRC, FE_TEST_SRC, schema, file);
     p = popen(full, "r");
@@ -351,23 +347,13 @@ START_TEST(options_documented_completed_and_accepted)
     static const char *const commands[] = {"stats", "calibrate", "discover", "synth"};
     static char completion[16384], page[16384];
     char path[512];
-    FILE *f;
-    size_t n;
     snprintf(path, sizeof path, "%s/doc/completion/foldest.bash", FE_TEST_SRC);
-    f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    n = fread(completion, 1, sizeof completion - 1, f);
-    completion[n] = '\0';
-    fclose(f);
+    fe_test_read_file(path, completion, sizeof completion);
     for (size_t c = 0; c < sizeof commands / sizeof commands[0]; c++) {
         char key[64], opts[1024], *at, *end;
         int count = 0;
         snprintf(path, sizeof path, "%s/doc/man/foldest-%s.1", FE_TEST_SRC, commands[c]);
-        f = fopen(path, "r");
-        ck_assert_ptr_nonnull(f);
-        n = fread(page, 1, sizeof page - 1, f);
-        page[n] = '\0';
-        fclose(f);
+        fe_test_read_file(path, page, sizeof page);
         snprintf(key, sizeof key, "%s) opts=\"", commands[c]);
         at = strstr(completion, key);
         ck_assert_msg(at != NULL, "no options for %s in the completion", commands[c]);
@@ -392,11 +378,7 @@ START_TEST(options_documented_completed_and_accepted)
         ck_assert_int_ge(count, 3);
     }
     snprintf(path, sizeof path, "%s/doc/man/foldest.1", FE_TEST_SRC);
-    f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    n = fread(page, 1, sizeof page - 1, f);
-    page[n] = '\0';
-    fclose(f);
+    fe_test_read_file(path, page, sizeof page);
     ck_assert(strstr(page, "\\-\\-decimal\\-comma") != NULL);
     ck_assert(strstr(page, "\\-\\-skip\\-bad\\-rows") != NULL);
     ck_assert(strstr(page, "\\-V") != NULL);

@@ -185,9 +185,26 @@ START_TEST(byte_order_mark_semicolons_and_read_functions)
 }
 END_TEST
 
+struct number_case { const char *text; int rc; double value; };
+
+/* Each case through `parse`: its status, its value, and an untouched
+   value on a refusal. */
+static void check_numbers(int (*parse)(const fe_csv_field *, double *),
+                          const struct number_case *cases, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char text[64];
+        fe_csv_field f = {text, 1};
+        double v = -7.0;
+        strcpy(text, cases[i].text);
+        ck_assert_msg(parse(&f, &v) == cases[i].rc, "'%s'", cases[i].text);
+        ck_assert_double_eq(v, cases[i].rc == FE_OK ? cases[i].value : -7.0);
+    }
+}
+
 START_TEST(strtod_extensions_are_not_numbers)
 {
-    static const struct { const char *text; int rc; double value; } cases[] = {
+    static const struct number_case cases[] = {
         {"0x1p3", FE_EPARSE, 0}, {"0x10", FE_EPARSE, 0}, {"-0X1.8P1", FE_EPARSE, 0},
         {"nan", FE_ENONFINITE, 0}, {"NaN", FE_ENONFINITE, 0}, {"-inf", FE_ENONFINITE, 0},
         {"+Infinity", FE_ENONFINITE, 0}, {"nan(123)", FE_EPARSE, 0}, {"infinit", FE_EPARSE, 0},
@@ -197,31 +214,13 @@ START_TEST(strtod_extensions_are_not_numbers)
         {".5", FE_OK, 0.5}, {"5.", FE_OK, 5.0}, {"-1.25e-3", FE_OK, -1.25e-3},
         {"1e-400", FE_OK, 0.0},
     };
-    static const struct { const char *text; int rc; double value; } comma[] = {
+    static const struct number_case comma[] = {
         {"1,5", FE_OK, 1.5}, {"-0,25e2", FE_OK, -25.0}, {"3", FE_OK, 3.0},
         {"1.5", FE_EPARSE, 0}, {"1.234,5", FE_EPARSE, 0}, {"1,2,3", FE_EPARSE, 0},
         {"0x1,8p1", FE_EPARSE, 0}, {"nan", FE_ENONFINITE, 0},
     };
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        char text[64];
-        fe_csv_field f = {text, 1};
-        double v = -7.0;
-        strcpy(text, cases[i].text);
-        ck_assert_msg(fe_csv_number(&f, &v) == cases[i].rc, "'%s'", cases[i].text);
-        if (cases[i].rc == FE_OK)
-            ck_assert_double_eq(v, cases[i].value);
-        else
-            ck_assert_double_eq(v, -7.0);        /* untouched */
-    }
-    for (size_t i = 0; i < sizeof comma / sizeof comma[0]; i++) {
-        char text[64];
-        fe_csv_field f = {text, 1};
-        double v = -7.0;
-        strcpy(text, comma[i].text);
-        ck_assert_msg(fe_csv_number_comma(&f, &v) == comma[i].rc, "'%s'", comma[i].text);
-        if (comma[i].rc == FE_OK)
-            ck_assert_double_eq(v, comma[i].value);
-    }
+    check_numbers(fe_csv_number, cases, sizeof cases / sizeof cases[0]);
+    check_numbers(fe_csv_number_comma, comma, sizeof comma / sizeof comma[0]);
 }
 END_TEST
 

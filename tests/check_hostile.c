@@ -414,14 +414,8 @@ static int any_named(const char *d, const char *part)
 static void read_stderr(const char *d, char *buf, size_t len)
 {
     char path[256];
-    FILE *f;
-    size_t got;
     snprintf(path, sizeof path, "%s/stderr.txt", d);
-    f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    got = fread(buf, 1, len - 1, f);
-    buf[got] = '\0';
-    fclose(f);
+    fe_test_read_file(path, buf, len);
 }
 
 /* A valid recording d/good.csv: a header and GOOD_ROWS samples. */

@@ -144,34 +144,46 @@ struct ba {
     int hold;                    /* camera 0 held at cam0 */
 };
 
-/* Globals: the free cameras (1..9, or all 10); blocks: landmarks. */
+/* The bearing residual of camera i and landmark j at x, wrapped into
+   (-pi, pi]; jl gets its gradient with respect to the landmark (that with
+   respect to the camera is -jl); *cam is the index of camera i's x among
+   the parameters, or -1 when the camera is held.  Globals: the free
+   cameras (1..9, or all 10); blocks: landmarks. */
+static double ba_residual(const struct ba *b, const double *x, int i, int j, double jl[2],
+                          int *cam)
+{
+    const double pi = 3.14159265358979323846;
+    int h = b->hold ? 2 : 0, free_cam = !(b->hold && i == 0);
+    double cx = free_cam ? x[2 * i - h] : b->cam0[0];
+    double cy = free_cam ? x[2 * i + 1 - h] : b->cam0[1];
+    const double *l = x + 2 * NC - h + 2 * j;
+    double dx = l[0] - cx, dy = l[1] - cy, q = dx * dx + dy * dy;
+    double f = atan2(dy, dx) - b->theta[i][j];
+    jl[0] = -dy / q;
+    jl[1] = dx / q;
+    *cam = free_cam ? 2 * i - h : -1;
+    return f - 2.0 * pi * floor(f / (2.0 * pi) + 0.5);
+}
+
 static int ba_model(const double *x, fe_lm_sink *s, void *ctx)
 {
     const struct ba *b = ctx;
-    const double pi = 3.14159265358979323846;
-    int h = b->hold ? 2 : 0, ng = 2 * NC - h;
     double jg[2 * NC] = {0};
-    for (int i = 0; i < NC; i++) {
-        int free_cam = !(b->hold && i == 0);
-        double cx = free_cam ? x[2 * i - h] : b->cam0[0];
-        double cy = free_cam ? x[2 * i + 1 - h] : b->cam0[1];
+    for (int i = 0; i < NC; i++)
         for (int j = 0; j < NLM; j++) {
-            const double *l = x + ng + 2 * j;
-            double dx = l[0] - cx, dy = l[1] - cy, q = dx * dx + dy * dy;
-            double f = atan2(dy, dx) - b->theta[i][j], jl[2] = {-dy / q, dx / q};
-            int rc;
-            f -= 2.0 * pi * floor(f / (2.0 * pi) + 0.5);
-            if (free_cam) {
-                jg[2 * i - h] = dy / q;
-                jg[2 * i + 1 - h] = -dx / q;
+            double jl[2];
+            int cam, rc;
+            double f = ba_residual(b, x, i, j, jl, &cam);
+            if (cam >= 0) {
+                jg[cam] = -jl[0];
+                jg[cam + 1] = -jl[1];
             }
             rc = fe_lm_emit(s, f, 1.0, jg, (size_t)j, jl);
-            if (free_cam)
-                jg[2 * i - h] = jg[2 * i + 1 - h] = 0.0;
+            if (cam >= 0)
+                jg[cam] = jg[cam + 1] = 0.0;
             if (rc != FE_OK)
                 return rc;
         }
-    }
     return FE_OK;
 }
 
@@ -253,38 +265,26 @@ END_TEST
    the solver. */
 static double ba_cost(const struct ba *b, const double *x, double *g, double *diag)
 {
-    const double pi = 3.14159265358979323846;
-    int h = b->hold ? 2 : 0, ng = 2 * NC - h;
+    int np = 2 * NC - (b->hold ? 2 : 0) + 2 * NLM;
     long double cost = 0.0L;
     if (g != NULL)
-        for (int k = 0; k < ng + 2 * NLM; k++)
+        for (int k = 0; k < np; k++)
             g[k] = diag[k] = 0.0;
-    for (int i = 0; i < NC; i++) {
-        int free_cam = !(b->hold && i == 0);
-        double cx = free_cam ? x[2 * i - h] : b->cam0[0];
-        double cy = free_cam ? x[2 * i + 1 - h] : b->cam0[1];
+    for (int i = 0; i < NC; i++)
         for (int j = 0; j < NLM; j++) {
-            const double *l = x + ng + 2 * j;
-            double dx = l[0] - cx, dy = l[1] - cy, q = dx * dx + dy * dy;
-            double f = atan2(dy, dx) - b->theta[i][j];
-            f -= 2.0 * pi * floor(f / (2.0 * pi) + 0.5);
+            double jl[2];
+            int cam, kl = np - 2 * NLM + 2 * j;
+            double f = ba_residual(b, x, i, j, jl, &cam);
             cost += 0.5L * (long double)f * f;
-            if (g == NULL)
-                continue;
-            {
-                int kl = ng + 2 * j;
-                double jl[2] = {-dy / q, dx / q};
-                for (int c = 0; c < 2; c++) {
-                    g[kl + c] += f * jl[c];
-                    diag[kl + c] += jl[c] * jl[c];
-                    if (free_cam) {
-                        g[2 * i + c - h] -= f * jl[c];
-                        diag[2 * i + c - h] += jl[c] * jl[c];
-                    }
+            for (int c = 0; c < 2 && g != NULL; c++) {
+                g[kl + c] += f * jl[c];
+                diag[kl + c] += jl[c] * jl[c];
+                if (cam >= 0) {
+                    g[cam + c] -= f * jl[c];
+                    diag[cam + c] += jl[c] * jl[c];
                 }
             }
         }
-    }
     return (double)cost;
 }
 
