@@ -704,6 +704,9 @@ static void fe__cli_on_signal(int sig)
 {
     if (fe__cli_held) {
         fe__cli_deferred = sig;
+        /* Read again (volatile): a hold that ended meanwhile has already
+           looked for a deferred signal; then the handler goes on. */
+        /* cppcheck-suppress identicalInnerCondition */
         if (fe__cli_held)
             return;             /* fe_cli_signals_hold(0) raises it */
     }
@@ -925,7 +928,8 @@ int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
             fprintf(stderr, "'foldest %s --help' for usage\n", command);
             return FE_CLI_USAGE;
         }
-        flag = c == 'h' ? "--help" : c == 'V' ? "--version" : flag_of[c - 256];
+        index = c >= 256 ? c - 256 : -1;    /* ours, or -h and -V */
+        flag = index >= 0 ? flag_of[index] : c == 'h' ? "--help" : "--version";
         if (strcmp(flag, "--version") == 0) {
             printf("foldest %s\n", FE_VERSION);
             return -1;
@@ -942,7 +946,7 @@ int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
             continue;
         }
         out[k++] = (char *)flag;
-        if (c >= 256 && lo[c - 256].has_arg == required_argument)
+        if (index >= 0 && lo[index].has_arg == required_argument)
             out[k++] = optarg;
     }
     /* Then the operands, which getopt_long has moved to the end. */
