@@ -14,6 +14,8 @@ DESTDIR      ?=
 LIBDIR       ?= $(PREFIX)/lib
 INCLUDEDIR   ?= $(PREFIX)/include
 BINDIR       ?= $(PREFIX)/bin
+MANDIR       ?= $(PREFIX)/share/man
+COMPLETIONDIR ?= $(PREFIX)/share/bash-completion/completions
 
 CC           ?= cc
 CFLAGS       ?= -O2 -g
@@ -30,6 +32,8 @@ EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm -pthread
 BENCH_LIBS    = $(shell pkg-config --libs gsl)
 CHECK_CFLAGS  = $(shell pkg-config --cflags check)
 CHECK_LIBS    = $(shell pkg-config --libs check)
+# The command (never the library) reads gzip-compressed tables with zlib.
+CLI_LIBS     := -lz
 
 ORG          := $(wildcard literate/*.org)
 LIB_SRC      := $(wildcard src/*.c)
@@ -95,7 +99,7 @@ $(B)/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(CC) $(WARN) $(CFLAGS) -Iinclude -Isrc/cli -c $< -o $@
 $(CLI): $(CLI_OBJ) $(STATIC)
 	@mkdir -p $(@D)
-	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS),@true)
+	$(if $(CLI_OBJ),$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(CLI_OBJ) $(STATIC) $(EXT_LIBS) $(CLI_LIBS),@true)
 
 # ---------------------------------------------------------------- examples, bench
 examples: $(EXAMPLES)
@@ -140,10 +144,17 @@ bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
 # double), and report the code size and the size of its state.
 ARM   := arm-none-eabi
 ARMCC  = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -ffreestanding $(WARN) -Iinclude
+# Without the cross compiler, say what will be installed and how big it is
+# (apt's own figure: about 436 MB for gcc-arm-none-eabi on Debian 12) before
+# installing it as root; otherwise print the command.
 size:
-	@command -v $(ARM)-gcc >/dev/null || { [ "$$(id -u)" = 0 ] && \
-	  apt-get install -y -q --no-install-recommends gcc-arm-none-eabi; } || \
-	  { echo "size: needs $(ARM)-gcc: sudo apt-get install -y gcc-arm-none-eabi"; exit 1; }
+	@command -v $(ARM)-gcc >/dev/null || { \
+	  mb=$$(apt-cache show gcc-arm-none-eabi 2>/dev/null | awk '/^Installed-Size/ {printf "%.0f", $$2 / 1000; exit}'); \
+	  echo "size: needs $(ARM)-gcc, the cross compiler in Debian's gcc-arm-none-eabi (about $${mb:-436} MB installed, with binutils-arm-none-eabi)"; \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "size: installing it now with apt-get (interrupt within 5 s to stop)"; sleep 5; \
+	    apt-get install -y -q --no-install-recommends gcc-arm-none-eabi; \
+	  else echo "size: sudo apt-get install -y --no-install-recommends gcc-arm-none-eabi"; exit 1; fi; }
 	@mkdir -p $(B)/arm && printf '%s\n' '#include <stddef.h>' '#include "foldest/quadric.h"' \
 	  'fe_quadric fe_state;' 'int fe_probe(const double *x);' \
 	  'int fe_probe(const double *x) { return fe_quadric_add(&fe_state, x); }' \
@@ -164,7 +175,7 @@ $(B)/tests/suites.h: $(TEST_SRC)
 	@mkdir -p $(@D)
 	sed -n 's/^Suite \*\(fe_[a-z0-9_]*_suite\)(void)$$/FE_SUITE(\1)/p' $(TEST_SRC) > $@
 
-TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"'
+TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"' -DFE_TEST_SRC='"$(abspath .)"'
 
 $(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
@@ -227,7 +238,16 @@ check-install: lib
 	done; \
 	PKG_CONFIG_SYSROOT_DIR="$$d" PKG_CONFIG_PATH="$$d/usr/local/lib/pkgconfig" \
 	  sh -c 'set -e; $(CXX) $(CXXWARN) -o "$$1/use_from_cxx" tests/cxx/use_from_cxx.cpp $$(pkg-config --cflags --libs foldest)' _ "$$d"; \
-	LD_LIBRARY_PATH="$$d/usr/local/lib" "$$d/use_from_cxx"
+	LD_LIBRARY_PATH="$$d/usr/local/lib" "$$d/use_from_cxx"; \
+	for m in doc/man/*.1; do \
+	  f="$$d/usr/local/share/man/man1/$$(basename $$m)"; [ -f "$$f" ] || { echo "not installed: $$f"; exit 1; }; \
+	  w=$$(LC_ALL=C.UTF-8 MANWIDTH=80 man --warnings -l "$$f" 2>&1 >/dev/null); \
+	  [ -z "$$w" ] || { echo "$$f: $$w"; exit 1; }; \
+	done; \
+	c=$$(bash -c '. "$$1"; COMP_WORDS=(foldest stats --co); COMP_CWORD=2; _foldest; echo "$${COMPREPLY[*]}"' _ \
+	     "$$d/usr/local/share/bash-completion/completions/foldest"); \
+	[ "$$c" = "--columns" ] || { echo "bash completion: 'foldest stats --co' gave '$$c'"; exit 1; }; \
+	echo "man pages and bash completion installed; the pages render without warnings"
 
 # ---------------------------------------------------------------- acceptance
 # `make accept`: foldest discover on cases drawn by an independent generator
@@ -284,7 +304,7 @@ $(B)/fuzz/obj/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -Dmain=fe_cli_main -DFE_CLI_KEEP_STDOUT -Iinclude -Isrc/cli -c $< -o $@
 $(B)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
 	$(FUZZ_CC) $(WARN) -Wno-unused-function -O1 -g $(FUZZ_SAN) -fsanitize=fuzzer -Iinclude -Itests/fuzz \
-	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS)
+	  -o $@ $< $(FUZZ_CLI_OBJ) $(FUZZ_LIB_OBJ) $(EXT_LIBS) $(CLI_LIBS)
 
 # Keep the instrumented objects (make would delete them as intermediates).
 .SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_CLI_OBJ)
@@ -391,10 +411,14 @@ install: lib cli
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBDIR@|$(LIBDIR)|' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|' \
 	    -e 's|@VERSION@|$(VERSION)|' foldest.pc.in > $(DESTDIR)$(LIBDIR)/pkgconfig/foldest.pc
 	$(if $(CLI_OBJ),install -d $(DESTDIR)$(BINDIR) && install -m 755 $(CLI) $(DESTDIR)$(BINDIR)/,)
+	install -d $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(COMPLETIONDIR)
+	install -m 644 $(wildcard doc/man/*.1) $(DESTDIR)$(MANDIR)/man1/
+	install -m 644 doc/completion/foldest.bash $(DESTDIR)$(COMPLETIONDIR)/foldest
 
 uninstall:
 	rm -rf $(DESTDIR)$(INCLUDEDIR)/foldest $(DESTDIR)$(INCLUDEDIR)/foldest.h
 	rm -f $(DESTDIR)$(LIBDIR)/libfoldest.* $(DESTDIR)$(LIBDIR)/pkgconfig/foldest.pc $(DESTDIR)$(BINDIR)/foldest
+	rm -f $(addprefix $(DESTDIR)$(MANDIR)/man1/,$(notdir $(wildcard doc/man/*.1))) $(DESTDIR)$(COMPLETIONDIR)/foldest
 
 clean:
 	rm -rf $(B)

@@ -18,6 +18,8 @@ int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap)
     if (r == NULL || fd < 0 || buffer == NULL || cap < 2)
         return FE_EINVAL;
     r->fd = fd;
+    r->read = NULL;
+    r->read_ctx = NULL;
     r->buf = buffer;
     r->cap = cap;
     r->len = r->pos = 0;
@@ -25,6 +27,21 @@ int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap)
     r->eof = 0;
     r->skipping = 0;
     return FE_OK;
+}
+
+int fe_csv_reader_init_read(fe_csv_reader *r, fe_csv_read_fn *fn, void *ctx,
+                            char *buffer, size_t cap)
+{
+    int rc;
+    if (fn == NULL)
+        return FE_EINVAL;
+    rc = fe_csv_reader_init(r, 0, buffer, cap);
+    if (rc == FE_OK) {
+        r->fd = -1;
+        r->read = fn;
+        r->read_ctx = ctx;
+    }
+    return rc;
 }
 
 /* Move the unread bytes to the front and read until the buffer is full
@@ -37,7 +54,9 @@ static int fe__csv_refill(fe_csv_reader *r)
     r->len = left;
     r->pos = 0;
     while (!r->eof && r->len < r->cap - 1) {
-        ssize_t got = read(r->fd, r->buf + r->len, r->cap - 1 - r->len);
+        ssize_t got = r->read != NULL
+                          ? (ssize_t)r->read(r->read_ctx, r->buf + r->len, r->cap - 1 - r->len)
+                          : read(r->fd, r->buf + r->len, r->cap - 1 - r->len);
         if (got < 0) {
             if (errno == EINTR)
                 continue;
@@ -100,6 +119,11 @@ int fe_csv_next_line(fe_csv_reader *r, char **line, size_t *len)
     start[n] = '\0';            /* the newline's place, or the spare byte */
     if (n > 0 && start[n - 1] == '\r')
         start[--n] = '\0';
+    /* A UTF-8 byte-order mark (EF BB BF) before the first line. */
+    if (r->line == 1 && n >= 3 && memcmp(start, "\xEF\xBB\xBF", 3) == 0) {
+        start += 3;
+        n -= 3;
+    }
     if (memchr(start, '\0', n) != NULL)
         return FE_EPARSE;
     *line = start;
@@ -110,10 +134,10 @@ int fe_csv_next_line(fe_csv_reader *r, char **line, size_t *len)
 /* [[file:../literate/csv.org::Split a line into fields][Split a line into fields]] */
 char fe_csv_guess_delimiter(const char *line)
 {
-    if (strchr(line, ',') != NULL)
-        return ',';
     if (strchr(line, ';') != NULL)
         return ';';
+    if (strchr(line, ',') != NULL)
+        return ',';
     if (strchr(line, '\t') != NULL)
         return '\t';
     return FE_CSV_WHITESPACE;
@@ -260,6 +284,47 @@ static int fe__csv_fast_number(const char *s, double *value)
     return 1;
 }
 
+/* Is s entirely a plain decimal with `point` as its decimal mark? */
+static int fe__csv_plain(const char *s, char point)
+{
+    int digits = 0;
+    if (*s == '+' || *s == '-')
+        s++;
+    for (; *s >= '0' && *s <= '9'; s++)
+        digits++;
+    if (*s == point)
+        for (s++; *s >= '0' && *s <= '9'; s++)
+            digits++;
+    if (digits == 0)
+        return 0;
+    if (*s == 'e' || *s == 'E') {
+        s++;
+        if (*s == '+' || *s == '-')
+            s++;
+        if (!(*s >= '0' && *s <= '9'))
+            return 0;
+        while (*s >= '0' && *s <= '9')
+            s++;
+    }
+    return *s == '\0';
+}
+
+/* "nan", "inf", "infinity", signed or not, in any case. */
+static int fe__csv_nonfinite_word(const char *s)
+{
+    static const char *const words[] = {"nan", "inf", "infinity"};
+    if (*s == '+' || *s == '-')
+        s++;
+    for (size_t w = 0; w < sizeof words / sizeof words[0]; w++) {
+        size_t i = 0;
+        while (words[w][i] != '\0' && (s[i] | 0x20) == words[w][i])
+            i++;
+        if (words[w][i] == '\0' && s[i] == '\0')
+            return 1;
+    }
+    return 0;
+}
+
 int fe_csv_number(const fe_csv_field *field, double *value)
 {
     char *end;
@@ -273,6 +338,8 @@ int fe_csv_number(const fe_csv_field *field, double *value)
         return FE_EPARSE;
     if (fe__csv_fast_number(s, value))
         return FE_OK;
+    if (!fe__csv_plain(s, '.'))
+        return fe__csv_nonfinite_word(s) ? FE_ENONFINITE : FE_EPARSE;
     errno = 0;
     v = strtod(s, &end);
     if (end == s || *end != '\0')
@@ -283,5 +350,28 @@ int fe_csv_number(const fe_csv_field *field, double *value)
         return FE_ENONFINITE;   /* overflow; an underflow to 0 or a denormal is kept */
     *value = v;
     return FE_OK;
+}
+
+int fe_csv_number_comma(const fe_csv_field *field, double *value)
+{
+    char copy[256];
+    fe_csv_field f;
+    size_t n;
+    char *comma;
+
+    if (field == NULL || field->text == NULL || value == NULL)
+        return FE_EINVAL;
+    n = strlen(field->text);
+    if (n >= sizeof copy)
+        return FE_EPARSE;
+    memcpy(copy, field->text, n + 1);
+    if (strchr(copy, '.') != NULL)
+        return FE_EPARSE;
+    comma = strchr(copy, ',');
+    if (comma != NULL)
+        *comma = '.';
+    f.text = copy;
+    f.column = field->column;
+    return fe_csv_number(&f, value);
 }
 /* Parse a field as a number ends here */

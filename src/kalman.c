@@ -201,10 +201,13 @@ static void fe__kalman_fill_report(fe_kalman_report *r, size_t b,
     r->log_det_D = log_det;
 }
 
+static void fe__kalman_joseph(size_t n, size_t b, const fe_kalman_obs *o,
+                              double *P, double *U, const double *K);
+
 static int fe__kalman_solve_update(size_t n, const fe_kalman_obs *o,
                                    double *x, double *P,
                                    const struct fe__kalman_ws *w,
-                                   fe_kalman_report *r)
+                                   fe_kalman_report *r, int joseph)
 {
     const size_t b = o->b;
     const int ni = (int)n, bi = (int)b;
@@ -257,10 +260,30 @@ static int fe__kalman_solve_update(size_t n, const fe_kalman_obs *o,
                 x, 1);
     cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ni, ni, bi, -1.0,
                 PAT, bi, R + b, bi, 1.0, P, ni);
+    if (joseph)
+        fe__kalman_joseph(n, b, o, P, PAT, R + b);
     fe__symmetrise(P, n);
     return FE_OK;
 }
 /* Update by solving with the Kalman denominator ends here */
+/* [[file:../literate/kalman.org::Apply Joseph's form][Apply Joseph's form]] */
+/* P holds M P = P - K A P of the standard update, K (n x b, row-major,
+   leading dimension b) the gain; U (n x b) is scratch.  Make P the
+   Joseph form M P + (K Z - (M P) A^T) K^T. */
+static void fe__kalman_joseph(size_t n, size_t b, const fe_kalman_obs *o,
+                              double *P, double *U, const double *K)
+{
+    const int ni = (int)n, bi = (int)b;
+    /* U = (M P) A^T, then U = K Z - U (Z by its lower triangle). */
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ni, bi, ni, 1.0, P,
+                ni, o->A, ni, 0.0, U, bi);
+    cblas_dsymm(CblasRowMajor, CblasRight, CblasLower, ni, bi, 1.0, o->Z, bi,
+                K, bi, -1.0, U, bi);
+    /* P += U K^T. */
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, ni, ni, bi, 1.0, U,
+                bi, K, bi, 1.0, P, ni);
+}
+/* Apply Joseph's form ends here */
 /* [[file:../literate/kalman.org::Decorrelate a packet][Decorrelate a packet]] */
 /* A packet as decorrelated scalar rows: row i is (A[i], z[i]) with noise
    variance var[i * var_stride], or 1 when var is NULL. */
@@ -532,9 +555,12 @@ static void fe__kalman_predict_into(size_t n, const fe_kalman_model *m,
 }
 /* Predict into the workspace ends here */
 /* [[file:../literate/kalman.org::Step atomically][Step atomically]] */
+/* Which covariance update a step runs. */
+enum { FE__KALMAN_REFERENCE, FE__KALMAN_FAST, FE__KALMAN_JOSEPH };
+
 static int fe__kalman_step(fe_kalman *k, const fe_kalman_model *m,
                            const fe_kalman_obs *o, fe_kalman_report *r,
-                           int fast)
+                           int kind)
 {
     struct fe__kalman_ws w;
     size_t n;
@@ -556,8 +582,10 @@ static int fe__kalman_step(fe_kalman *k, const fe_kalman_model *m,
     }
     rc = FE_OK;
     if (o != NULL)
-        rc = fast ? fe__kalman_seq_update(n, o, w.x, w.P, &w, r)
-                  : fe__kalman_solve_update(n, o, w.x, w.P, &w, r);
+        rc = kind == FE__KALMAN_FAST
+                 ? fe__kalman_seq_update(n, o, w.x, w.P, &w, r)
+                 : fe__kalman_solve_update(n, o, w.x, w.P, &w, r,
+                                           kind == FE__KALMAN_JOSEPH);
     if (rc == FE_OK && (!fe__finite(w.x, n) || !fe__finite(w.P, n * n)
                         || (o != NULL && !fe__report_finite(r))))
         rc = FE_ENONFINITE;
@@ -575,7 +603,15 @@ int fe_kalman_update(fe_kalman *k, const fe_kalman_obs *o,
 {
     if (o == NULL)
         return FE_EINVAL;
-    return fe__kalman_step(k, NULL, o, r, 0);
+    return fe__kalman_step(k, NULL, o, r, FE__KALMAN_REFERENCE);
+}
+
+int fe_kalman_update_joseph(fe_kalman *k, const fe_kalman_obs *o,
+                            fe_kalman_report *r)
+{
+    if (o == NULL)
+        return FE_EINVAL;
+    return fe__kalman_step(k, NULL, o, r, FE__KALMAN_JOSEPH);
 }
 
 int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
@@ -587,7 +623,7 @@ int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
     if (o == NULL || !fe__kalman_usable(k))
         return FE_EINVAL;
     if (k->n > FE__KALMAN_SMALL)
-        return fe__kalman_step(k, NULL, o, r, 1);
+        return fe__kalman_step(k, NULL, o, r, FE__KALMAN_FAST);
     /* Small n: decorrelate, then the fixed-size kernel. */
     if (o->b == 0 || o->A == NULL || o->z == NULL || o->Z == NULL)
         return FE_EINVAL;
@@ -628,7 +664,7 @@ int fe_kalman_predict(fe_kalman *k, const fe_kalman_model *m)
 {
     if (m == NULL)
         return FE_EINVAL;
-    return fe__kalman_step(k, m, NULL, NULL, 0);
+    return fe__kalman_step(k, m, NULL, NULL, FE__KALMAN_REFERENCE);
 }
 
 int fe_kalman_track(fe_kalman *k, const fe_kalman_track_obs *o,
@@ -636,7 +672,7 @@ int fe_kalman_track(fe_kalman *k, const fe_kalman_track_obs *o,
 {
     if (o == NULL)
         return FE_EINVAL;
-    return fe__kalman_step(k, &o->model, &o->obs, r, 0);
+    return fe__kalman_step(k, &o->model, &o->obs, r, FE__KALMAN_REFERENCE);
 }
 
 int fe_kalman_track_fast(fe_kalman *k, const fe_kalman_track_obs *o,
@@ -644,7 +680,15 @@ int fe_kalman_track_fast(fe_kalman *k, const fe_kalman_track_obs *o,
 {
     if (o == NULL)
         return FE_EINVAL;
-    return fe__kalman_step(k, &o->model, &o->obs, r, 1);
+    return fe__kalman_step(k, &o->model, &o->obs, r, FE__KALMAN_FAST);
+}
+
+int fe_kalman_track_joseph(fe_kalman *k, const fe_kalman_track_obs *o,
+                           fe_kalman_report *r)
+{
+    if (o == NULL)
+        return FE_EINVAL;
+    return fe__kalman_step(k, &o->model, &o->obs, r, FE__KALMAN_JOSEPH);
 }
 /* Step atomically ends here */
 /* [[file:../literate/kalman.org::Fold in information space][Fold in information space]] */

@@ -19,6 +19,11 @@ enum { FE__LM_SPARSE_MAX = 64 };
 
 /* Relative size of the rounding in a computed cost. */
 #define FE__LM_COST_NOISE (64 * DBL_EPSILON)
+
+/* A step whose gain ratio exceeds this is tried further along its line,
+   at most this many times its length. */
+#define FE__LM_LINE_RHO 0.25
+#define FE__LM_EXTEND_MAX 64.0
 /* Levenberg-Marquardt Includes ends here */
 /* [[file:../literate/lm.org::The sink][The sink]] */
 struct fe_lm_sink {
@@ -181,10 +186,91 @@ static int fe__lm_dense_step(const fe_lsq *a, double lambda, double *F,
     return FE_OK;
 }
 /* Solve the damped normal equations ends here */
+/* [[file:../literate/lm.org::Extend a step along its line][Extend a step along its line]] */
+/* xt = x + h has cost *trial_cost; try x + t* h with t* the minimum of
+   the parabola through the cost at 0 (value cost, slope -slope) and at 1.
+   On success xt and *trial_cost describe the new point and t* is
+   returned; otherwise xt is x + h again and 1 is returned. */
+static double fe__lm_extend(fe_lm_sink *s, const double *x, const double *h,
+                            double *xt, double cost, double slope,
+                            double *trial_cost)
+{
+    size_t p = s->prob->ng + s->prob->nb * s->prob->nl, k;
+    double c = *trial_cost - cost + slope, t, ext_cost = 0.0;
+    int rc;
+
+    if (!(c > 0.0) || !(slope > 0.0))
+        return 1.0;
+    t = fmin(slope / (2.0 * c), FE__LM_EXTEND_MAX);
+    if (!(t > 0.0) || t == 1.0)
+        return 1.0;
+    for (k = 0; k < p; k++)
+        xt[k] = x[k] + t * h[k];
+    rc = fe__lm_eval(s, xt, 0, &ext_cost);
+    if (rc == FE_OK && ext_cost < *trial_cost) {
+        *trial_cost = ext_cost;
+        return t;
+    }
+    for (k = 0; k < p; k++)
+        xt[k] = x[k] + h[k];
+    return 1.0;
+}
+/* Extend a step along its line ends here */
+/* [[file:../literate/lm.org::Search along the last two steps][Search along the last two steps]] */
+/* x has cost *cost and its normal equations folded; d = x - (the point
+   two accepted steps back).  Move x to the best of x + d and x + t* d
+   when that lowers the cost, refolding the normal equations there.
+   xt is scratch.  Returns FE_OK or the model's error at the new x. */
+static int fe__lm_accelerate(fe_lm_sink *s, double *x, const double *d,
+                             double *xt, double *cost, fe_lm_result *res)
+{
+    size_t p = s->prob->ng + s->prob->nb * s->prob->nl, k;
+    double slope = 0.0, c1 = 0.0, ct = 0.0, c, t;
+    int rc;
+
+    for (k = 0; k < p; k++) {
+        double b, a;
+        fe__lm_b_diag(s, k, &b, &a);
+        slope += b * d[k];
+    }
+    if (!(slope > 0.0))
+        return FE_OK;
+    /* The cost at x + d, and the parabola's minimum. */
+    for (k = 0; k < p; k++)
+        xt[k] = x[k] + d[k];
+    rc = fe__lm_eval(s, xt, 0, &c1);
+    res->evaluations++;
+    if (rc != FE_OK)
+        return FE_OK;
+    c = c1 - *cost + slope;
+    t = c > 0.0 ? fmin(slope / (2.0 * c), FE__LM_EXTEND_MAX) : FE__LM_EXTEND_MAX;
+    if (t != 1.0) {
+        for (k = 0; k < p; k++)
+            xt[k] = x[k] + t * d[k];
+        rc = fe__lm_eval(s, xt, 0, &ct);
+        res->evaluations++;
+        if (rc != FE_OK || !(ct < c1)) {
+            t = 1.0;
+            ct = c1;
+        }
+    } else {
+        ct = c1;
+    }
+    if (!(ct < *cost))
+        return FE_OK;
+    /* Move, and refold the normal equations there. */
+    for (k = 0; k < p; k++)
+        x[k] += t * d[k];
+    rc = fe__lm_eval(s, x, 1, cost);
+    res->evaluations++;
+    res->accelerated++;
+    return rc;
+}
+/* Search along the last two steps ends here */
 /* [[file:../literate/lm.org::Iterate Levenberg-Marquardt][Iterate Levenberg-Marquardt]] */
 fe_lm_params fe_lm_default_params(void)
 {
-    fe_lm_params p = {100, 1e-3, 1e-12, 0.0, 0.0};
+    fe_lm_params p = {100, 1e-3, 1e-12, 0.0, 0.0, 1e-12, 1e-10};
     return p;
 }
 
@@ -195,10 +281,10 @@ size_t fe_lm_work(const fe_lm_problem *prob, int method)
         return 0;
     p = prob->ng + prob->nb * prob->nl;
     if (method == FE_LM_DENSE)
-        return fe_lsq_storage(p) + p * p + 3 * p;
+        return fe_lsq_storage(p) + p * p + 4 * p;
     if (method == FE_LM_SCHUR)
         return fe_schur_storage(prob->ng, prob->nl, prob->nb)
-               + fe_schur_solve_work(prob->ng, prob->nl) + 2 * p;
+               + fe_schur_solve_work(prob->ng, prob->nl) + 3 * p;
     return 0;
 }
 
@@ -216,19 +302,21 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
                 fe_lm_result *result)
 {
     fe_lm_params par = params != NULL ? *params : fe_lm_default_params();
-    fe_lm_result res = {0, 0, 0, 0.0, 0.0, FE_LM_RUNNING};
+    fe_lm_result res = {0, 0, 0, 0.0, 0.0, FE_LM_RUNNING, 0, 0};
     fe_lm_problem pr;
     fe_lm_sink s;
     fe_lsq dense;
     fe_schur schur;
-    double *solve_work, *xt, *h, cost = 0.0, lambda, nu = 2.0;
+    double *solve_work, *xt, *h, *xa, cost = 0.0, lambda, nu = 2.0;
     size_t p, k;
-    int rc, it;
+    int rc, it, have_xa = 0;
 
     if (prob == NULL || prob->model == NULL || x == NULL || work == NULL
         || (method != FE_LM_DENSE && method != FE_LM_SCHUR)
         || par.max_iter < 0 || !(par.lambda0 > 0.0) || !isfinite(par.lambda0)
-        || !(par.xtol >= 0.0) || !(par.gtol >= 0.0) || !(par.ftol >= 0.0))
+        || !(par.xtol >= 0.0) || !(par.gtol >= 0.0) || !(par.ftol >= 0.0)
+        || !(par.rtol >= 0.0) || !(par.lambda_min >= 0.0)
+        || !(par.lambda_min <= par.lambda0))
         return FE_EINVAL;
     pr = *prob;
     if (pr.nl == 0)
@@ -254,6 +342,7 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
         s.schur = &schur;
     }
     h = xt + p;
+    xa = h + p;
     if (rc != FE_OK)
         return rc;
 
@@ -270,8 +359,8 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
 
     for (it = 1; res.stop == FE_LM_RUNNING; it++) {
         fe_lm_iteration row = {it, cost, 0.0, 0.0, lambda, 0.0, 0};
-        double gmax = 0.0, pred = 0.0, trial_cost = 0.0, hn, rho, noise;
-        int trial_rc;
+        double gmax = 0.0, pred = 0.0, slope = 0.0, trial_cost = 0.0, hn, rho, noise;
+        int trial_rc, rtol_pending = 0;
 
         /* Converged already? */
         for (k = 0; k < p; k++) {
@@ -308,11 +397,13 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
                 res.stop = FE_LM_XTOL;
                 break;
             }
-            /* Predicted reduction: (1/2) h'(b + lambda diag(A) h). */
+            /* Predicted reduction: (1/2) h'(b + lambda diag(A) h); the
+               slope of the cost along h is -b'h. */
             for (k = 0; k < p; k++) {
                 double b, a;
                 fe__lm_b_diag(&s, k, &b, &a);
                 pred += h[k] * (b + lambda * a * h[k]);
+                slope += h[k] * b;
                 xt[k] = x[k] + h[k];
             }
             pred *= 0.5;
@@ -321,20 +412,41 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
             rho = trial_rc == FE_OK && pred > 0.0 ? (cost - trial_cost) / pred
                                                    : -1.0;
             row.ratio = rho;
+            /* A step the model underrates may go further along its line. */
+            if (trial_rc == FE_OK && rho > 0.0 && fabs(rho - 1.0) > FE__LM_LINE_RHO) {
+                double t = fe__lm_extend(&s, x, h, xt, cost, slope, &trial_cost);
+                res.evaluations++;
+                row.step *= t;
+                res.extended += t != 1.0;
+            }
             row.change = trial_rc == FE_OK ? cost - trial_cost : 0.0;
             /* A reduction below the rounding of the cost cannot be judged:
                take the step unless it is measurably worse. */
             noise = FE__LM_COST_NOISE * cost;
             if (trial_rc == FE_OK && pred <= noise && trial_cost <= cost + noise)
                 rho = 1.0;
+            /* Relative change of the cost negligible, predicted and
+                   actual (MINPACK's test): this step is the last. */
+            rtol_pending = trial_rc == FE_OK && rho > 0.0
+                           && pred <= par.rtol * cost
+                           && fabs(cost - trial_cost) <= par.rtol * cost;
             if (trial_rc == FE_OK && rho > 0.0) {
                 double t = 2.0 * rho - 1.0;
+                int accel = have_xa;
+                /* Take the step; remember where it started. */
+                for (k = 0; k < p; k++)
+                    h[k] = xt[k] - xa[k];
+                memcpy(xa, x, p * sizeof *x);
+                have_xa = 1;
                 memcpy(x, xt, p * sizeof *x);
                 rc = fe__lm_eval(&s, x, 1, &cost);
                 res.evaluations++;
+                if (rc == FE_OK && accel)
+                    rc = fe__lm_accelerate(&s, x, h, xt, &cost, &res);
                 if (rc != FE_OK)
                     break;
-                lambda *= fmax(1.0 / 3.0, 1.0 - t * t * t);
+                lambda = fmax(par.lambda_min,
+                              lambda * fmax(1.0 / 3.0, 1.0 - t * t * t));
                 nu = 2.0;
                 row.accepted = 1;
                 res.accepted++;
@@ -349,6 +461,8 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
         res.iterations = it;
         if (report != NULL && report(&row, report_ctx) != 0)
             res.stop = FE_LM_STOPPED;
+        if (res.stop == FE_LM_RUNNING && rtol_pending)
+            res.stop = FE_LM_RTOL;
         if (res.stop == FE_LM_RUNNING && lambda > FE__LM_LAMBDA_MAX)
             res.stop = FE_LM_STUCK;
     }

@@ -59,6 +59,37 @@ static const struct cli_case cases[] = {
     {"unterminated quote", "stats", "a,b\n1,2\n1,\"2\n", 3, "%s:3:3: unterminated"},
     {"unknown column", "stats --columns zz", "a,b\n1,2\n", 2, "no column 'zz'; the columns are: 'a', 'b'"},
     {"unknown option", "stats --frobnicate", "a\n1\n", 2, "unknown option '--frobnicate'"},
+    /* Files as phones, loggers and spreadsheets export them (issue 19). */
+    {"UTF-8 byte-order mark", "stats --columns time --json",
+     "\xEF\xBB\xBFtime,x\n0,1\n1,3\n", 0, "[{\"name\": \"time\", \"mean\": 0.5,"},
+    {"byte-order mark, column numbers after it", "stats",
+     "\xEF\xBB\xBF" "a,b\n1,x\n", 3, "%s:2:3: 'x' in column 'b'"},
+    {"semicolons and decimal commas", "stats --columns a,b --json",
+     "a;b\n1,5;2\n2,5;4,25\n", 0, "{\"name\": \"a\", \"mean\": 2,"},
+    {"semicolons, decimal commas, second column", "stats --columns b --json",
+     "a;b\n1,5;2\n2,5;4,25\n", 0, "\"mean\": 3.125,"},
+    {"semicolons with decimal points", "stats --columns b --json",
+     "a;b\n1.5;2\n2.5;4.5\n", 0, "\"mean\": 3.25,"},
+    {"--decimal-comma in a tab table", "stats --decimal-comma --columns a --json",
+     "a\tb\n1,5\t2\n2,5\t3\n", 0, "\"mean\": 2,"},
+    {"--decimal-comma refuses a point", "stats --decimal-comma",
+     "a\tb\n1,5\t2\n2.5\t3\n", 3, "%s:3:1: '2.5' in column 'a' is not a number"},
+    {"hexadecimal is not a number", "stats", "a,b\n1,2\n0x1p3,2\n", 3,
+     "%s:3:1: '0x1p3' in column 'a' is not a number"},
+    {"hexadecimal integer", "stats", "a\n1\n0x10\n", 3, "'0x10' in column 'a' is not a number"},
+    {"infinity word", "stats", "a\n1\nInfinity\n", 3, "'Infinity' in column 'a' is not a finite number"},
+    {"nan with a payload", "stats", "a\n1\nnan(0x7)\n", 3, "'nan(0x7)' in column 'a' is not a number"},
+    {"empty cell", "stats", "a,b\n1,2\n3,\n", 3, "%s:3:3: empty cell in column 'b'"},
+    {"empty cell first", "stats", "a,b\n1,2\n,4\n", 3, "%s:3:1: empty cell in column 'a'"},
+    {"--skip-bad-rows counts by reason", "stats --skip-bad-rows --json",
+     "a,b\n1,2\n,3\nNaN,4\nx,5\n7\n3,6\n", 0,
+     "\"rows\": 2, \"bad_rows\": {\"total\": 4, \"empty_cell\": 1, \"not_finite\": 1, "
+     "\"not_a_number\": 1, \"field_count\": 1}"},
+    {"--skip-bad-rows says so", "stats --skip-bad-rows",
+     "a,b\n1,2\n,3\n3,6\n", 0, "skipped 1 bad rows (1 with an empty cell, 0 with NaN"},
+    {"no bad rows: zero in the JSON", "stats --json", "a\n1\n", 0,
+     "\"bad_rows\": {\"total\": 0, "},
+    {"--skip-bad-rows after --", "stats -- --skip-bad-rows", "a\n1\n", 2, NULL},
 };
 
 START_TEST(table_driven)
@@ -67,10 +98,290 @@ START_TEST(table_driven)
     char out[4096], path[64], want[512];
     int status = run_on(c->args, c->content, strlen(c->content), out, sizeof out,
                         path, sizeof path);
-    snprintf(want, sizeof want, c->expect, path);
+    snprintf(want, sizeof want, c->expect != NULL ? c->expect : "", path);
     ck_assert_msg(status == c->status, "%s: status %d, want %d; output:\n%s", c->what,
                   status, c->status, out);
     ck_assert_msg(strstr(out, want) != NULL, "%s: output lacks \"%s\":\n%s", c->what, want, out);
+}
+END_TEST
+
+/* A gzip file made here, independently of zlib: the header, one stored
+   (uncompressed) deflate block per 65535 bytes, CRC-32 and length. */
+static unsigned long crc32_of(const unsigned char *p, size_t n)
+{
+    unsigned long c = 0xFFFFFFFFul;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = (c >> 1) ^ (0xEDB88320ul & (0ul - (c & 1ul)));
+    }
+    return c ^ 0xFFFFFFFFul;
+}
+
+static size_t gzip_stored(const char *text, size_t n, unsigned char *out)
+{
+    static const unsigned char head[10] = {0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 0xff};
+    size_t o = 0, at = 0;
+    unsigned long crc = crc32_of((const unsigned char *)text, n);
+    memcpy(out, head, 10);
+    o = 10;
+    do {
+        size_t len = n - at > 65535 ? 65535 : n - at;
+        out[o++] = at + len == n ? 1 : 0;       /* BFINAL, BTYPE 00 */
+        out[o++] = (unsigned char)(len & 0xff);
+        out[o++] = (unsigned char)(len >> 8);
+        out[o++] = (unsigned char)(~len & 0xff);
+        out[o++] = (unsigned char)((~len >> 8) & 0xff);
+        memcpy(out + o, text + at, len);
+        o += len;
+        at += len;
+    } while (at < n);
+    for (int k = 0; k < 4; k++)
+        out[o++] = (unsigned char)((crc >> (8 * k)) & 0xff);
+    for (int k = 0; k < 4; k++)
+        out[o++] = (unsigned char)((n >> (8 * k)) & 0xff);
+    return o;
+}
+
+START_TEST(gzip_files_read_like_plain_ones)
+{
+    static char text[200000], out[4096], plain[4096];
+    static unsigned char gz[210000];
+    char path[64];
+    size_t n = 0, m;
+    n += (size_t)snprintf(text + n, sizeof text - n, "\xEF\xBB\xBFt;x\n");
+    for (int i = 0; i < 10000; i++)
+        n += (size_t)snprintf(text + n, sizeof text - n, "%d;%d,%d\n", i, i % 13, i % 10);
+    m = gzip_stored(text, n, gz);
+    ck_assert_int_eq(run_on("stats --json", text, n, plain, sizeof plain, path, sizeof path), 0);
+    ck_assert_int_eq(run_on("stats --json", (const char *)gz, m, out, sizeof out, path, sizeof path), 0);
+    ck_assert_msg(strstr(out, "\"rows\": 10000") != NULL, "%s", out);
+    /* Same numbers as the plain file (the file names differ). */
+    ck_assert_str_eq(strstr(out, "\"rows\""), strstr(plain, "\"rows\""));
+    /* A corrupt gzip stream is an error, not a short table. */
+    gz[m - 5] ^= 0x55;
+    ck_assert_int_ne(run_on("stats --json", (const char *)gz, m, out, sizeof out, path, sizeof path), 0);
+    /* Standard input, compressed. */
+    {
+        char cmd[512];
+        FILE *p;
+        size_t got;
+        int fd, status;
+        gz[m - 5] ^= 0x55;
+        snprintf(path, sizeof path, "/tmp/foldest-cli-XXXXXX");
+        fd = mkstemp(path);
+        ck_assert_int_ge(fd, 0);
+        ck_assert_int_eq(write(fd, gz, m), (ssize_t)m);
+        close(fd);
+        snprintf(cmd, sizeof cmd, "cat %s | %s stats --json - 2>&1", path, FE_TEST_CLI);
+        p = popen(cmd, "r");
+        ck_assert_ptr_nonnull(p);
+        got = fread(out, 1, sizeof out - 1, p);
+        out[got] = '\0';
+        status = pclose(p);
+        unlink(path);
+        ck_assert_int_eq(WEXITSTATUS(status), 0);
+        ck_assert_str_eq(strstr(out, "\"rows\""), strstr(plain, "\"rows\""));
+    }
+}
+END_TEST
+
+/* ------------------------------------------------ JSON and its schemas */
+
+#ifndef FE_TEST_SRC
+#define FE_TEST_SRC "."
+#endif
+
+/* Run `cmd` (a shell command line writing JSON to stdout) into a file,
+   require exit status `status`, then validate the file against
+   doc/schema/SCHEMA with tests/schema/validate.py (python3, standard
+   library only).  The output is left in `out`. */
+static void json_valid(const char *cmd, int status, const char *schema, char *out, size_t outlen)
+{
+    char full[4096], file[64], msg[4096];
+    FILE *p;
+    size_t got;
+    int fd, rc;
+    snprintf(file, sizeof file, "/tmp/foldest-json-XXXXXX");
+    fd = mkstemp(file);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    snprintf(full, sizeof full, "%s > %s 2>/dev/null", cmd, file);
+    rc = system(full);
+    ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == status, "%s: status %d, want %d", cmd,
+                  WEXITSTATUS(rc), status);
+    fe_test_read_file(file, out, outlen);
+    snprintf(full, sizeof full, "python3 %s/tests/schema/validate.py %s/doc/schema/%s < %s 2>&1",
+             FE_TEST_SRC, FE_TEST_SRC, schema, file);
+    p = popen(full, "r");
+    ck_assert_ptr_nonnull(p);
+    got = fread(msg, 1, sizeof msg - 1, p);
+    msg[got] = '\0';
+    rc = pclose(p);
+    unlink(file);
+    ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == 0, "%s: output not valid against %s:\n%s\n%s",
+                  cmd, schema, msg, out);
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    ck_assert_ptr_nonnull(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+START_TEST(json_outputs_follow_their_schemas)
+{
+    static char out[1 << 16];
+    char dir[64], cmd[2048], path[256];
+    const char *F = FE_TEST_CLI;
+    snprintf(dir, sizeof dir, "/tmp/foldest-schema-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(dir));
+
+    /* stats: a Latin-1 byte and a broken UTF-8 sequence in the header, a
+       good UTF-8 name, a tab and a quote: the JSON stays UTF-8, the bad
+       bytes become U+FFFD, the rest is escaped. */
+    snprintf(path, sizeof path, "%s/names.csv", dir);
+    write_text(path, "caf\xe9,\xe2\x82,\xce\xbcT,\"a\"\"b\tc\"\n0.1,1,2,3\n0.2,1,2,4\n,1,2,3\nNaN,1,1,1\n");
+    snprintf(cmd, sizeof cmd, "%s stats --skip-bad-rows --json %s", F, path);
+    json_valid(cmd, 0, "stats.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"name\": \"caf\\ufffd\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"\\ufffd\\ufffd\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"\xce\xbcT\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"a\\\"b\\u0009c\"") != NULL, "%s", out);
+    /* One number format: the shortest that reads back (15 to 17 digits). */
+    ck_assert_msg(strstr(out, "\"min\": 0.1, \"max\": 0.2}") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"bad_rows\": {\"total\": 2, \"empty_cell\": 1, \"not_finite\": 1") != NULL,
+                  "%s", out);
+
+    /* calibrate: a fit, and a refusal. */
+    snprintf(path, sizeof path, "%s/mag.csv", dir);
+    {
+        FILE *f = fopen(path, "w");
+        fe_rng g = fe_rng_seed(11);
+        ck_assert_ptr_nonnull(f);
+        fprintf(f, "t,mx,my,mz\n");
+        for (int i = 0; i < 2000; i++) {
+            double v[3];
+            fe_rng_unit_vector(&g, v);
+            fprintf(f, "%d,%.5f,%.5f,%.5f\n", i, 20 + 400 * v[0] + fe_rng_normal(&g),
+                    -10 + 380 * v[1] + fe_rng_normal(&g), 5 + 420 * v[2] + fe_rng_normal(&g));
+        }
+        fclose(f);
+    }
+    for (int m = 0; m < 3; m++) {
+        static const char *const model[] = {"sphere", "axial", "ellipsoid"};
+        snprintf(cmd, sizeof cmd, "%s calibrate --model %s --columns mx,my,mz --json %s", F, model[m], path);
+        json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
+    }
+    snprintf(path, sizeof path, "%s/plane.csv", dir);
+    write_text(path, "x,y,z\n1,0,0\n0,1,0\n-1,0,0\n0,-1,0\n0.7,0.7,0\n-0.7,0.7,0\n0.7,-0.7,0\n-0.7,-0.7,0\n"
+                     "0.6,0.8,0\n0.8,0.6,0\n-0.6,0.8,0\n0.8,-0.6,0\n");
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns x,y,z --json %s", F, path);
+    json_valid(cmd, 1, "calibrate.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"refusal\": \"") != NULL, "%s", out);
+
+    /* discover --sphere: an analysis, and a refusal. */
+    snprintf(cmd, sizeof cmd, "%s discover --sphere %s/mag.csv --columns mx,my,mz --json", F, dir);
+    json_valid(cmd, 0, "discover-sphere.schema.json", out, sizeof out);
+    snprintf(cmd, sizeof cmd, "%s discover --sphere %s --columns x,y,z --json", F, path);
+    json_valid(cmd, 1, "discover-sphere.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"verdict\": \"refused\"") != NULL, "%s", out);
+
+    /* discover: a concealed effect, and none. */
+    for (int e = 0; e < 2; e++) {
+        snprintf(cmd, sizeof cmd, "%s synth --effect %s --seed 5 --rows 20000 --real %s/r.csv --sim %s/s.csv "
+                 ">/dev/null 2>&1", F, e ? "none" : "quadratic_drag", dir, dir);
+        ck_assert_int_eq(system(cmd), 0);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel acceleration "
+                 "--role position=position --role velocity=velocity --role input=input --base bias,gain --json",
+                 F, dir, dir);
+        json_valid(cmd, 0, "discover.schema.json", out, sizeof out);
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
+/* The validator itself refuses what it must: invalid UTF-8, NaN, a
+   duplicate key, a missing required property, a wrong type. */
+START_TEST(schema_validator_refuses)
+{
+    static const char *const bad[] = {
+        "{\"file\": \"a\xff\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, \"not_finite\": 0, "
+        "\"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": NaN, \"bad_rows\": {}, \"columns\": []}",
+        "{\"file\": \"a\", \"file\": \"b\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, "
+        "\"not_finite\": 0, \"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": 1, \"columns\": []}",
+        "{\"file\": \"a\", \"rows\": \"1\", \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, \"not_finite\": 0, "
+        "\"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}",
+    };
+    const char *good = "{\"file\": \"a\", \"rows\": 1, \"bad_rows\": {\"total\": 0, \"empty_cell\": 0, "
+                       "\"not_finite\": 0, \"not_a_number\": 0, \"field_count\": 0}, \"columns\": []}";
+    for (size_t i = 0; i <= sizeof bad / sizeof bad[0]; i++) {
+        char path[64], cmd[1024];
+        int fd, rc;
+        const char *text = i < sizeof bad / sizeof bad[0] ? bad[i] : good;
+        snprintf(path, sizeof path, "/tmp/foldest-json-XXXXXX");
+        fd = mkstemp(path);
+        ck_assert_int_ge(fd, 0);
+        ck_assert_int_eq(write(fd, text, strlen(text)), (ssize_t)strlen(text));
+        close(fd);
+        snprintf(cmd, sizeof cmd, "python3 %s/tests/schema/validate.py %s/doc/schema/stats.schema.json < %s 2>/dev/null",
+                 FE_TEST_SRC, FE_TEST_SRC, path);
+        rc = system(cmd);
+        unlink(path);
+        ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == (text == good ? 0 : 1), "case %zu: status %d", i,
+                      WEXITSTATUS(rc));
+    }
+}
+END_TEST
+
+/* Every option the bash completion offers for a command is in the
+   command's man page and is accepted by the command (as --opt or
+   --opt=value, before --help), and the man pages list the common ones. */
+START_TEST(options_documented_completed_and_accepted)
+{
+    static const char *const commands[] = {"stats", "calibrate", "discover", "synth"};
+    static char completion[16384], page[16384];
+    char path[512];
+    snprintf(path, sizeof path, "%s/doc/completion/foldest.bash", FE_TEST_SRC);
+    fe_test_read_file(path, completion, sizeof completion);
+    for (size_t c = 0; c < sizeof commands / sizeof commands[0]; c++) {
+        char key[64], opts[1024], *at, *end;
+        int count = 0;
+        snprintf(path, sizeof path, "%s/doc/man/foldest-%s.1", FE_TEST_SRC, commands[c]);
+        fe_test_read_file(path, page, sizeof page);
+        snprintf(key, sizeof key, "%s) opts=\"", commands[c]);
+        at = strstr(completion, key);
+        ck_assert_msg(at != NULL, "no options for %s in the completion", commands[c]);
+        at += strlen(key);
+        end = strchr(at, '"');
+        ck_assert_ptr_nonnull(end);
+        snprintf(opts, sizeof opts, "%.*s", (int)(end - at), at);
+        for (char *o = strtok(opts, " \n"); o != NULL; o = strtok(NULL, " \n")) {
+            char man[64], cmd[512];
+            int plain, valued;
+            snprintf(man, sizeof man, "\\-\\-%s", o + 2);
+            ck_assert_msg(strstr(page, man) != NULL, "%s: %s not in its man page", commands[c], o);
+            snprintf(cmd, sizeof cmd, "%s %s %s --help >/dev/null 2>&1", FE_TEST_CLI, commands[c], o);
+            plain = system(cmd);
+            snprintf(cmd, sizeof cmd, "%s %s %s=x --help >/dev/null 2>&1", FE_TEST_CLI, commands[c], o);
+            valued = system(cmd);
+            ck_assert_msg((WIFEXITED(plain) && WEXITSTATUS(plain) == 0)
+                          || (WIFEXITED(valued) && WEXITSTATUS(valued) == 0),
+                          "%s does not accept %s", commands[c], o);
+            count++;
+        }
+        ck_assert_int_ge(count, 3);
+    }
+    snprintf(path, sizeof path, "%s/doc/man/foldest.1", FE_TEST_SRC);
+    fe_test_read_file(path, page, sizeof page);
+    ck_assert(strstr(page, "\\-\\-decimal\\-comma") != NULL);
+    ck_assert(strstr(page, "\\-\\-skip\\-bad\\-rows") != NULL);
+    ck_assert(strstr(page, "\\-V") != NULL);
 }
 END_TEST
 
@@ -118,20 +429,39 @@ static const struct usage_case usage_cases[] = {
     {"calibrate --model cube a.csv", 2, "--model: 'cube' is not sphere, axial or ellipsoid"},
     {"calibrate --skip x a.csv", 2, "--skip: 'x' is not a whole number"},
     {"calibrate --skip -1 a.csv", 2, "--skip: negative"},
-    {"calibrate --bogus a.csv", 2, "unknown option or missing value '--bogus'"},
+    {"calibrate --bogus a.csv", 2, "unknown option '--bogus'"},
     {"calibrate a.csv b.csv", 2, "one input file, please"},
     {"calibrate --apply out.csv -", 2, "--apply reads the input twice"},
     {"calibrate /nonexistent/a.csv", 4, "cannot open"},
     {"discover --help", 0, "usage: foldest discover"},
-    {"discover --sphere", 2, "--sphere needs a value"},
+    {"discover --sphere", 2, "option '--sphere' needs a value"},
     {"discover --sphere a.csv --role t=velocity", 2, "--role with --sphere: COLUMN=temperature"},
     {"discover --sphere a.csv --holdout 0.95", 2, "--holdout: 0.95 is not in [0, 0.9)"},
     {"discover --sphere a.csv --blocks 2", 2, "--blocks: 2 is not in [4, 64]"},
     {"discover --sphere a.csv --alpha x", 2, "--alpha: 'x' is not a number"},
-    {"discover --sphere a.csv --wobble 1", 2, "unknown option '--wobble' with --sphere"},
+    {"discover --sphere a.csv --wobble 1", 2, "unknown option '--wobble'"},
     {"discover --sphere /nonexistent/a.csv", 4, "cannot open"},
     {"synth --help", 0, "usage: foldest synth"},
     {"synth --effect quadratic_drag --seed x --real r --sim s", 2, "--seed"},
+    /* Conventions of the shell (issue 19, item 8): getopt_long everywhere. */
+    {"-V", 0, "foldest 0."},
+    {"stats -V", 0, "foldest 0."},
+    {"discover --version", 0, "foldest 0."},
+    {"stats -h", 0, "usage: foldest stats"},
+    {"synth -h", 0, "usage: foldest synth"},
+    {"discover -h --real x", 0, "usage: foldest discover"},
+    {"stats --skip=x a.csv", 2, "--skip: 'x' is not a whole number"},
+    {"calibrate --mo cube a.csv", 2, "--model: 'cube' is not sphere, axial or ellipsoid"},
+    {"calibrate --mod=cube a.csv", 2, "--model: 'cube' is not sphere, axial or ellipsoid"},
+    {"calibrate a.csv --skip -1", 2, "--skip: negative"},
+    {"stats --colums a a.csv", 2, "unknown option '--colums'; did you mean '--columns'?"},
+    {"discover --rael x --sim y --channel c", 2, "unknown option '--rael'; did you mean '--real'?"},
+    {"synth --efect drag", 2, "unknown option '--efect'; did you mean '--effect'?"},
+    {"calibrate --apple out.csv a.csv", 2, "unknown option '--apple'; did you mean '--apply'?"},
+    {"stats --frobnicate a.csv", 2, "unknown option '--frobnicate'\n"},
+    {"discover --r x", 2, "ambiguous option '--r': it could be --real --role --report"},
+    {"synth --effect", 2, "option '--effect' needs a value"},
+    {"stats -x a.csv", 2, "unknown option '-x'"},
 };
 
 START_TEST(usage_and_help)
@@ -189,6 +519,10 @@ Suite *fe_cli_suite(void)
     tcase_set_timeout(t, 60);
     tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
     tcase_add_test(t, binary_and_long_lines);
+    tcase_add_test(t, json_outputs_follow_their_schemas);
+    tcase_add_test(t, schema_validator_refuses);
+    tcase_add_test(t, options_documented_completed_and_accepted);
+    tcase_add_test(t, gzip_files_read_like_plain_ones);
     tcase_add_loop_test(t, usage_and_help, 0, (int)(sizeof usage_cases / sizeof usage_cases[0]));
     tcase_add_test(t, discover_sphere_in_words);
     suite_add_tcase(s, t);

@@ -141,6 +141,89 @@ START_TEST(numbers)
 }
 END_TEST
 
+/* What spreadsheets and loggers write (issue 19): a byte-order mark, a
+   semicolon table with decimal commas, a read function instead of a file
+   descriptor, and strtod's extensions refused. */
+struct chunks { const char *text; size_t at, step; };
+
+static long read_chunks(void *ctx, char *buf, size_t n)
+{
+    struct chunks *c = ctx;
+    size_t left = strlen(c->text) - c->at, k = left < c->step ? left : c->step;
+    if (k > n)
+        k = n;
+    memcpy(buf, c->text + c->at, k);
+    c->at += k;
+    return (long)k;
+}
+
+START_TEST(byte_order_mark_semicolons_and_read_functions)
+{
+    struct chunks c = {"\xEF\xBB\xBFtime;x\n0;1,5\n\xEF\xBB\xBF" "1;2\n", 0, 3};
+    fe_csv_reader r;
+    char buf[64], *line;
+    size_t len, nf;
+    fe_csv_field f[4];
+    double v;
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, NULL, NULL, buf, sizeof buf), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "time;x");           /* the mark is gone */
+    ck_assert_uint_eq(len, 6);
+    ck_assert_int_eq(fe_csv_guess_delimiter(line), ';');
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_int_eq(fe_csv_guess_delimiter(line), ';');   /* "0;1,5" has a comma too */
+    ck_assert_int_eq(fe_csv_split(line, ';', f, 4, &nf, NULL), FE_OK);
+    ck_assert_uint_eq(nf, 2);
+    ck_assert_int_eq(fe_csv_number(&f[1], &v), FE_EPARSE);
+    ck_assert_int_eq(fe_csv_number_comma(&f[1], &v), FE_OK);
+    ck_assert_double_eq(v, 1.5);
+    /* Only at the start of the input. */
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "\xEF\xBB\xBF" "1;2");
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+}
+END_TEST
+
+struct number_case { const char *text; int rc; double value; };
+
+/* Each case through `parse`: its status, its value, and an untouched
+   value on a refusal. */
+static void check_numbers(int (*parse)(const fe_csv_field *, double *),
+                          const struct number_case *cases, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char text[64];
+        fe_csv_field f = {text, 1};
+        double v = -7.0;
+        strcpy(text, cases[i].text);
+        ck_assert_msg(parse(&f, &v) == cases[i].rc, "'%s'", cases[i].text);
+        ck_assert_double_eq(v, cases[i].rc == FE_OK ? cases[i].value : -7.0);
+    }
+}
+
+START_TEST(strtod_extensions_are_not_numbers)
+{
+    static const struct number_case cases[] = {
+        {"0x1p3", FE_EPARSE, 0}, {"0x10", FE_EPARSE, 0}, {"-0X1.8P1", FE_EPARSE, 0},
+        {"nan", FE_ENONFINITE, 0}, {"NaN", FE_ENONFINITE, 0}, {"-inf", FE_ENONFINITE, 0},
+        {"+Infinity", FE_ENONFINITE, 0}, {"nan(123)", FE_EPARSE, 0}, {"infinit", FE_EPARSE, 0},
+        {"1e999", FE_ENONFINITE, 0}, {"1e", FE_EPARSE, 0}, {".", FE_EPARSE, 0},
+        {"1.5.2", FE_EPARSE, 0}, {"1,5", FE_EPARSE, 0}, {"", FE_EPARSE, 0},
+        {"12345678901234567890", FE_OK, 12345678901234567890.0},
+        {".5", FE_OK, 0.5}, {"5.", FE_OK, 5.0}, {"-1.25e-3", FE_OK, -1.25e-3},
+        {"1e-400", FE_OK, 0.0},
+    };
+    static const struct number_case comma[] = {
+        {"1,5", FE_OK, 1.5}, {"-0,25e2", FE_OK, -25.0}, {"3", FE_OK, 3.0},
+        {"1.5", FE_EPARSE, 0}, {"1.234,5", FE_EPARSE, 0}, {"1,2,3", FE_EPARSE, 0},
+        {"0x1,8p1", FE_EPARSE, 0}, {"nan", FE_ENONFINITE, 0},
+    };
+    check_numbers(fe_csv_number, cases, sizeof cases / sizeof cases[0]);
+    check_numbers(fe_csv_number_comma, comma, sizeof comma / sizeof comma[0]);
+}
+END_TEST
+
 START_TEST(numbers_equal_strtod_bit_for_bit)
 {
     /* Random decimals in every form a recording or a printf writes (1 to
@@ -198,6 +281,8 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, split_white_space_and_errors);
     tcase_add_test(t, numbers);
     tcase_add_test(t, numbers_equal_strtod_bit_for_bit);
+    tcase_add_test(t, byte_order_mark_semicolons_and_read_functions);
+    tcase_add_test(t, strtod_extensions_are_not_numbers);
     suite_add_tcase(s, t);
     return s;
 }

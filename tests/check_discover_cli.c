@@ -4,6 +4,7 @@
    recordings (skipped without them). */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -106,6 +107,151 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* One input from standard input or a pipe, or compressed: the same
+   answer as from the files; the copy of standard input leaves nothing in
+   TMPDIR; two inputs from standard input are refused. */
+START_TEST(inputs_from_a_pipe_and_compressed)
+{
+    static char want[65536], out[65536];
+    char cmd[4096], tmp[256];
+    const char *roles = "--channel acceleration --role position=position "
+                        "--role velocity=velocity --role input=input --base bias,gain --json";
+    make_dir();
+    snprintf(tmp, sizeof tmp, "%s/tmp", dir);
+    ck_assert_int_eq(mkdir(tmp, 0700), 0);
+    snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 3 --rows 20000 --real %s/r.csv --sim %s/s.csv",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s", FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, want, sizeof want), 0);
+    ck_assert_msg(strstr(want, "\"bad_rows\": {\"total\": 0,") != NULL, "%s", want);
+    /* The recording from a pipe. */
+    snprintf(cmd, sizeof cmd, "cat %s/r.csv | TMPDIR=%s %s discover --real - --sim %s/s.csv %s",
+             dir, tmp, FE_TEST_CLI, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* The simulation from standard input, compressed. */
+    snprintf(cmd, sizeof cmd, "gzip -c %s/s.csv | TMPDIR=%s %s discover --real %s/r.csv --sim - %s",
+             dir, tmp, FE_TEST_CLI, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* A compressed file. */
+    snprintf(cmd, sizeof cmd, "gzip -c %s/r.csv > %s/r.csv.gz && %s discover --real %s/r.csv.gz --sim %s/s.csv %s",
+             dir, dir, FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    /* Nothing left in TMPDIR. */
+    snprintf(cmd, sizeof cmd, "ls -A %s", tmp);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(out[0] == '\0', "left in TMPDIR: %s", out);
+    /* Standard input once only. */
+    snprintf(cmd, sizeof cmd, "%s discover --real - --sim - %s < %s/r.csv", FE_TEST_CLI, roles, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "standard input can be read only once") != NULL, "%s", out);
+    remove_dir();
+}
+END_TEST
+
+/* Clocks as sensors produce them (issue 19, item 7): a static recording
+   read in bursts (4 reads 1 ms apart, then a 37 ms wait) against a
+   simulation built from its own times, against one on a regular 10 ms
+   grid, and against ones that start late, end early and miss a second;
+   every row whose time the simulation covers is compared, every other is
+   counted by reason; a simulation in milliseconds draws a warning. */
+static void write_bursty(const char *name, int rows, int mode)
+{
+    char path[256];
+    FILE *f;
+    fe_rng g = fe_rng_seed(17);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fprintf(f, "time,az\n");
+    for (int i = 0; i < rows; i++) {
+        double t = 0.040 * (i / 4) + 0.001 * (i % 4);
+        if (mode == 0)          /* the recording */
+            fprintf(f, "%.3f,%.6f\n", t, 9.81 + 0.01 * fe_rng_normal(&g));
+        else if (mode == 1)     /* the simulation on the recording's own times */
+            fprintf(f, "%.3f,9.81\n", t);
+        else if (mode == 2)     /* the same in milliseconds */
+            fprintf(f, "%.0f,9.81\n", 1000 * t);
+    }
+    if (mode == 3)              /* a regular 10 ms grid, 0 to 40 s */
+        for (int i = 0; i <= rows; i++)
+            fprintf(f, "%.3f,9.81\n", 0.010 * i);
+    if (mode == 4)              /* 1 s to 19 s and 21 s to 30 s: late, a gap, early end */
+        for (int i = 0; i <= 2900; i++) {
+            double t = 1.0 + 0.010 * i;
+            if (t < 19.0 - 1e-9 || t > 21.0 + 1e-9)
+                fprintf(f, "%.3f,9.81\n", t);
+        }
+    fclose(f);
+}
+
+/* The number after `key` in `text`, or -1. */
+static long json_count(const char *text, const char *key)
+{
+    const char *at = strstr(text, key);
+    return at != NULL ? strtol(at + strlen(key), NULL, 10) : -1;
+}
+
+START_TEST(bursty_clocks_keep_every_covered_row)
+{
+    static char out[65536];
+    char cmd[2048];
+    const int rows = 4000;      /* 1000 bursts, 40 s */
+    long before = 0, after = 0, gap = 0;
+    make_dir();
+    write_bursty("real.csv", rows, 0);
+    write_bursty("own.csv", rows, 1);
+    write_bursty("ms.csv", rows, 2);
+    write_bursty("grid.csv", rows, 3);
+    write_bursty("holes.csv", rows, 4);
+    /* The simulation's own times: every row compared. */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/own.csv --channel az --json",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(json_count(out, "\"compared\": ") == rows, "%s", out);
+    ck_assert_msg(strstr(out, "\"outside_simulation\": 0,") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "same unit of time") == NULL, "%s", out);
+    /* A regular grid over the recording's span: every row compared. */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/grid.csv --channel az --json",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(json_count(out, "\"compared\": ") == rows, "%s", out);
+    /* Late start, a 2 s hole, early end: counted by reason, counted here
+       independently from the times. */
+    for (int i = 0; i < rows; i++) {
+        double t = 0.040 * (i / 4) + 0.001 * (i % 4);
+        if (t < 1.0)
+            before++;
+        else if (t > 30.0 + 1e-9)
+            after++;
+        else if (t > 18.99 + 1e-9 && t < 21.01 - 1e-9)
+            gap++;
+    }
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/holes.csv --channel az --json",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(json_count(out, "\"before_start\": ") == before, "want %ld: %s", before, out);
+    ck_assert_msg(json_count(out, "\"after_end\": ") == after, "want %ld: %s", after, out);
+    ck_assert_msg(json_count(out, "\"in_gap\": ") == gap, "want %ld: %s", gap, out);
+    ck_assert_msg(json_count(out, "\"compared\": ") == rows - before - after - gap, "%s", out);
+    ck_assert_msg(json_count(out, "\"outside_simulation\": ") == before + after + gap, "%s", out);
+    /* The story says it in words. */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/holes.csv --channel az",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "before it starts") != NULL && strstr(out, "in its gaps") != NULL, "%s", out);
+    /* Milliseconds against seconds: a warning (and nothing compared). */
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/ms.csv --channel az --json",
+             FE_TEST_CLI, dir, dir);
+    run(cmd, out, sizeof out);
+    ck_assert_msg(strstr(out, "same unit of time") != NULL, "%s", out);
+    remove_dir();
+}
+END_TEST
+
 /* Bad inputs: each gives its exit status and a message naming the problem. */
 struct bad_case {
     const char *what, *real, *sim, *args;
@@ -123,6 +269,8 @@ static const struct bad_case bad_cases[] = {
      "no column 'v'"},
     {"NaN in the recording", "time,y\n0,1\n1,nan\n", "time,y\n0,1\n1,2\n", "--channel y", 3,
      "real.csv:3:3: 'nan' in column 'y' is not a finite number"},
+    {"empty cell in the simulation", "time,y\n0,1\n1,2\n", "time,y\n0,1\n1,\n", "--channel y", 3,
+     "sim.csv:3:3: empty cell in column 'y'"},
     {"time going backwards", "time,y\n0,1\n2,1\n1,1\n", "time,y\n0,1\n1,2\n2,3\n", "--channel y", 3,
      "real.csv:4: time does not increase"},
     {"simulation time going backwards", "time,y\n0,1\n1,1\n2,1\n", "time,y\n0,1\n2,2\n1,3\n",
@@ -266,6 +414,8 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, inputs_from_a_pipe_and_compressed);
+    tcase_add_test(t, bursty_clocks_keep_every_covered_row);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));
     tcase_add_test(t, free_fall_recordings_show_quadratic_drag);
     tcase_add_test(t, magnetometers_show_axis_gain_and_cross_axis);

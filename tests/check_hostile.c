@@ -67,6 +67,14 @@ static const struct hostile cases[] = {
      "IN:102:10: '-Inf' in column 'mz' is not a finite number"},
     {"overflowing number", "t,mx,my,mz\n", "9.99,1,2,1e999\n", GOOD_ROWS, 0, 0, 0, 3,
      "IN:102:10: '1e999' in column 'mz' is not a finite number"},
+    {"hexadecimal number", "t,mx,my,mz\n", "9.99,1,2,0x1p3\n", GOOD_ROWS, 0, 0, 0, 3,
+     "IN:102:10: '0x1p3' in column 'mz' is not a number"},
+    {"empty cell", "t,mx,my,mz\n", "9.99,1,2,\n", GOOD_ROWS, 0, 0, 0, 3,
+     "IN:102:10: empty cell in column 'mz'"},
+    {"truncated gzip", NULL, NULL /* written by write_hostile */, GOOD_ROWS, 0, 0, 0, 3,
+     "corrupt or truncated gzip data"},
+    {"byte-order mark, semicolons, decimal commas (valid)", "\xEF\xBB\xBFt;mx;my;mz\n", "",
+     GOOD_ROWS, 0, 0, 0, 0, NULL},
     {"too many fields", "t,mx,my,mz\n", "9.99,1,2,3,4\n", GOOD_ROWS, 0, 0, 0, 3,
      "IN:102:1: expected 4 fields, found 5"},
     {"too few fields", "t,mx,my,mz\n", "9.99,1,2\n", GOOD_ROWS, 0, 0, 0, 3,
@@ -82,24 +90,48 @@ enum { NCASES = sizeof cases / sizeof cases[0] };
 
 static char dir[64];
 
-static void write_rows(FILE *f, int rows, int crlf, int extra, double t0)
+static void write_rows_as(FILE *f, int rows, int crlf, int extra, double t0, int comma)
 {
     fe_rng g = fe_rng_seed(5);
     for (int i = 0; i < rows; i++) {
         double v[3];
+        char line[256];
         fe_rng_unit_vector(&g, v);
-        fprintf(f, "%.2f,%.4f,%.4f,%.4f%s%s", t0 + 0.01 * i, 20 + 400 * v[0],
-                -10 + 380 * v[1], 5 + 420 * v[2], extra ? ",0" : "", crlf ? "\r\n" : "\n");
+        snprintf(line, sizeof line, comma ? "%.2f;%.4f;%.4f;%.4f%s%s" : "%.2f,%.4f,%.4f,%.4f%s%s",
+                 t0 + 0.01 * i, 20 + 400 * v[0], -10 + 380 * v[1], 5 + 420 * v[2],
+                 extra ? (comma ? ";0" : ",0") : "", crlf ? "\r\n" : "\n");
+        if (comma)              /* a spreadsheet's decimal commas */
+            for (char *c = line; *c != '\0'; c++)
+                if (*c == '.')
+                    *c = ',';
+        fputs(line, f);
     }
+}
+
+static void write_rows(FILE *f, int rows, int crlf, int extra, double t0)
+{
+    write_rows_as(f, rows, crlf, extra, t0, 0);
 }
 
 static void write_hostile(const char *path, const struct hostile *h)
 {
-    FILE *f = fopen(path, "wb");
+    FILE *f;
+    if (strcmp(h->what, "truncated gzip") == 0) {
+        /* A valid recording compressed by gzip(1), cut in the middle. */
+        struct hostile good = {"", "t,mx,my,mz\n", "", GOOD_ROWS, 0, 0, 0, 0, NULL};
+        char cmd[512];
+        write_hostile(path, &good);
+        snprintf(cmd, sizeof cmd, "gzip -c '%s' > '%s.gz' && head -c 1500 '%s.gz' > '%s' && rm '%s.gz'",
+                 path, path, path, path, path);
+        ck_assert_int_eq(system(cmd), 0);
+        return;
+    }
+    f = fopen(path, "wb");
     ck_assert_ptr_nonnull(f);
     if (h->header != NULL)
         fputs(h->header, f);
-    write_rows(f, h->rows, h->crlf, h->extra, 0.0);
+    write_rows_as(f, h->rows, h->crlf, h->extra, 0.0,
+                  h->header != NULL && strchr(h->header, ';') != NULL);
     if (h->tail != NULL) {
         /* The binary case has a NUL inside: write its bytes by length. */
         size_t n = strcmp(h->what, "binary block") == 0 ? 19 : strlen(h->tail);
@@ -382,14 +414,8 @@ static int any_named(const char *d, const char *part)
 static void read_stderr(const char *d, char *buf, size_t len)
 {
     char path[256];
-    FILE *f;
-    size_t got;
     snprintf(path, sizeof path, "%s/stderr.txt", d);
-    f = fopen(path, "r");
-    ck_assert_ptr_nonnull(f);
-    got = fread(buf, 1, len - 1, f);
-    buf[got] = '\0';
-    fclose(f);
+    fe_test_read_file(path, buf, len);
 }
 
 /* A valid recording d/good.csv: a header and GOOD_ROWS samples. */

@@ -63,4 +63,17 @@ static inline void fe_test_ellipsoid_points(double *x, size_t n, const double c[
     }
 }
 
+/* Read at most len - 1 bytes of the file at `path` into buf, NUL-terminated;
+   the count.  The test fails when the file cannot be opened. */
+static inline size_t fe_test_read_file(const char *path, char *buf, size_t len)
+{
+    FILE *f = fopen(path, "rb");
+    size_t got;
+    ck_assert_msg(f != NULL, "cannot open %s", path);
+    got = fread(buf, 1, len - 1, f);
+    buf[got] = '\0';
+    fclose(f);
+    return got;
+}
+
 #endif /* FE_TESTUTIL_H */

@@ -10,9 +10,17 @@
 extern "C" {
 #endif
 
-/* A line reader over a file descriptor, through a caller buffer. */
+/* Where a reader gets its bytes, when not from a file descriptor: like
+   read(2), up to n bytes into buf; returns the count, 0 at the end, or -1
+   with errno set (EINTR: called again). */
+typedef long fe_csv_read_fn(void *ctx, char *buf, size_t n);
+
+/* A line reader over a file descriptor or a read function, through a
+   caller buffer. */
 typedef struct fe_csv_reader {
     int fd;
+    fe_csv_read_fn *read;       /* NULL: read(2) from fd */
+    void *read_ctx;
     char *buf;
     size_t cap, len, pos;
     size_t line;                /* number of the line last returned, from 1 */
@@ -21,8 +29,14 @@ typedef struct fe_csv_reader {
 } fe_csv_reader;
 
 /* fe_csv_reader_init: read from `fd` (the caller's to close) through
-   `buffer` of `cap` bytes; `cap` - 1 is the longest line accepted. */
+   `buffer` of `cap` bytes; `cap` - 1 is the longest line accepted.  A
+   UTF-8 byte-order mark at the start of the input is skipped. */
 int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap);
+
+/* fe_csv_reader_init_read: the same, reading through `fn(ctx, ...)` (a
+   decompressor, say) instead of a file descriptor.  FE_EINVAL for NULL. */
+int fe_csv_reader_init_read(fe_csv_reader *r, fe_csv_read_fn *fn, void *ctx,
+                            char *buffer, size_t cap);
 
 /* fe_csv_next_line: point *line at the next line, NUL-terminated, without
    its line end (LF or CRLF); *len is its length.  The line lives in the
@@ -41,8 +55,8 @@ typedef struct fe_csv_field {
     size_t column;              /* byte column where the field starts, from 1 */
 } fe_csv_field;
 
-/* fe_csv_guess_delimiter: ',', ';', '\t' (the first the line contains),
-   else FE_CSV_WHITESPACE. */
+/* fe_csv_guess_delimiter: ';' if the line has one, else ',' or '\t' (the
+   first the line contains), else FE_CSV_WHITESPACE. */
 char fe_csv_guess_delimiter(const char *line);
 
 /* fe_csv_split: split `line` in place into at most `max` fields.
@@ -53,10 +67,16 @@ char fe_csv_guess_delimiter(const char *line);
 int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
                  size_t max, size_t *count, size_t *bad_column);
 
-/* fe_csv_number: parse a whole field as a finite double (C locale).
-   FE_EPARSE when it is empty or not entirely a number; FE_ENONFINITE
-   for "nan", "inf" and values that overflow. */
+/* fe_csv_number: parse a whole field as a finite double: a plain decimal,
+   [+-] digits [. digits] [(e|E) [+-] digits] with at least one digit
+   before the exponent.  FE_EPARSE when it is empty or anything else
+   (hexadecimal, text, spaces inside); FE_ENONFINITE for "nan", "inf",
+   "infinity" (any case, signed or not) and values that overflow. */
 int fe_csv_number(const fe_csv_field *field, double *value);
+
+/* fe_csv_number_comma: the same with a decimal comma: "1,5" is 1.5 and a
+   point is not accepted.  A field of more than 255 bytes is FE_EPARSE. */
+int fe_csv_number_comma(const fe_csv_field *field, double *value);
 
 #ifdef __cplusplus
 }

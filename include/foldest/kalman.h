@@ -103,6 +103,16 @@ int fe_kalman_update(fe_kalman *k, const fe_kalman_obs *o,
    O(n^2 b + n b^2 + b^3) flops, no library calls, allocates nothing. */
 int fe_kalman_update_fast(fe_kalman *k, const fe_kalman_obs *o,
                           fe_kalman_report *r);
+
+/* fe_kalman_update_joseph: the reference update with the covariance in
+   Joseph's form, P <- (I - K A) P (I - K A)^T + K Z K^T, arranged so that
+   no term cancels to the size of the old P: right where the standard
+   form loses everything (a vague prior against a precise measurement, P0
+   = 1e10 I and Z = 1e-8 I: the standard forms give P = 0).  Errors and
+   the unchanged-on-error promise as fe_kalman_update.  Cost about twice
+   fe_kalman_update's O(n^2 b) products. */
+int fe_kalman_update_joseph(fe_kalman *k, const fe_kalman_obs *o,
+                            fe_kalman_report *r);
 /* Kalman Filter Declarations ends here */
 /* [[file:../../literate/kalman.org::Tracking Filter Declarations][Tracking Filter Declarations]] */
 /* The motion model of one predict step:
@@ -133,6 +143,9 @@ int fe_kalman_track(fe_kalman *k, const fe_kalman_track_obs *o,
                     fe_kalman_report *r);
 int fe_kalman_track_fast(fe_kalman *k, const fe_kalman_track_obs *o,
                          fe_kalman_report *r);
+/* fe_kalman_track_joseph: the same with fe_kalman_update_joseph. */
+int fe_kalman_track_joseph(fe_kalman *k, const fe_kalman_track_obs *o,
+                           fe_kalman_report *r);
 /* Tracking Filter Declarations ends here */
 /* [[file:../../literate/kalman.org::Information Form Declarations][Information Form Declarations]] */
 /* A filter in information form: Lambda = P^{-1}, eta = P^{-1} x.  Packets

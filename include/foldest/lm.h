@@ -57,7 +57,8 @@ enum fe_lm_stop {
     FE_LM_GTOL,         /* negligible gradient */
     FE_LM_MAXITER,      /* max_iter reached (FE_ENOCONV) */
     FE_LM_STOPPED,      /* the report callback asked to stop */
-    FE_LM_STUCK         /* damping grew without bound (FE_ENOCONV) */
+    FE_LM_STUCK,        /* damping grew without bound (FE_ENOCONV) */
+    FE_LM_RTOL          /* negligible relative change of the cost */
 };
 
 typedef struct fe_lm_params {
@@ -66,6 +67,11 @@ typedef struct fe_lm_params {
     double xtol;        /* negligible step, relative (default 1e-12) */
     double gtol;        /* negligible max |J'Wf| (default 0) */
     double ftol;        /* cost low enough (default 0) */
+    double rtol;        /* negligible relative change of the cost: an
+                           accepted step whose actual and predicted
+                           reductions are both <= rtol * cost ends the
+                           iteration (default 1e-12; 0: never) */
+    double lambda_min;  /* floor on the damping (default 1e-10) */
 } fe_lm_params;
 
 /* fe_lm_default_params: the defaults above. */
@@ -93,11 +99,13 @@ typedef struct fe_lm_result {
     double initial_cost;
     double cost;        /* at the returned x */
     int stop;           /* an enum fe_lm_stop */
+    int extended;       /* steps taken further along their line */
+    int accelerated;    /* steps followed by a search along the last two */
 } fe_lm_result;
 
 /* fe_lm_work: doubles of workspace fe_lm_solve needs.  With p = ng+nb*nl:
-   dense (p+1)^2 + p^2 + 3p; Schur fe_schur_storage(ng, nl, nb) +
-   fe_schur_solve_work(ng, nl) + 2p.  0 for an unknown method. */
+   dense (p+1)^2 + p^2 + 4p; Schur fe_schur_storage(ng, nl, nb) +
+   fe_schur_solve_work(ng, nl) + 3p.  0 for an unknown method. */
 size_t fe_lm_work(const fe_lm_problem *prob, int method);
 
 /* fe_lm_solve: minimise (1/2) sum w f^2 from x (updated in place: on

@@ -58,12 +58,20 @@ typedef struct fe__calibrate_args {
 
 /* Parse argv; FE_CLI_OK, or an exit status after printing why (-1 for
    --help, printed). */
+static const fe_cli_option fe__calibrate_options[] = {
+    {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
+    {"--trace", 0}, {NULL, 0}};
+
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
     char err[512];
+    int rc;
     memset(a, 0, sizeof *a);
     a->skip = -1;
     a->model = FE_FIT_AXIAL;
+    rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(fe__calibrate_help, stdout);
@@ -247,9 +255,18 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
 static void fe__calibrate_json_array(const double *v, int n)
 {
     printf("[");
-    for (int k = 0; k < n; k++)
-        printf("%s%.10g", k ? ", " : "", v[k]);
+    for (int k = 0; k < n; k++) {
+        printf("%s", k ? ", " : "");
+        fe_cli_json_number(stdout, v[k]);
+    }
     printf("]");
+}
+
+/* `, "key": number`, the number as every command writes it (cli.org). */
+static void fe__calibrate_json_key(const char *key, double x)
+{
+    printf(", \"%s\": ", key);
+    fe_cli_json_number(stdout, x);
 }
 
 static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
@@ -271,28 +288,30 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
             printf("%s", i ? ", " : "");
             fe__calibrate_json_array(f->matrix + 3 * i, 3);
         }
-        printf("], \"radius\": %.10g, \"axes\": ", f->radius);
+        printf("]");
+        fe__calibrate_json_key("radius", f->radius);
+        printf(", \"axes\": ");
         fe__calibrate_json_array(f->axes, 3);
         printf(", \"params\": ");
         fe__calibrate_json_array(f->params, f->nparams);
         printf(", \"params_se\": ");
         fe__calibrate_json_array(f->se, f->nparams);
-        printf(", \"rms_percent\": %.6g", f->rms_percent);
+        fe__calibrate_json_key("rms_percent", f->rms_percent);
     } else {
         printf(", \"offset\": null, \"matrix\": null, \"rms_percent\": null");
     }
-    if (p2->done)
-        printf(", \"rms_radial_percent\": %.6g, \"coverage\": %.2f",
-               p2->rms_radial_percent, p2->regions / 100.0);
-    else
-        printf(", \"rms_radial_percent\": null, \"coverage\": %.2f", f->coverage);
-    printf(", \"coverage_fold\": %.2f, \"planarity\": %.4g", f->coverage, f->planarity);
+    fe__calibrate_json_key("rms_radial_percent", p2->done ? p2->rms_radial_percent : NAN);
+    fe__calibrate_json_key("coverage", p2->done ? p2->regions / 100.0 : f->coverage);
+    fe__calibrate_json_key("coverage_fold", f->coverage);
+    fe__calibrate_json_key("planarity", f->planarity);
     if (f->extent_lo[0] != 0.0 || f->extent_hi[0] != 0.0) {
         printf(", \"extent_lo\": ");
         fe__calibrate_json_array(f->extent_lo, 3);
         printf(", \"extent_hi\": ");
         fe__calibrate_json_array(f->extent_hi, 3);
     }
+    printf(", \"bad_rows\": ");
+    fe_cli_json_bad_rows(stdout);
     printf(", \"iterations\": %d, \"algebraic\": %s, \"refusal\": ", f->iterations,
            f->algebraic ? "true" : "false");
     if (rc == FE_OK)

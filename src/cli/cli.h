@@ -45,12 +45,31 @@ typedef struct fe_cli_table {
     char **pending;             /* looked-ahead data lines, replayed first */
     size_t *pending_line;
     size_t npending, next_pending;
+    size_t look_end;            /* the last line the look-ahead read */
     fe_csv_field *fields;
     size_t line;                /* line number of the row last returned */
     size_t rows;                /* rows returned so far */
     off_t size;                 /* file size for progress; 0: unknown */
     int progress;               /* show progress on stderr */
+    void *gz;                   /* the zlib stream everything is read through */
+    int decimal_comma;          /* 1: forced; 2: a semicolon table */
+    size_t bad[4];              /* rows skipped in this pass, by reason */
 } fe_cli_table;
+
+/* Why a row was bad (the index of fe_cli_table.bad). */
+enum { FE_CLI_BAD_EMPTY, FE_CLI_BAD_NONFINITE, FE_CLI_BAD_TEXT,
+       FE_CLI_BAD_FIELDS, FE_CLI_BAD_REASONS };
+
+/* The reader's options, for every table the process opens (set by the
+   dispatcher from --decimal-comma and --skip-bad-rows). */
+void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows);
+/* Turn on one reader option by its flag (from a command's options). */
+void fe_cli_reader_option(const char *flag);
+
+/* Rows skipped by --skip-bad-rows in the last pass over every table,
+   by reason; and the same as a JSON object. */
+void fe_cli_bad_rows(size_t counts[FE_CLI_BAD_REASONS]);
+void fe_cli_json_bad_rows(FILE *out);
 
 /* Open `path` ("-": standard input).  skip < 0 guesses where the data
    start; skip >= 0 skips that many lines.  On failure `err` holds the
@@ -68,7 +87,13 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen);
 
-/* Rewind to the first data row (files only: FE_CLI_IO for a pipe). */
+/* fe_cli_table_open_rewindable: the same, for a command that rewinds: an
+   input that is not a regular file (standard input, a pipe) is first
+   copied to an unlinked temporary file. */
+int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
+                                 char *err, size_t errlen);
+
+/* Rewind to the first data row (FE_CLI_IO when the input cannot seek). */
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen);
 
 void fe_cli_table_close(fe_cli_table *t);
@@ -118,6 +143,26 @@ int fe_cli_spawn(char *const argv[]);
 void fe_cli_progress(fe_cli_table *t);
 void fe_cli_progress_done(fe_cli_table *t);
 
+/* A command's option: its long form ("--real") and whether it takes a
+   value.  A table ends with {NULL, 0}. */
+typedef struct fe_cli_option {
+    const char *flag;
+    int takes_value;
+} fe_cli_option;
+
+/* fe_cli_options: parse argv (argv[0] the command's name) with
+   getopt_long against `opts`, plus --help/-h, --version/-V and the
+   reader's --decimal-comma and --skip-bad-rows, which every command
+   takes: --opt=value and --opt value, unambiguous abbreviations, options
+   and operands in any order.  On success *argcp and *argvp are replaced by
+   a canonical vector: argv[0], then each option as its full flag followed
+   by its value, then the operands; --help alone if it was asked for.
+   Returns FE_CLI_OK; -1 after printing the version; FE_CLI_USAGE after
+   printing "foldest COMMAND: unknown option '--x'; did you mean '--y'?",
+   an ambiguous abbreviation with its candidates, or a missing value. */
+int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
+                   char ***argvp);
+
 /* Parse option values; FE_CLI_USAGE with a message on error. */
 int fe_cli_parse_double(const char *opt, const char *text, double *value,
                         char *err, size_t errlen);
@@ -127,8 +172,12 @@ int fe_cli_parse_long(const char *opt, const char *text, long *value,
 /* Split "a,b,c" into at most `max` names (in place); the count or -1. */
 int fe_cli_split_list(char *text, char **items, int max);
 
-/* Print one JSON string, escaped. */
+/* Print one JSON string, escaped; bytes that are not UTF-8 become U+FFFD. */
 void fe_cli_json_string(FILE *out, const char *s);
+
+/* Print one JSON number: the shortest of 15, 16 or 17 significant digits
+   that reads back as the same double, or null when it is not finite. */
+void fe_cli_json_number(FILE *out, double x);
 
 #endif /* FOLDEST_CLI_H */
 /* Output Declarations ends here */

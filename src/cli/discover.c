@@ -45,7 +45,15 @@ typedef struct fe__pair {
     double min_step, last_real_t;
     int started;
     size_t skipped;
+    /* The simulation's median step (from a first scan of its times) and
+       its span; the recording's first time; rows left out, by reason. */
+    double step, sim_first, sim_last, first_real_t;
+    size_t outside[3];
+    int span_checked;
 } fe__pair;
+
+/* Why a recording row is outside the simulation. */
+enum { FE__BEFORE_START, FE__AFTER_END, FE__IN_GAP };
 
 /* Read the next simulation row into w[3], shifting the window left. */
 static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
@@ -83,9 +91,75 @@ static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
     return FE_CLI_OK;
 }
 
+/* Two simulation rows may be interpolated between when they are less
+   than five typical steps apart (the median step: bursts of fast rows do
+   not make every ordinary step a gap, as the smallest step did). */
 static int fe__linked(const fe__pair *p, const fe__simrow *a, const fe__simrow *b)
 {
-    return a->valid && b->valid && b->t - a->t <= 5.0 * p->min_step;
+    return a->valid && b->valid && b->t - a->t <= 5.0 * p->step;
+}
+
+static int fe__cmp_step(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Scan the simulation's times once: its median step and its span; then
+   rewind it.  A simulation whose time does not increase is reported by
+   the passes, with its line. */
+static int fe__sim_scan(fe__pair *p, char *err, size_t errlen)
+{
+    size_t n = 0, cap = 1024;
+    double *steps = malloc(cap * sizeof *steps), t, prev = 0.0;
+    int rc;
+    if (steps == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    p->step = 0.0;
+    while ((rc = fe_cli_table_next(&p->sim, p->sim_cols, 1, &t, err, errlen)) == FE_OK) {
+        if (p->sim.rows == 1)
+            p->sim_first = t;
+        else if (t > prev) {
+            if (n == cap) {
+                double *more = realloc(steps, 2 * cap * sizeof *steps);
+                if (more == NULL) {
+                    free(steps);
+                    snprintf(err, errlen, "out of memory");
+                    return FE_CLI_IO;
+                }
+                steps = more;
+                cap *= 2;
+            }
+            steps[n++] = t - prev;
+        }
+        prev = t;
+        p->sim_last = t;
+    }
+    if (n > 0) {
+        qsort(steps, n, sizeof *steps, fe__cmp_step);
+        p->step = steps[n / 2];
+    }
+    free(steps);
+    if (rc != FE_END)
+        return rc;
+    return fe_cli_table_rewind(&p->sim, err, errlen);
+}
+
+/* Say so when recording and simulation span times that differ a
+   hundredfold: seconds against milliseconds, say. */
+static void fe__check_spans(fe__pair *p)
+{
+    double real = p->last_real_t - p->first_real_t, sim = p->sim_last - p->sim_first;
+    if (p->span_checked || !(real > 0.0) || !(sim > 0.0))
+        return;
+    p->span_checked = 1;
+    if (real >= 100.0 * sim || sim >= 100.0 * real)
+        fprintf(stderr, "foldest discover: warning: %s spans %.6g time units but %s spans %.6g "
+                        "(%.0f times %s): do both use the same unit of time (seconds, milliseconds)?\n",
+                p->real.name, real, p->sim.name, sim, real > sim ? real / sim : sim / real,
+                real > sim ? "longer" : "shorter");
 }
 
 /* d(sim)/dt at window row i (1 or 2): central inside a segment. */
@@ -112,9 +186,13 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
     for (;;) {
         double t, lambda;
         rc = fe_cli_table_next(&p->real, p->real_cols, 2, v, err, errlen);
+        if (rc == FE_END)
+            fe__check_spans(p);
         if (rc != FE_OK)
             return rc;
         t = v[0];
+        if (p->real.rows == 1)
+            p->first_real_t = t;
         if (!(t > p->last_real_t)) {
             snprintf(err, errlen, "%s:%zu: time does not increase (%.17g after %.17g)",
                      p->real.name, p->real.line, t, p->last_real_t);
@@ -124,11 +202,29 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
         while (p->w[2].valid && p->w[2].t < t)
             if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
                 return rc;
-        if (!p->w[1].valid || t < p->w[1].t
-            || (!p->w[2].valid && t != p->w[1].t)
-            || (p->w[2].valid && !fe__linked(p, &p->w[1], &p->w[2]) && t != p->w[1].t)) {
-            p->skipped++;
-            continue;
+        /* Now w[1].t < t <= w[2].t, or the simulation has ended or not
+           begun.  A time the simulation has is always covered, whether it
+           lands on w[1] or on w[2] (the loop stops at w[2].t == t). */
+        {
+            int on1 = p->w[1].valid && t == p->w[1].t, on2 = p->w[2].valid && t == p->w[2].t;
+            if (!on1 && !on2
+                && (!p->w[1].valid || t < p->w[1].t || !p->w[2].valid
+                    || !fe__linked(p, &p->w[1], &p->w[2]))) {
+                p->skipped++;
+                p->outside[!p->w[1].valid || t < p->w[1].t ? FE__BEFORE_START
+                           : !p->w[2].valid ? FE__AFTER_END : FE__IN_GAP]++;
+                continue;
+            }
+            if (on2 && !on1) {  /* as if the window had moved one row on */
+                memset(out, 0, sizeof *out);
+                out->t = t;
+                out->real = v[1];
+                out->sim = p->w[2].s;
+                out->dsim = fe__dsim(p, 2);
+                for (int r = 0; r < FE__ROLES; r++)
+                    *fe__role(out, r) = p->w[2].role[r];
+                return FE_OK;
+            }
         }
         memset(out, 0, sizeof *out);
         out->t = t;
@@ -157,6 +253,7 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
     memset(p->w, 0, sizeof p->w);
     p->started = 0;
     p->skipped = 0;
+    memset(p->outside, 0, sizeof p->outside);
     p->min_step = 0.0;
     return rc;
 }
@@ -268,7 +365,9 @@ static const char fe__discover_help[] =
     "and show the fit improve, also on held-out rows.\n"
     "\n"
     "  --real FILE, --sim FILE  a recording and its simulation (CSV, with a time\n"
-    "                         column each); repeat the pair for several recordings\n"
+    "                         column each); repeat the pair for several recordings;\n"
+    "                         one input may be '-' (standard input) or a pipe: it is\n"
+    "                         copied once to a temporary file, removed at exit\n"
     "  --channel NAME         the measured channel, a column of both files\n"
     "  --time NAME            the time column (default: 'time', else the first)\n"
     "  --role COLUMN=ROLE     a simulation column's role: position, velocity,\n"
@@ -453,14 +552,12 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
 {
     int rc;
     size_t k = 2;
-    if (strcmp(p->real_path, "-") == 0 || strcmp(p->sim_path, "-") == 0) {
-        snprintf(err, errlen, "discover reads each file three times: give files, not '-'");
-        return FE_CLI_USAGE;
-    }
-    rc = fe_cli_table_open(&p->real, p->real_path, -1, err, errlen);
+    /* Three passes: an input that cannot seek (standard input, a pipe) is
+       copied once to an unlinked temporary file (cli.org). */
+    rc = fe_cli_table_open_rewindable(&p->real, p->real_path, -1, err, errlen);
     if (rc != FE_CLI_OK)
         return rc;
-    rc = fe_cli_table_open(&p->sim, p->sim_path, -1, err, errlen);
+    rc = fe_cli_table_open_rewindable(&p->sim, p->sim_path, -1, err, errlen);
     if (rc != FE_CLI_OK)
         return rc;
     if ((rc = fe__time_column(&p->real, a->time, &p->real_cols[0], err, errlen)) != FE_CLI_OK
@@ -485,14 +582,14 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
         p->role_col[r] = (int)k++;
         *roles |= 1u << r;
     }
-    return FE_CLI_OK;
+    return fe__sim_scan(p, err, errlen);
 }
 /* Open a pair and find its columns ends here */
 /* [[file:../../literate/cli_discover.org::Read the pairs as one stream][Read the pairs as one stream]] */
 typedef struct fe__stream {
     fe__discover_args *a;
     size_t cur;
-    size_t skipped;
+    size_t skipped, outside[3];
 } fe__stream;
 
 /* Returns FE_OK, FE_END, or an exit status; *new_pair is set when the
@@ -508,6 +605,8 @@ static int fe__stream_next(fe__stream *st, fe_sample *s, int *new_pair, char *er
         if (rc != FE_END)
             return rc;
         st->skipped += p->skipped;
+        for (int k = 0; k < 3; k++)
+            st->outside[k] += p->outside[k];
         st->cur++;
         *new_pair = 1;
     }
@@ -518,6 +617,7 @@ static int fe__stream_rewind(fe__stream *st, char *err, size_t errlen)
 {
     st->cur = 0;
     st->skipped = 0;
+    memset(st->outside, 0, sizeof st->outside);
     for (size_t i = 0; i < st->a->npairs; i++) {
         int rc = fe__pair_rewind(&st->a->pairs[i], err, errlen);
         if (rc != FE_CLI_OK)
@@ -534,6 +634,7 @@ typedef struct fe__outcome {
     size_t nbase;
     double baseline_coef[FE_DISCOVER_MAX_COLUMNS];
     size_t rows, skipped, fit, heldout, blocks;
+    size_t outside[3];                          /* skipped, by reason */
     double alpha;
     fe__located located[128];
     size_t nlocated;
@@ -564,10 +665,7 @@ static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
 
 static void fe__json_number(FILE *f, double x)
 {
-    if (isfinite(x))
-        fprintf(f, "%.10g", x);
-    else
-        fprintf(f, "null");
+    fe_cli_json_number(f, x);   /* one format in every command (cli.org) */
 }
 
 /* `, "key": number`. */
@@ -646,7 +744,12 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     const fe_discover_result *r = o->r;
     fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
     fprintf(f, "\"rows\": {\"compared\": %zu, \"outside_simulation\": %zu, \"fit\": %zu, "
-               "\"heldout\": %zu}, ", o->rows, o->skipped, o->fit, o->heldout);
+               "\"heldout\": %zu, \"outside_by_reason\": {\"before_start\": %zu, "
+               "\"after_end\": %zu, \"in_gap\": %zu}}, \"bad_rows\": ", o->rows, o->skipped,
+            o->fit, o->heldout, o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END],
+            o->outside[FE__IN_GAP]);
+    fe_cli_json_bad_rows(f);
+    fprintf(f, ", ");
     fprintf(f, "\"base\": [");
     for (size_t i = 0; i < o->nbase; i++) {
         fprintf(f, "%s", i ? ", " : "");
@@ -790,8 +893,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     const fe_discover_result *r = o->r;
     fe_discover_rank sorted[FE_DISCOVER_MAX_GROUPS];
     double rel;
-    fprintf(f, "compared %zu rows (%zu outside the simulation): %zu fitted, %zu held out\n",
-            o->rows, o->skipped, o->fit, o->heldout);
+    fprintf(f, "compared %zu rows (%zu outside the simulation", o->rows, o->skipped);
+    if (o->skipped > 0)
+        fprintf(f, ": %zu before it starts, %zu after it ends, %zu in its gaps",
+                o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END], o->outside[FE__IN_GAP]);
+    fprintf(f, "): %zu fitted, %zu held out\n", o->fit, o->heldout);
     fprintf(f, "baseline (simulation");
     for (size_t i = 0; i < o->nbase; i++)
         fprintf(f, " + %s", o->c->terms[o->base[i]].name);
@@ -1026,6 +1132,13 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const char *p
 /* [[file:../../literate/cli_discover.org::Run discovery on recordings][Run discovery on recordings]] */
 static int fe__discover_sphere_main(int argc, char **argv);
 
+/* Every option of discover and of discover --sphere (cli.org's
+   fe_cli_options parses them; the loops below read the canonical form). */
+static const fe_cli_option fe__discover_options[] = {
+    {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
+    {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--blocks", 1}, {"--alpha", 1},
+    {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
+
 int fe_cli_discover(int argc, char **argv)
 {
     fe__discover_args a;
@@ -1056,6 +1169,9 @@ int fe_cli_discover(int argc, char **argv)
     fe__panel *panel = NULL;
 
     memset(&out, 0, sizeof out);
+    rc = fe_cli_options("discover", fe__discover_options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc < 0 ? FE_CLI_OK : rc;
     for (int i = 1; i < argc; i++)
         if (strcmp(argv[i], "--sphere") == 0)
             return fe__discover_sphere_main(argc, argv);
@@ -1082,6 +1198,7 @@ int fe_cli_discover(int argc, char **argv)
     st.a = &a;
     st.cur = 0;
     st.skipped = 0;
+    memset(st.outside, 0, sizeof st.outside);
 
     /* Pass 1: scale and ranges. */
     for (int r = 0; r < FE__ROLES; r++) {
@@ -1111,6 +1228,7 @@ int fe_cli_discover(int argc, char **argv)
         }
     }
     out.skipped = st.skipped;
+    memcpy(out.outside, st.outside, sizeof out.outside);
     scale.temperature_kelvin = kelvin[2];
     scale.ambient_kelvin = kelvin[3];
     if (fe_catalog_init(&cat, roles, &scale) != FE_OK)
@@ -1586,15 +1704,10 @@ static int fe__discover_sphere(fe__sphere_args *a)
     int rc, has_time = 0, has_temp = a->temperature != NULL;
     double oct_n[8] = {0}, oct_s0[8] = {0}, oct_s1[8] = {0}, ms_all = 0;
 
-    rc = fe_cli_table_open(&t, a->path, -1, err, sizeof err);
+    rc = fe_cli_table_open_rewindable(&t, a->path, -1, err, sizeof err);
     if (rc != FE_CLI_OK) {
         fprintf(stderr, "foldest discover: %s\n", err);
         return rc;
-    }
-    if (strcmp(a->path, "-") == 0) {
-        fprintf(stderr, "foldest discover: --sphere reads the file three times: give a file\n");
-        fe_cli_table_close(&t);
-        return FE_CLI_USAGE;
     }
     /* Columns: three axes, then time and temperature when given. */
     if (a->columns != NULL) {
@@ -1655,7 +1768,9 @@ static int fe__discover_sphere(fe__sphere_args *a)
         if (a->json) {
             printf("{\"verdict\": \"refused\", \"reason\": ");
             fe_cli_json_string(stdout, fe_sphere_refusal_string(fit.refusal));
-            printf(", \"coverage\": %.4g, \"n\": %zu}\n", fit.coverage, rows);
+            printf(", \"coverage\": ");
+            fe_cli_json_number(stdout, fit.coverage);
+            printf(", \"n\": %zu}\n", rows);
         }
         fprintf(stderr, "foldest discover: %s: the sphere is not determined by these data "
                         "(%s; coverage %.0f%% of the regions): nothing to compare against\n",
@@ -1754,31 +1869,50 @@ static int fe__discover_sphere(fe__sphere_args *a)
         const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
         const char *verdict = res->steps > 0 ? "mismatch explained" : "no significant mismatch";
         if (a->json) {
-            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu, "
-                   "\"radius\": %.10g, \"offset\": [%.10g, %.10g, %.10g], \"coverage\": %.4g, ",
-                   verdict, rows, held, fit.radius, fit.offset[0], fit.offset[1], fit.offset[2],
-                   fit.coverage);
-            printf("\"baseline\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
-                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, ", b0->rms, 100 * b0->rms / fit.radius,
-                   b0->bic, b0->heldout_rms, b0->lag1);
-            printf("\"final\": {\"rms\": %.6g, \"rms_percent\": %.4g, \"bic\": %.6g, "
-                   "\"heldout_rms\": %.6g, \"lag1\": %.4g}, \"discovered\": [", b1->rms,
-                   100 * b1->rms / fit.radius, b1->bic, b1->heldout_rms, b1->lag1);
+            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu",
+                   verdict, rows, held);
+            fe__json_pair(stdout, "radius", fit.radius);
+            printf(", \"offset\": [");
+            for (int c = 0; c < 3; c++) {
+                printf("%s", c ? ", " : "");
+                fe__json_number(stdout, fit.offset[c]);
+            }
+            printf("]");
+            fe__json_pair(stdout, "coverage", fit.coverage);
+            printf(", \"bad_rows\": ");
+            fe_cli_json_bad_rows(stdout);
+            for (int w = 0; w < 2; w++) {
+                const fe_discover_fit *b = w ? b1 : b0;
+                printf(", \"%s\": {\"rms\": ", w ? "final" : "baseline");
+                fe__json_number(stdout, b->rms);
+                fe__json_pair(stdout, "rms_percent", 100 * b->rms / fit.radius);
+                fe__json_pair(stdout, "bic", b->bic);
+                fe__json_pair(stdout, "heldout_rms", b->heldout_rms);
+                fe__json_pair(stdout, "lag1", b->lag1);
+                printf("}");
+            }
+            printf(", \"discovered\": [");
             for (size_t s = 0; s < res->steps; s++) {
                 const fe_discover_group *g = &groups[res->added[s]];
                 printf("%s{\"name\": \"%s\", \"description\": \"%s\", \"coefficients\": [",
                        s ? ", " : "", g->name, desc[res->added[s] < 5 ? res->added[s] : 5]);
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
-                        if (res->cols[j] == g->first + c)
-                            printf("%s%.6g", c ? ", " : "", res->coef[j]);
+                        if (res->cols[j] == g->first + c) {
+                            printf("%s", c ? ", " : "");
+                            fe__json_number(stdout, res->coef[j]);
+                        }
                 printf("], \"stderr\": [");
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
-                        if (res->cols[j] == g->first + c)
-                            printf("%s%.3g", c ? ", " : "", res->stderr_[j]);
-                printf("], \"statistic\": %.4g, \"p_value\": %.3g}", res->added_rank[s].statistic,
-                       res->added_rank[s].p_value);
+                        if (res->cols[j] == g->first + c) {
+                            printf("%s", c ? ", " : "");
+                            fe__json_number(stdout, res->stderr_[j]);
+                        }
+                printf("]");
+                fe__json_pair(stdout, "statistic", res->added_rank[s].statistic);
+                fe__json_pair(stdout, "p_value", res->added_rank[s].p_value);
+                printf("}");
             }
             printf("]}\n");
         } else {

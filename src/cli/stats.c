@@ -15,6 +15,9 @@ static const char fe__stats_help[] =
     "every column.  The header is found automatically among metadata lines;\n"
     "--skip N skips N lines first.  Malformed input: FILE:LINE:COLUMN: message.\n";
 
+static const fe_cli_option fe__stats_options[] = {
+    {"--columns", 1}, {"--skip", 1}, {"--json", 0}, {NULL, 0}};
+
 int fe_cli_stats(int argc, char **argv)
 {
     const char *path = NULL;
@@ -26,6 +29,9 @@ int fe_cli_stats(int argc, char **argv)
     double *row = NULL, *lo = NULL, *hi = NULL;
     fe_meanvar *mv = NULL;
 
+    rc = fe_cli_options("stats", fe__stats_options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc < 0 ? FE_CLI_OK : rc;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
             fputs(fe__stats_help, stdout);
@@ -117,12 +123,21 @@ int fe_cli_stats(int argc, char **argv)
     if (json) {
         printf("{\"file\": ");
         fe_cli_json_string(stdout, t.name);
-        printf(", \"rows\": %zu, \"columns\": [", t.rows);
+        printf(", \"rows\": %zu, \"bad_rows\": ", t.rows);
+        fe_cli_json_bad_rows(stdout);
+        printf(", \"columns\": [");
         for (size_t j = 0; j < k; j++) {
             printf("%s{\"name\": ", j ? ", " : "");
             fe_cli_json_string(stdout, t.names[cols[j]]);
-            printf(", \"mean\": %.17g, \"stddev\": %.17g, \"min\": %.17g, \"max\": %.17g}",
-                   fe_meanvar_mean(&mv[j]), fe_meanvar_stddev(&mv[j]), lo[j], hi[j]);
+            printf(", \"mean\": ");
+            fe_cli_json_number(stdout, fe_meanvar_mean(&mv[j]));
+            printf(", \"stddev\": ");
+            fe_cli_json_number(stdout, fe_meanvar_stddev(&mv[j]));
+            printf(", \"min\": ");
+            fe_cli_json_number(stdout, lo[j]);
+            printf(", \"max\": ");
+            fe_cli_json_number(stdout, hi[j]);
+            printf("}");
         }
         printf("]}\n");
     } else {

@@ -27,6 +27,11 @@ int fe_cli_synth(int argc, char **argv)
     fe_cli_output ro, so;
     int pending_real;
     int rc;
+    static const fe_cli_option options[] = {
+        {"--effect", 1}, {"--real", 1}, {"--sim", 1}, {"--seed", 1}, {"--rows", 1}, {NULL, 0}};
+    rc = fe_cli_options("synth", options, &argc, &argv);
+    if (rc != FE_CLI_OK)
+        return rc < 0 ? FE_CLI_OK : rc;
     for (int i = 1; i < argc; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (strcmp(o, "--help") == 0 || strcmp(o, "-h") == 0) {

@@ -6,6 +6,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,7 +17,45 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <getopt.h>
+#include <zlib.h>
+
 extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
+
+/* The reader's options (fe_cli_reader_configure) and the rows skipped in
+   the current pass of every table, by reason. */
+static int fe__cli_force_comma, fe__cli_skip_bad, fe__cli_stdin_used;
+static size_t fe__cli_bad_total[FE_CLI_BAD_REASONS];
+
+void fe_cli_reader_configure(int decimal_comma, int skip_bad_rows)
+{
+    fe__cli_force_comma = decimal_comma;
+    fe__cli_skip_bad = skip_bad_rows;
+    fe__cli_stdin_used = 0;
+    memset(fe__cli_bad_total, 0, sizeof fe__cli_bad_total);
+}
+
+void fe_cli_reader_option(const char *flag)
+{
+    if (strcmp(flag, "--decimal-comma") == 0)
+        fe__cli_force_comma = 1;
+    else if (strcmp(flag, "--skip-bad-rows") == 0)
+        fe__cli_skip_bad = 1;
+}
+
+void fe_cli_bad_rows(size_t counts[FE_CLI_BAD_REASONS])
+{
+    memcpy(counts, fe__cli_bad_total, sizeof fe__cli_bad_total);
+}
+
+void fe_cli_json_bad_rows(FILE *out)
+{
+    size_t *b = fe__cli_bad_total;
+    fprintf(out, "{\"total\": %zu, \"empty_cell\": %zu, \"not_finite\": %zu, "
+                 "\"not_a_number\": %zu, \"field_count\": %zu}",
+            b[0] + b[1] + b[2] + b[3], b[FE_CLI_BAD_EMPTY], b[FE_CLI_BAD_NONFINITE],
+            b[FE_CLI_BAD_TEXT], b[FE_CLI_BAD_FIELDS]);
+}
 /* Table Includes ends here */
 /* [[file:../../literate/cli.org::Format a located message][Format a located message]] */
 static int fe__cli_at(const fe_cli_table *t, size_t line, size_t column,
@@ -45,6 +84,15 @@ static int fe__cli_line_error(const fe_cli_table *t, int rc, char *err,
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
                           "NUL byte: this is not a text file");
     default:
+        if (t->gz != NULL) {
+            int zerr = Z_OK;
+            const char *msg = gzerror((gzFile)t->gz, &zerr), *colon = strstr(msg, ": ");
+            if (colon != NULL)          /* zlib's "<fd:N>: " prefix */
+                msg = colon + 2;
+            if (zerr != Z_OK && zerr != Z_ERRNO)
+                return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
+                                  "corrupt or truncated gzip data (%s)", msg);
+        }
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_IO, err, errlen,
                           "read error: %s", strerror(errno));
     }
@@ -57,11 +105,105 @@ static int fe__cli_ignorable(const char *line)
     return *line == '\0' || *line == '#';
 }
 
-static int fe__cli_numeric(const fe_csv_field *f)
+/* A field as a number, by the table's convention: with a decimal comma
+   forced, only "1,5"; in a semicolon table "1,5" or "1.5". */
+static int fe__cli_number(const fe_cli_table *t, const fe_csv_field *f, double *v)
+{
+    int rc;
+    if (t->decimal_comma == 1)
+        return fe_csv_number_comma(f, v);
+    rc = fe_csv_number(f, v);
+    if (rc == FE_EPARSE && t->decimal_comma == 2 && strchr(f->text, ',') != NULL)
+        rc = fe_csv_number_comma(f, v);
+    return rc;
+}
+
+static int fe__cli_numeric(const fe_cli_table *t, const fe_csv_field *f)
 {
     double v;
-    int rc = fe_csv_number(f, &v);
+    int rc = fe__cli_number(t, f, &v);
     return rc == FE_OK || rc == FE_ENONFINITE;
+}
+
+/* Read through zlib (transparent for bytes that are not gzip). */
+static long fe__cli_gz_read(void *ctx, char *buf, size_t n)
+{
+    int got = gzread((gzFile)ctx, buf, (unsigned)(n > (1u << 30) ? (1u << 30) : n));
+    if (got < 0) {
+        int zerr;
+        gzerror((gzFile)ctx, &zerr);
+        if (zerr != Z_ERRNO)
+            errno = EIO;        /* the message comes from gzerror */
+        return -1;
+    }
+    if (got == 0) {
+        /* zlib ends a truncated stream as if it were complete (it reads
+           files still being written) and keeps Z_BUF_ERROR for gzerror. */
+        int zerr;
+        gzerror((gzFile)ctx, &zerr);
+        if (zerr == Z_BUF_ERROR) {
+            errno = EIO;
+            return -1;
+        }
+    }
+    return got;
+}
+
+/* Attach the zlib stream over a duplicate of t->fd and start the reader. */
+static int fe__cli_attach(fe_cli_table *t)
+{
+    int fd = dup(t->fd);
+    gzFile gz = fd >= 0 ? gzdopen(fd, "rb") : NULL;
+    if (gz == NULL) {
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    gzbuffer(gz, 1u << 16);
+    t->gz = gz;
+    return fe_csv_reader_init_read(&t->reader, fe__cli_gz_read, gz, t->buffer,
+                                   FE_CLI_LINE_MAX) == FE_OK ? 0 : -1;
+}
+
+/* Copy a non-seekable input once to an unlinked temporary file; the
+   descriptor of the copy, positioned at its start, or -1. */
+static int fe__cli_spool(int in)
+{
+    const char *dir = getenv("TMPDIR");
+    char path[4096], buf[1 << 16];
+    int fd;
+    if (dir == NULL || *dir == '\0')
+        dir = "/tmp";
+    if ((size_t)snprintf(path, sizeof path, "%s/foldest-spool-XXXXXX", dir) >= sizeof path)
+        return -1;
+    fe_cli_signals_hold(1);
+    fd = mkstemp(path);
+    if (fd >= 0)
+        unlink(path);           /* gone from the directory: nothing left behind */
+    fe_cli_signals_hold(0);
+    if (fd < 0)
+        return -1;
+    for (;;) {
+        ssize_t got = read(in, buf, sizeof buf), put = 0;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0)
+            break;
+        if (got == 0)
+            return lseek(fd, 0, SEEK_SET) == 0 ? fd : (close(fd), -1);
+        while (put < got) {
+            ssize_t w = write(fd, buf + put, (size_t)(got - put));
+            if (w < 0 && errno == EINTR)
+                continue;
+            if (w <= 0) {
+                close(fd);
+                return -1;
+            }
+            put += w;
+        }
+    }
+    close(fd);
+    return -1;
 }
 
 static char *fe__cli_strdup(const char *s)
@@ -80,8 +222,8 @@ static void fe__cli_free_lines(char **lines, size_t n)
         free(lines[i]);
 }
 
-int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
-                      char *err, size_t errlen)
+static int fe__cli_table_open(fe_cli_table *t, const char *path, long skip,
+                              int rewindable, char *err, size_t errlen)
 {
     char *look[FE_CLI_LOOKAHEAD];
     size_t look_line[FE_CLI_LOOKAHEAD], look_fields[FE_CLI_LOOKAHEAD];
@@ -92,6 +234,11 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     int rc;
 
     memset(t, 0, sizeof *t);
+    if (strcmp(path, "-") == 0 && fe__cli_stdin_used++) {
+        snprintf(err, errlen, "-: standard input can be read only once: give files for the other inputs");
+        t->fd = -1;
+        return FE_CLI_USAGE;
+    }
     t->name = strcmp(path, "-") == 0 ? "<stdin>" : path;
     t->fd = strcmp(path, "-") == 0 ? 0 : open(path, O_RDONLY);
     if (t->fd < 0) {
@@ -100,15 +247,27 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     }
     if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode))
         t->size = st.st_size;
+    else if (rewindable) {
+        int copy = fe__cli_spool(t->fd);
+        if (copy < 0) {
+            snprintf(err, errlen, "%s: cannot copy the input to a temporary file: %s",
+                     t->name, strerror(errno));
+            fe_cli_table_close(t);
+            return FE_CLI_IO;
+        }
+        if (t->fd > 0)
+            close(t->fd);
+        t->fd = copy;
+    }
     t->buffer = malloc(FE_CLI_LINE_MAX);
     t->scratch = malloc(FE_CLI_LINE_MAX);
     t->fields = malloc(FE_CLI_FIELDS_MAX * sizeof *t->fields);
-    if (t->buffer == NULL || t->scratch == NULL || t->fields == NULL) {
+    if (t->buffer == NULL || t->scratch == NULL || t->fields == NULL
+        || fe__cli_attach(t) != 0) {
         snprintf(err, errlen, "%s: out of memory", t->name);
         fe_cli_table_close(t);
         return FE_CLI_IO;
     }
-    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
 
     /* Skip what the user said to skip. */
     for (long i = 0; skip > 0 && i < skip; i++) {
@@ -135,8 +294,12 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
         }
         if (fe__cli_ignorable(line))
             continue;
-        if (nlook == 0)
+        if (nlook == 0) {
             t->delimiter = fe_csv_guess_delimiter(line);
+            if (fe__cli_force_comma && t->delimiter == ',')
+                t->delimiter = strchr(line, '\t') != NULL ? '\t' : FE_CSV_WHITESPACE;
+            t->decimal_comma = fe__cli_force_comma ? 1 : t->delimiter == ';' ? 2 : 0;
+        }
         look[nlook] = fe__cli_strdup(line);
         look_line[nlook] = t->reader.line;
         if (look[nlook] == NULL
@@ -146,6 +309,7 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
         }
         look_fields[nlook++] = nf;
     }
+    t->look_end = t->reader.line;
     if (nlook == 0) {
         snprintf(err, errlen, "%s: no data: the file is empty", t->name);
         fe_cli_table_close(t);
@@ -188,8 +352,8 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
         if (copy1 != NULL && b != NULL)
             fe_csv_split(copy1, t->delimiter, b, FE_CLI_FIELDS_MAX, &nb, NULL);
         for (size_t j = 0; j < na && !is_header; j++)
-            if (!fe__cli_numeric(&a[j])
-                && (start + 1 == nlook || (j < nb && fe__cli_numeric(&b[j]))))
+            if (!fe__cli_numeric(t, &a[j])
+                && (start + 1 == nlook || (j < nb && fe__cli_numeric(t, &b[j]))))
                 is_header = 1;
         if (is_header)
             header = start;
@@ -224,6 +388,18 @@ int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
     }
     t->progress = isatty(2) && t->size > (off_t)(1 << 22);
     return FE_CLI_OK;
+}
+
+int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
+                      char *err, size_t errlen)
+{
+    return fe__cli_table_open(t, path, skip, 0, err, errlen);
+}
+
+int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
+                                 char *err, size_t errlen)
+{
+    return fe__cli_table_open(t, path, skip, 1, err, errlen);
 }
 /* Open a table and find its header ends here */
 /* [[file:../../literate/cli.org::Find a column by name or number][Find a column by name or number]] */
@@ -273,6 +449,9 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 }
 /* Find a column by name or number ends here */
 /* [[file:../../literate/cli.org::Read the next row][Read the next row]] */
+static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
+                        size_t k, double *out, char *err, size_t errlen);
+
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen)
 {
@@ -301,39 +480,62 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
     if (rc == FE_EPARSE)
         return fe__cli_at(t, t->line, bad, FE_CLI_INPUT, err, errlen,
                           "unterminated or misplaced quote");
-    if (rc != FE_OK || nf != t->ncols)
+    if (rc != FE_OK || nf != t->ncols) {
+        if (fe__cli_skip_bad)
+            return fe__cli_skip(t, FE_CLI_BAD_FIELDS, cols, k, out, err, errlen);
         return fe__cli_at(t, t->line, 1, FE_CLI_INPUT, err, errlen,
                           "expected %zu fields, found %s%zu", t->ncols,
                           rc == FE_ESIZE ? "more than " : "", rc == FE_ESIZE ? (size_t)FE_CLI_FIELDS_MAX : nf);
+    }
     for (size_t i = 0; i < k; i++) {
         const fe_csv_field *f = &t->fields[cols[i]];
-        rc = fe_csv_number(f, &out[i]);
-        if (rc == FE_ENONFINITE)
+        int reason;
+        rc = fe__cli_number(t, f, &out[i]);
+        if (rc == FE_OK)
+            continue;
+        reason = f->text[0] == '\0' ? FE_CLI_BAD_EMPTY
+                 : rc == FE_ENONFINITE ? FE_CLI_BAD_NONFINITE : FE_CLI_BAD_TEXT;
+        if (fe__cli_skip_bad)
+            return fe__cli_skip(t, reason, cols, k, out, err, errlen);
+        if (reason == FE_CLI_BAD_EMPTY)
             return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
-                              "'%s' in column '%s' is not a finite number",
-                              f->text, t->names[cols[i]]);
-        if (rc != FE_OK)
-            return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
-                              "'%s' in column '%s' is not a number", f->text,
+                              "empty cell in column '%s' (--skip-bad-rows skips such rows)",
                               t->names[cols[i]]);
+        return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
+                          "'%s' in column '%s' is not a %snumber", f->text,
+                          t->names[cols[i]], reason == FE_CLI_BAD_NONFINITE ? "finite " : "");
     }
     t->rows++;
     return FE_OK;
 }
 
+/* Count a bad row and go on to the next one. */
+static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
+                        size_t k, double *out, char *err, size_t errlen)
+{
+    t->bad[reason]++;
+    fe__cli_bad_total[reason]++;
+    return fe_cli_table_next(t, cols, k, out, err, errlen);
+}
+
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
 {
-    if (t->fd == 0 || lseek(t->fd, 0, SEEK_SET) == (off_t)-1) {
+    if (lseek(t->fd, 0, SEEK_CUR) == (off_t)-1 || gzrewind((gzFile)t->gz) != 0) {
         snprintf(err, errlen, "%s: cannot read the input twice (a pipe?)", t->name);
         return FE_CLI_IO;
     }
-    fe_csv_reader_init(&t->reader, t->fd, t->buffer, FE_CLI_LINE_MAX);
-    /* Skip to just past the last looked-ahead line; replay the rest. */
-    if (t->npending > 0) {
-        size_t last = t->pending_line[t->npending - 1];
+    fe_csv_reader_init_read(&t->reader, fe__cli_gz_read, t->gz, t->buffer, FE_CLI_LINE_MAX);
+    /* The skipped rows are counted again in the new pass. */
+    for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
+        fe__cli_bad_total[r] -= t->bad[r];
+        t->bad[r] = 0;
+    }
+    /* Skip to just past the last looked-ahead line (a header with no data
+       after it too); replay the looked-ahead data lines. */
+    {
         char *line;
         size_t len;
-        while (t->reader.line < last)
+        while (t->reader.line < t->look_end)
             if (fe_csv_next_line(&t->reader, &line, &len) == FE_END)
                 break;
     }
@@ -344,6 +546,16 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
 
 void fe_cli_table_close(fe_cli_table *t)
 {
+    size_t nbad = t->bad[0] + t->bad[1] + t->bad[2] + t->bad[3];
+    if (nbad > 0)
+        fprintf(stderr, "foldest: %s: skipped %zu bad rows (%zu with an empty cell, "
+                        "%zu with NaN or infinity, %zu with text, %zu with a wrong number "
+                        "of fields)\n", t->name, nbad, t->bad[FE_CLI_BAD_EMPTY],
+                t->bad[FE_CLI_BAD_NONFINITE], t->bad[FE_CLI_BAD_TEXT], t->bad[FE_CLI_BAD_FIELDS]);
+    memset(t->bad, 0, sizeof t->bad);
+    if (t->gz != NULL)
+        gzclose_r((gzFile)t->gz);
+    t->gz = NULL;
     if (t->fd > 0)
         close(t->fd);
     t->fd = -1;
@@ -481,10 +693,23 @@ void fe_cli_pending_clear(void)
         fe__cli_pending_used[i] = 0;
 }
 
+/* Set while the signals are held; a signal that a thread without the
+   main thread's mask (OpenBLAS starts its workers before main) catches
+   meanwhile is kept here and raised again when the hold ends. */
+static volatile sig_atomic_t fe__cli_held, fe__cli_deferred;
+
 /* Files first, then directories (which are then empty, if they were
    ours); only async-signal-safe calls. */
 static void fe__cli_on_signal(int sig)
 {
+    if (fe__cli_held) {
+        fe__cli_deferred = sig;
+        /* Read again (volatile): a hold that ended meanwhile has already
+           looked for a deferred signal; then the handler goes on. */
+        /* cppcheck-suppress identicalInnerCondition */
+        if (fe__cli_held)
+            return;             /* fe_cli_signals_hold(0) raises it */
+    }
     for (int pass = 1; pass <= 2; pass++)
         for (int i = 0; i < FE__CLI_PENDING; i++)
             if (fe__cli_pending_used[i] == pass) {
@@ -515,7 +740,15 @@ void fe_cli_signals_hold(int hold)
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
-    sigprocmask(hold ? SIG_BLOCK : SIG_UNBLOCK, &set, NULL);
+    if (hold) {
+        sigprocmask(SIG_BLOCK, &set, NULL);
+        fe__cli_held = 1;
+    } else {
+        fe__cli_held = 0;
+        sigprocmask(SIG_UNBLOCK, &set, NULL);
+        if (fe__cli_deferred)
+            raise(fe__cli_deferred);
+    }
 }
 /* Remove pending files when interrupted ends here */
 /* [[file:../../literate/cli.org::Check standard output at the end][Check standard output at the end]] */
@@ -570,7 +803,7 @@ void fe_cli_progress(fe_cli_table *t)
     off_t at;
     if (!t->progress || (t->rows & 0xffff) != 0)
         return;
-    at = lseek(t->fd, 0, SEEK_CUR);
+    at = t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
     if (at >= 0)
         fprintf(stderr, "\r%s: %3.0f%% (%zu rows)", t->name,
                 100.0 * (double)at / (double)t->size, t->rows);
@@ -580,6 +813,149 @@ void fe_cli_progress_done(fe_cli_table *t)
 {
     if (t->progress)
         fprintf(stderr, "\r%*s\r", 60, "");
+}
+
+/* Edit distance (insertions, deletions, substitutions, transpositions)
+   between a and b, up to 63 bytes each; larger when longer. */
+static size_t fe__cli_distance(const char *a, const char *b)
+{
+    size_t n = strlen(a), m = strlen(b), d[64][64];
+    if (n > 63 || m > 63)
+        return 64;
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            size_t best = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < best)
+                best = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < best)
+                best = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]
+                && d[i - 2][j - 2] + 1 < best)
+                best = d[i - 2][j - 2] + 1;
+            d[i][j] = best;
+        }
+    return d[n][m];
+}
+
+enum { FE__CLI_OPTS_MAX = 48, FE__CLI_ARGV_MAX = 4096 };
+
+/* The options every command takes, after its own. */
+static const fe_cli_option fe__cli_common[] = {
+    {"--help", 0}, {"--version", 0}, {"--decimal-comma", 0}, {"--skip-bad-rows", 0}, {NULL, 0}};
+
+/* Say what is wrong with the option argv[at] (getopt_long refused it). */
+static void fe__cli_bad_option(const char *command, const char *arg, const struct option *lo,
+                               int missing_value)
+{
+    char name[128];
+    const char *best = NULL;
+    size_t len, best_d = (size_t)-1, prefixed = 0;
+    if (missing_value) {
+        fprintf(stderr, "foldest %s: option '%s' needs a value\n", command, arg);
+        return;
+    }
+    if (arg[0] != '-' || arg[1] != '-') {
+        fprintf(stderr, "foldest %s: unknown option '%s'\n", command, arg);
+        return;
+    }
+    snprintf(name, sizeof name, "%s", arg + 2);
+    name[strcspn(name, "=")] = '\0';
+    len = strlen(name);
+    for (const struct option *o = lo; o->name != NULL; o++)
+        prefixed += len > 0 && strncmp(o->name, name, len) == 0;
+    if (prefixed > 1) {
+        fprintf(stderr, "foldest %s: ambiguous option '--%s': it could be", command, name);
+        for (const struct option *o = lo; o->name != NULL; o++)
+            if (strncmp(o->name, name, len) == 0)
+                fprintf(stderr, " --%s", o->name);
+        fputc('\n', stderr);
+        return;
+    }
+    for (const struct option *o = lo; o->name != NULL; o++) {
+        size_t d = fe__cli_distance(name, o->name);
+        if (d < best_d) {
+            best_d = d;
+            best = o->name;
+        }
+    }
+    if (best != NULL && best_d <= (len < 6 ? 1 : len < 12 ? 2 : 3))
+        fprintf(stderr, "foldest %s: unknown option '--%s'; did you mean '--%s'?\n", command,
+                name, best);
+    else
+        fprintf(stderr, "foldest %s: unknown option '--%s'\n", command, name);
+}
+
+int fe_cli_options(const char *command, const fe_cli_option *opts, int *argcp,
+                   char ***argvp)
+{
+    static struct option lo[FE__CLI_OPTS_MAX + 1];
+    static const char *flag_of[FE__CLI_OPTS_MAX];
+    static char *out[FE__CLI_ARGV_MAX + 1];
+    int argc = *argcp, n = 0, k = 1, c, index;
+    char **argv = *argvp;
+    const fe_cli_option *tables[2] = {opts, fe__cli_common};
+
+    /* getopt_long's table from ours, the common options after. */
+    for (int t = 0; t < 2; t++)
+        for (const fe_cli_option *o = tables[t]; o != NULL && o->flag != NULL; o++) {
+            if (n == FE__CLI_OPTS_MAX)
+                return FE_CLI_USAGE;
+            lo[n].name = o->flag + 2;
+            lo[n].has_arg = o->takes_value ? required_argument : no_argument;
+            lo[n].flag = NULL;
+            lo[n].val = 256 + n;
+            flag_of[n++] = o->flag;
+        }
+    memset(&lo[n], 0, sizeof lo[n]);
+    if (argc > FE__CLI_ARGV_MAX) {
+        fprintf(stderr, "foldest %s: more than %d arguments\n", command, FE__CLI_ARGV_MAX);
+        return FE_CLI_USAGE;
+    }
+    /* Options first, in the canonical form. */
+    out[0] = argv[0];
+    optind = 0;                 /* a fresh scan, even if main runs again */
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":hV", lo, &index)) != -1) {
+        const char *flag;
+        if (c == '?' || c == ':') {
+            const char *arg = optopt != 0 && optopt < 256 ? NULL : argv[optind - 1];
+            char shortopt[3] = {'-', (char)optopt, '\0'};
+            fe__cli_bad_option(command, arg != NULL ? arg : shortopt, lo, c == ':');
+            fprintf(stderr, "'foldest %s --help' for usage\n", command);
+            return FE_CLI_USAGE;
+        }
+        index = c >= 256 ? c - 256 : -1;    /* ours, or -h and -V */
+        flag = index >= 0 ? flag_of[index] : c == 'h' ? "--help" : "--version";
+        if (strcmp(flag, "--version") == 0) {
+            printf("foldest %s\n", FE_VERSION);
+            return -1;
+        }
+        if (strcmp(flag, "--help") == 0) {
+            out[1] = (char *)"--help";
+            out[2] = NULL;
+            *argcp = 2;
+            *argvp = out;
+            return FE_CLI_OK;
+        }
+        if (strcmp(flag, "--decimal-comma") == 0 || strcmp(flag, "--skip-bad-rows") == 0) {
+            fe_cli_reader_option(flag);
+            continue;
+        }
+        out[k++] = (char *)flag;
+        if (index >= 0 && lo[index].has_arg == required_argument)
+            out[k++] = optarg;
+    }
+    /* Then the operands, which getopt_long has moved to the end. */
+    while (optind < argc)
+        out[k++] = argv[optind++];
+    out[k] = NULL;
+    *argcp = k;
+    *argvp = out;
+    return FE_CLI_OK;
 }
 
 int fe_cli_parse_double(const char *opt, const char *text, double *value,
@@ -628,18 +1004,74 @@ int fe_cli_split_list(char *text, char **items, int max)
     }
 }
 
+/* Length of the well-formed UTF-8 sequence at s (RFC 3629: no overlong
+   forms, no surrogates, nothing above U+10FFFF), or 0. */
+static size_t fe__cli_utf8_length(const unsigned char *s)
+{
+    unsigned c = s[0];
+    size_t n;
+    unsigned lo = 0x80, hi = 0xBF;
+    if (c < 0x80)
+        return 1;
+    if (c >= 0xC2 && c <= 0xDF)
+        n = 2;
+    else if (c >= 0xE0 && c <= 0xEF) {
+        n = 3;
+        if (c == 0xE0)
+            lo = 0xA0;          /* overlong */
+        else if (c == 0xED)
+            hi = 0x9F;          /* surrogates */
+    } else if (c >= 0xF0 && c <= 0xF4) {
+        n = 4;
+        if (c == 0xF0)
+            lo = 0x90;
+        else if (c == 0xF4)
+            hi = 0x8F;          /* above U+10FFFF */
+    } else
+        return 0;
+    if (s[1] < lo || s[1] > hi)
+        return 0;
+    for (size_t i = 2; i < n; i++)
+        if (s[i] < 0x80 || s[i] > 0xBF)
+            return 0;
+    return n;
+}
+
 void fe_cli_json_string(FILE *out, const char *s)
 {
+    const unsigned char *p = (const unsigned char *)s;
     fputc('"', out);
-    for (; *s != '\0'; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(out, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(out, "\\u%04x", c);
-        else
-            fputc(c, out);
+    while (*p != '\0') {
+        size_t n = fe__cli_utf8_length(p);
+        if (n == 0) {
+            fputs("\\ufffd", out);   /* not UTF-8: the replacement character */
+            p++;
+        } else if (*p == '"' || *p == '\\') {
+            fprintf(out, "\\%c", *p++);
+        } else if (*p < 0x20 || *p == 0x7F) {
+            fprintf(out, "\\u%04x", *p++);
+        } else {
+            fwrite(p, 1, n, out);
+            p += n;
+        }
     }
     fputc('"', out);
+}
+
+void fe_cli_json_number(FILE *out, double x)
+{
+    char text[32];
+    if (!isfinite(x)) {
+        fputs("null", out);
+        return;
+    }
+    /* The shortest of 15, 16 and 17 significant digits that reads back as
+       x: 0.04, not 0.040000000000000001. */
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, x);
+        if (strtod(text, NULL) == x)
+            break;
+    }
+    fputs(text, out);
 }
 /* Show progress ends here */

@@ -45,13 +45,44 @@ static void split_all(const char *line, size_t len, char delimiter)
         rc = fe_csv_number(&fields[i], &v);
         REQUIRE(rc == FE_OK || rc == FE_EPARSE || rc == FE_ENONFINITE);
         if (rc == FE_OK) {
-            /* The fast path and strtod agree to the bit. */
+            /* The fast path and strtod agree to the bit, and what is
+               accepted is a plain decimal: no hexadecimal, inf or nan. */
             char *end;
             double w = strtod(fields[i].text, &end);
             REQUIRE(isfinite(v));
             REQUIRE(*end == '\0' && memcmp(&v, &w, sizeof v) == 0);
+            REQUIRE(strpbrk(fields[i].text, "xXpPnNiI") == NULL);
+        }
+        /* The decimal comma: a number is the one with the comma made a
+           point, and a field with a point is never one. */
+        rc = fe_csv_number_comma(&fields[i], &v);
+        REQUIRE(rc == FE_OK || rc == FE_EPARSE || rc == FE_ENONFINITE);
+        if (rc == FE_OK) {
+            char point[300], *c;
+            double w;
+            REQUIRE(isfinite(v) && strchr(fields[i].text, '.') == NULL);
+            strcpy(point, fields[i].text);
+            if ((c = strchr(point, ',')) != NULL)
+                *c = '.';
+            w = strtod(point, &c);
+            REQUIRE(*c == '\0' && memcmp(&v, &w, sizeof v) == 0);
         }
     }
+}
+
+/* Bytes from memory in chunks of `step`: the reader's read-function path. */
+struct chunks { const uint8_t *p; size_t left, step; };
+
+static long read_chunks(void *ctx, char *buf, size_t n)
+{
+    struct chunks *c = ctx;
+    size_t k = c->left < c->step ? c->left : c->step;
+    if (k > n)
+        k = n;
+    memcpy(buf, c->p, k);
+    c->p += k;
+    c->left -= k;
+    return (long)k;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -68,7 +99,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     REQUIRE(fd >= 0);
     REQUIRE(write(fd, data + 1, size - 1) == (ssize_t)(size - 1));
     REQUIRE(lseek(fd, 0, SEEK_SET) == 0);
-    REQUIRE(fe_csv_reader_init(&r, fd, buffer, cap) == FE_OK);
+    /* An odd first byte reads through a function, in chunks of 1 to 7. */
+    struct chunks ch = {data + 1, size - 1, 1 + (size_t)(data[0] >> 1) % 7};
+    if (data[0] & 1)
+        REQUIRE(fe_csv_reader_init_read(&r, read_chunks, &ch, buffer, cap) == FE_OK);
+    else
+        REQUIRE(fe_csv_reader_init(&r, fd, buffer, cap) == FE_OK);
     for (;;) {
         char *line;
         size_t len;
@@ -86,6 +122,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         REQUIRE(line[len] == '\0' && strlen(line) == len);
         split_all(line, len, fe_csv_guess_delimiter(line));
         split_all(line, len, ',');
+        split_all(line, len, ';');
         split_all(line, len, FE_CSV_WHITESPACE);
     }
     close(fd);
