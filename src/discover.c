@@ -1865,7 +1865,7 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
     return f;
 }
 
-enum { FE__GLS_ROUNDS = 4 };    /* noise model, then GLS, four times */
+enum { FE__GLS_ROUNDS = 10 };   /* noise model, then GLS, ten times */
 
 /* Feasible GLS of the columns `cols`: the coefficients, the summary and
    the noise model, leaving the prewhitened Gram matrix in w->gt, the

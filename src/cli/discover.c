@@ -1136,7 +1136,8 @@ static int fe__discover_sphere_main(int argc, char **argv);
    fe_cli_options parses them; the loops below read the canonical form). */
 static const fe_cli_option fe__discover_options[] = {
     {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
-    {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--blocks", 1}, {"--alpha", 1},
+    {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--lags", 1}, {"--blocks", 1},
+    {"--alpha", 1},
     {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
 
 int fe_cli_discover(int argc, char **argv)
