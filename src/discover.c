@@ -21,13 +21,12 @@ static double fe__sym(const double *g, size_t dim, size_t i, size_t j)
 /* [[file:../literate/discover.org::Fold the lagged products][Fold the lagged products]] */
 /* S += x x^T for x the `count` rows at `rows` stacked (M each), S of
    side E M. */
-static void fe__discover_edge_add(double *S, size_t dim, const double *rows, size_t count,
-                                  double sign)
+static void fe__discover_edge_add(double *S, size_t dim, const double *rows, size_t count)
 {
     size_t n = FE_DISCOVER_EDGE * dim, c = count * dim;
     for (size_t i = 0; i < c; i++)
         for (size_t j = 0; j < c; j++)
-            S[i * n + j] += sign * rows[i] * rows[j];
+            S[i * n + j] += rows[i] * rows[j];
 }
 
 static size_t fe__discover_min(size_t x, size_t y)
@@ -54,12 +53,11 @@ static void fe__discover_edges_close(fe_discover_acc *a)
     if (a->lags == 0)
         return;
     if (a->nhist >= FE_DISCOVER_EDGE)
-        fe__discover_edge_add(a->edge_end, dim, a->hist, FE_DISCOVER_EDGE, 1.0);
+        fe__discover_edge_add(a->edge_end, dim, a->hist, FE_DISCOVER_EDGE);
     fe__discover_shead_clear(a);
 }
 
-/* Forget the rows that the next row would pair with: a break or a
-   held-out row. */
+/* Forget the rows that the next row would pair with: a break. */
 static void fe__discover_lags_cut(fe_discover_acc *a)
 {
     memset(a->hist, 0, a->nhist * (a->m + 1) * sizeof *a->hist);
@@ -91,7 +89,7 @@ static void fe__discover_lags_row(fe_discover_acc *a, const double *z, int fitte
     if (a->shead_pending) {
         memcpy(a->shead + a->nshead++ * dim, z, dim * sizeof *z);
         if (a->nshead == FE_DISCOVER_EDGE) {
-            fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead, 1.0);
+            fe__discover_edge_add(a->edge_start, dim, a->shead, a->nshead);
             fe__discover_shead_clear(a);
         }
     }
@@ -120,7 +118,7 @@ static void fe__discover_lags_panel(fe_discover_acc *a, const double *const *col
     for (size_t t = 0; t < q && a->shead_pending; t++) {
         memcpy(a->shead + a->nshead++ * dim, buf + (P + t) * dim, dim * sizeof *buf);
         if (a->nshead == E) {
-            fe__discover_edge_add(a->edge_start, dim, a->shead, E, 1.0);
+            fe__discover_edge_add(a->edge_start, dim, a->shead, E);
             fe__discover_shead_clear(a);
         }
     }
@@ -186,7 +184,7 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         if (a->n > 0 && !b->first_linked) {
             fe__discover_edges_close(a);
             if (b->nhead >= E) {                         /* b's first recording's start */
-                fe__discover_edge_add(a->edge_start, dim, b->head, E, 1.0);
+                fe__discover_edge_add(a->edge_start, dim, b->head, E);
             } else if (b->head_open) {                   /* it goes on past b: pending */
                 memcpy(a->shead, b->head, b->nhead * dim * sizeof *a->shead);
                 a->nshead = b->nhead;
@@ -198,7 +196,7 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
                 memcpy(a->shead + a->nshead * dim, b->head, take * dim * sizeof *a->shead);
                 a->nshead += take;
                 if (a->nshead == E)
-                    fe__discover_edge_add(a->edge_start, dim, a->shead, E, 1.0);
+                    fe__discover_edge_add(a->edge_start, dim, a->shead, E);
                 if (a->nshead == E || !b->head_open)
                     fe__discover_shead_clear(a);
             }
@@ -210,7 +208,7 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
                 for (size_t j = 0; j < b->nhead; j++)       /* newest first */
                     memcpy(part + j * dim, b->head + (b->nhead - 1 - j) * dim, dim * sizeof *part);
                 memcpy(part + b->nhead * dim, a->hist, (E - b->nhead) * dim * sizeof *part);
-                fe__discover_edge_add(a->edge_end, dim, part, E, 1.0);
+                fe__discover_edge_add(a->edge_end, dim, part, E);
             }
         }
         /* From here on the open recording is b's, unless b's first one is
