@@ -1321,6 +1321,20 @@ static double fe__quad_resid(const double *m, size_t dim, const size_t *cols,
     return s;
 }
 
+/* The held-out rows' RMS under the coefficients (NaN without any). */
+static void fe__heldout(const fe_discover_acc *a, const size_t *cols, size_t ncols,
+                        const double *coef, fe_discover_fit *fit)
+{
+    size_t dim = a->m + 1, K = a->blocks;
+    fit->heldout_n = a->counts[K];
+    if (a->counts[K] > 0) {
+        double h = fe__quad_resid(a->gram + K * dim * dim, dim, cols, ncols, coef, a->m, 1);
+        fit->heldout_rms = sqrt((h > 0 ? h : 0) / a->counts[K]);
+    } else {
+        fit->heldout_rms = NAN;
+    }
+}
+
 /* What a fit of chosen columns needs: the columns below `limit`, the
    workspace carved, every block with rows, the total Gram matrix. */
 static int fe__fit_prepare(const fe_discover_acc *a, const size_t *cols, size_t ncols,
@@ -1373,13 +1387,7 @@ static int fe__fit(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     fit->n_eff = n * (1.0 - rho) / (1.0 + rho);
     fit->bic = fit->n_eff * log(fit->rss > 0 ? fit->rss / n : 1e-300)
                + (double)ncols * log(fit->n_eff);
-    fit->heldout_n = a->counts[K];
-    if (a->counts[K] > 0) {
-        double h = fe__quad_resid(a->gram + K * dim * dim, dim, cols, ncols, coef, r, 1);
-        fit->heldout_rms = sqrt((h > 0 ? h : 0) / a->counts[K]);
-    } else {
-        fit->heldout_rms = NAN;
-    }
+    fe__heldout(a, cols, ncols, coef, fit);
     /* Block sandwich standard errors. */
     if (se != NULL && ncols > 0) {
         memset(w->omega, 0, ncols * ncols * sizeof *w->omega);
@@ -1873,7 +1881,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
                    size_t ncols, size_t maxp, double *coef, fe_discover_fit *fit,
                    fe_discover_noise *nz)
 {
-    size_t dim = a->m + 1, r = a->m, K = a->blocks;
+    size_t dim = a->m + 1, r = a->m;
     fe__model mo = {ncols, cols, w->css, {0}};
     double n = fe__fitted_rows(a), rsst, q2 = 0.0;
     int rc = fe__factor(&mo, w->g, dim);
@@ -1914,13 +1922,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     fit->bic = n * log(rsst > 0.0 ? rsst / n : 1e-300)
                + (double)(ncols + nz->order) * log(n);
     nz->innovation_variance = rsst / n;
-    fit->heldout_n = a->counts[K];
-    if (a->counts[K] > 0) {
-        double h = fe__quad_resid(a->gram + K * dim * dim, dim, cols, ncols, coef, r, 1);
-        fit->heldout_rms = sqrt((h > 0 ? h : 0) / a->counts[K]);
-    } else {
-        fit->heldout_rms = NAN;
-    }
+    fe__heldout(a, cols, ncols, coef, fit);
     /* Whiteness of the whitened residual, from the zero-padded lagged
        sums (see the text for what that costs under red noise). */
     nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
