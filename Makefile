@@ -278,7 +278,7 @@ mutate: lib cli $(B)/tests/suites.h
 	python3 tests/mutate/mutate.py --mutants $(MUTANTS) --seed $(SEED) --exclude '$(MUTATE_EXCLUDE)' \
 	  --min-rate $(MUTATE_MIN) $(if $(MUTANT_IDS),--ids '$(MUTANT_IDS)') --build $(B) --cc '$(CC)' \
 	  --cflags '$(filter-out -Werror,$(WARN)) $(CFLAGS)' --ext-cflags '$(EXT_CFLAGS)' \
-	  --ext-libs '$(EXT_LIBS)' --check-cflags '$(CHECK_CFLAGS)' --check-libs '$(CHECK_LIBS)'
+	  --ext-libs '$(EXT_LIBS) $(CLI_LIBS)' --check-cflags '$(CHECK_CFLAGS)' --check-libs '$(CHECK_LIBS)'
 
 # ---------------------------------------------------------------- fuzzing
 # libFuzzer harnesses (tests/fuzz/fuzz_*.c), clang with ASan and UBSan; the
