@@ -1871,6 +1871,20 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
     return f;
 }
 
+/* Ljung-Box over the nz->lags_tested autocovariances acov[1 ..] of a
+   series of n rows (acov[0] its sum of squares), against chi-square with
+   H - p degrees of freedom (at least 1). */
+static void fe__ljung_box(fe_discover_noise *nz, const double *acov, double n)
+{
+    double q2 = 0.0;
+    for (size_t h = 1; h <= nz->lags_tested && acov[0] > 0.0; h++)
+        q2 += (acov[h] / acov[0]) * (acov[h] / acov[0]) / (n - (double)h);
+    nz->portmanteau = n * (n + 2.0) * q2;
+    nz->portmanteau_dof = nz->lags_tested > nz->order
+                              ? (double)(nz->lags_tested - nz->order) : 1.0;
+    nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
+}
+
 enum { FE__GLS_ROUNDS = 10 };   /* noise model, then GLS, ten times */
 
 /* Feasible GLS of the columns `cols`: the coefficients, the summary and
@@ -1883,7 +1897,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
 {
     size_t dim = a->m + 1, r = a->m;
     fe__model mo = {ncols, cols, w->css, {0}};
-    double n = fe__fitted_rows(a), rsst, q2 = 0.0;
+    double n = fe__fitted_rows(a), rsst;
     int rc = fe__factor(&mo, w->g, dim);
     if (rc != FE_OK)
         return rc;
@@ -1926,14 +1940,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     /* Whiteness of the whitened residual, from the zero-padded lagged
        sums (see the text for what that costs under red noise). */
     nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
-    for (size_t h = 1; h <= nz->lags_tested && w->acov_e[0] > 0.0; h++) {
-        double rho = w->acov_e[h] / w->acov_e[0];
-        q2 += rho * rho / (n - (double)h);
-    }
-    nz->portmanteau = n * (n + 2.0) * q2;
-    nz->portmanteau_dof = nz->lags_tested > nz->order
-                              ? (double)(nz->lags_tested - nz->order) : 1.0;
-    nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
+    fe__ljung_box(nz, w->acov_e, n);
     nz->long_run = nz->portmanteau_p < 0.05;
     fe__block_ratio(a, w->uv, nz);
     return FE_OK;
@@ -2116,16 +2123,10 @@ static void fe__batch_noise(const fe_discover_acc *a, const fe__ws *w, const siz
     nz->block_ratio = 1.0;
     nz->block_p = NAN;
     if (a->lags > 0) {
-        double q2 = 0.0;
         fe__residual_weights(a->m + 1, cols, ncols, coef, w->uv);
         fe__lagged_sums(a, w->g, w->uv, w->q);
         nz->lags_tested = fe__white_acov(w->q, a->lags, nz, w->acov_e);
-        for (size_t h = 1; h <= nz->lags_tested && w->acov_e[0] > 0.0; h++)
-            q2 += (w->acov_e[h] / w->acov_e[0]) * (w->acov_e[h] / w->acov_e[0])
-                  / (fit->n - (double)h);
-        nz->portmanteau = fit->n * (fit->n + 2.0) * q2;
-        nz->portmanteau_dof = (double)nz->lags_tested;
-        nz->portmanteau_p = fe_chi2_upper(nz->portmanteau, nz->portmanteau_dof);
+        fe__ljung_box(nz, w->acov_e, fit->n);
     }
 }
 

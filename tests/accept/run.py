@@ -201,21 +201,11 @@ def print_tables(runs):
     row_counts("OVERALL", ident)
     for fam, rs in sorted(group_by(ident, lambda r: r["truth"]["family"]).items()):
         row("family " + fam, rs)
-    print("-- per case")
-    for c, rs in sorted(group_by(ident, lambda r: r["truth"]["case"]).items()):
-        row(c, rs)
-    print("-- per noise")
-    for c, rs in sorted(group_by(ident, lambda r: r["truth"]["noise"]).items()):
-        row(c, rs)
-    print("-- per length (rows)")
-    for c, rs in sorted(group_by(ident, lambda r: r["truth"]["rows"]).items()):
-        row(str(c), rs)
-    print("-- per clock")
-    for c, rs in sorted(group_by(ident, lambda r: r["truth"]["clock"]).items()):
-        row(c, rs)
-    print("-- per rig")
-    for c, rs in sorted(group_by(ident, lambda r: r["truth"]["rig"]).items()):
-        row(c, rs)
+    for title, key in (("case", "case"), ("noise", "noise"), ("length (rows)", "rows"),
+                       ("clock", "clock"), ("rig", "rig")):
+        print("-- per " + title)
+        for c, rs in sorted(group_by(ident, lambda r, k=key: r["truth"][k]).items()):
+            row(str(c), rs)
     print("-- draws NOT identifiable by design (the concealment limit of 0.3 sd per sample forbids "
           "|z| >= 8): not counted above")
     row("not identifiable", nonid)
