@@ -1752,6 +1752,18 @@ static size_t fe__white_acov(const double *q, size_t P, const fe_discover_noise 
     return H;
 }
 /* Fit the noise model ends here */
+/* [[file:../literate/discover.org::What a row is worth][What a row is worth]] */
+double fe_discover_row_worth(const fe_discover_noise *nz, double n)
+{
+    double w;
+    if (nz == NULL)
+        return 1.0;
+    w = n > 0 ? nz->n_eff / n : 1.0;
+    if (nz->long_range)
+        w /= nz->block_ratio;
+    return w > 1.0 ? 1.0 : w < 1e-6 ? 1e-6 : w;
+}
+/* What a row is worth ends here */
 /* [[file:../literate/discover.org::Fit by generalised least squares][Fit by generalised least squares]] */
 /* u <- the weights of the residual r - sum coef_i z_cols[i] on the columns. */
 static void fe__residual_weights(size_t dim, const size_t *cols, size_t ncols,

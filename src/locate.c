@@ -3,7 +3,9 @@
 /* [[file:../literate/locate.org::Locate Includes][Locate Includes]] */
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "foldest/error.h"
@@ -234,7 +236,7 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
             continue;
         if (!open) {
             memset(&cur, 0, sizeof cur);
-            cur.is_time = 1;
+            cur.region = FE_REGION_TIME;
             cur.t0 = b->t0;
             cur.pair = b->pair;
             cur.z = zn;
@@ -263,57 +265,508 @@ int fe_innovations_locate(const fe_innovations *a, double alpha, fe_located *out
 }
 /* Locate the windows ends here */
 /* [[file:../literate/locate.org::Write a located window as JSON][Write a located window as JSON]] */
-static int fe__json_num(char *buf, size_t len, size_t *at, const char *key, double v)
+/* Append printf-formatted text at *at; FE_ESIZE when it does not fit. */
+static int fe__append(char *buf, size_t len, size_t *at, const char *fmt, ...)
 {
-    int n = isfinite(v) ? snprintf(buf + *at, len - *at, ", \"%s\": %.10g", key, v)
-                        : snprintf(buf + *at, len - *at, ", \"%s\": null", key);
+    va_list ap;
+    int n;
+    if (*at >= len)
+        return FE_ESIZE;
+    va_start(ap, fmt);
+    n = vsnprintf(buf + *at, len - *at, fmt, ap);
+    va_end(ap);
     if (n < 0 || (size_t)n >= len - *at)
         return FE_ESIZE;
     *at += (size_t)n;
     return FE_OK;
 }
 
+static int fe__json_num(char *buf, size_t len, size_t *at, const char *key, double v)
+{
+    char text[32];
+    if (!isfinite(v))
+        return fe__append(buf, len, at, ", \"%s\": null", key);
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, v);
+        if (strtod(text, NULL) == v)
+            break;
+    }
+    return fe__append(buf, len, at, ", \"%s\": %s", key, text);
+}
+
 int fe_located_json(const fe_located *l, char *buf, size_t len)
 {
     size_t at = 0;
-    int n, rc = FE_OK;
+    int rc, residual;
+    char words[96];
     if (l == NULL || buf == NULL || len == 0)
         return FE_EINVAL;
     buf[0] = '\0';
-    n = snprintf(buf, len, "{\"kind\": \"time\", \"recording\": %d, \"end_recording\": %d",
-                 l->pair + 1, l->pair1 + 1);
-    if (n < 0 || (size_t)n >= len)
-        return FE_ESIZE;
-    at = (size_t)n;
-    rc = fe__json_num(buf, len, &at, "start", l->t0);
-    if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "end", l->t1);
+    residual = l->test != NULL && strncmp(l->test, "residual", 8) == 0;
+    if (l->region == FE_REGION_TIME) {
+        rc = fe__append(buf, len, &at, "{\"kind\": \"time\", \"recording\": %d, "
+                        "\"end_recording\": %d", l->pair + 1, l->pair1 + 1);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "start", l->t0);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "end", l->t1);
+    } else {
+        rc = fe_region_describe(l, words, sizeof words);
+        if (rc == FE_OK)
+            rc = fe__append(buf, len, &at, "{\"kind\": \"state\", \"variable\": \"%s\", "
+                            "\"region\": \"%s\"", fe_region_variable(l->region), words);
+    }
     if (rc == FE_OK)
         rc = fe__json_num(buf, len, &at, "rows", l->n);
     if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "statistic",
-                          fabs(l->z) > fabs(l->t) ? l->z : l->t);
-    if (rc == FE_OK) {
-        n = snprintf(buf + at, len - at, ", \"test\": \"%s\"",
-                     l->test != NULL ? l->test : "");
-        rc = n < 0 || (size_t)n >= len - at ? FE_ESIZE : FE_OK;
-        if (rc == FE_OK)
-            at += (size_t)n;
-    }
+        rc = fe__json_num(buf, len, &at, "statistic", fabs(l->z) > fabs(l->t) ? l->z : l->t);
+    if (rc == FE_OK)
+        rc = fe__append(buf, len, &at, ", \"test\": \"%s\"", l->test != NULL ? l->test : "");
     if (rc == FE_OK)
         rc = fe__json_num(buf, len, &at, "p_value", l->p_value);
-    if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "nis_statistic", l->z);
-    if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "acf_statistic", l->t);
-    if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "mean_nis_per_dof", l->mean_nis);
-    if (rc == FE_OK)
-        rc = fe__json_num(buf, len, &at, "lag1", l->lag1);
-    if (rc == FE_OK) {
-        n = snprintf(buf + at, len - at, "}");
-        rc = n < 0 || (size_t)n >= len - at ? FE_ESIZE : FE_OK;
+    if (residual) {
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "mean_residual_before", l->mean_before);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "mean_residual_after", l->mean_after);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "ms_ratio_before", l->ms_ratio_before);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "ms_ratio_after", l->ms_ratio_after);
+    } else {
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "nis_statistic", l->z);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "acf_statistic", l->t);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "mean_nis_per_dof", l->mean_nis);
+        if (rc == FE_OK)
+            rc = fe__json_num(buf, len, &at, "lag1", l->lag1);
     }
+    if (rc == FE_OK)
+        rc = fe__append(buf, len, &at, "}");
     return rc;
 }
 /* Write a located window as JSON ends here */
+/* [[file:../literate/locate.org::Name a region][Name a region]] */
+const char *fe_region_variable(fe_region r)
+{
+    switch (r) {
+    case FE_REGION_TIME: return "time";
+    case FE_REGION_VELOCITY_NEGATIVE:
+    case FE_REGION_VELOCITY_POSITIVE:
+    case FE_REGION_VELOCITY_ZERO: return "velocity";
+    case FE_REGION_SPEED: return "speed";
+    case FE_REGION_POSITION_NEGATIVE:
+    case FE_REGION_POSITION_POSITIVE: return "position";
+    case FE_REGION_TEMPERATURE: return "temperature";
+    }
+    return "";
+}
+
+int fe_region_describe(const fe_located *l, char *buf, size_t len)
+{
+    int n;
+    if (l == NULL || buf == NULL || len == 0)
+        return FE_EINVAL;
+    switch (l->region) {
+    case FE_REGION_TIME: n = snprintf(buf, len, "%.4g to %.4g", l->t0, l->t1); break;
+    case FE_REGION_VELOCITY_NEGATIVE: n = snprintf(buf, len, "v < 0"); break;
+    case FE_REGION_VELOCITY_POSITIVE: n = snprintf(buf, len, "v > 0"); break;
+    case FE_REGION_VELOCITY_ZERO: n = snprintf(buf, len, "v = 0"); break;
+    case FE_REGION_SPEED: n = snprintf(buf, len, "|v| %.3g to %.3g", l->lo, l->hi); break;
+    case FE_REGION_POSITION_NEGATIVE: n = snprintf(buf, len, "x < 0"); break;
+    case FE_REGION_POSITION_POSITIVE: n = snprintf(buf, len, "x > 0"); break;
+    case FE_REGION_TEMPERATURE: n = snprintf(buf, len, "%.4g to %.4g", l->lo, l->hi); break;
+    default: n = snprintf(buf, len, "?"); break;
+    }
+    return n < 0 || (size_t)n >= len ? FE_ESIZE : FE_OK;
+}
+/* Name a region ends here */
+/* [[file:../literate/locate.org::Start a residual map][Start a residual map]] */
+static void fe__add_region(fe_residual_map *m, fe_region r, double lo, double hi)
+{
+    m->region[m->nregions] = r;
+    m->region_lo[m->nregions] = lo;
+    m->region_hi[m->nregions] = hi;
+    m->nregions++;
+}
+
+int fe_residual_map_init(fe_residual_map *m, size_t blocks, uint64_t fit, uint64_t row0,
+                         unsigned roles, const double lo[3], const double hi[3])
+{
+    static const unsigned role[3] = {FE_ROLE_POSITION, FE_ROLE_VELOCITY, FE_ROLE_TEMPERATURE};
+    if (m == NULL || (roles != 0 && (lo == NULL || hi == NULL)))
+        return FE_EINVAL;
+    if (blocks < 2 || blocks > FE_DISCOVER_MAX_BLOCKS)
+        return FE_ESIZE;
+    if (fit < 2 * (uint64_t)blocks)
+        return FE_ETOOFEW;
+    for (int v = 0; v < 3; v++)
+        if (roles & role[v]) {
+            if (!isfinite(lo[v]) || !isfinite(hi[v]))
+                return FE_ENONFINITE;
+            if (lo[v] > hi[v])
+                return FE_EINVAL;
+        }
+    memset(m, 0, sizeof *m);
+    m->blocks = blocks;
+    m->fit = fit;
+    m->row0 = row0;
+    m->first_linked = 1;
+    m->roles = roles & (FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE);
+    for (int v = 0; v < 3; v++)
+        if (m->roles & role[v]) {
+            m->lo[v] = lo[v];
+            m->hi[v] = hi[v];
+        }
+    m->vmax = fabs(m->lo[1]) > fabs(m->hi[1]) ? fabs(m->lo[1]) : fabs(m->hi[1]);
+    if (m->roles & FE_ROLE_VELOCITY) {
+        fe__add_region(m, FE_REGION_VELOCITY_NEGATIVE, 0, 0);
+        fe__add_region(m, FE_REGION_VELOCITY_POSITIVE, 0, 0);
+        fe__add_region(m, FE_REGION_VELOCITY_ZERO, 0, 0);
+        for (int b = 0; b < 4; b++)
+            fe__add_region(m, FE_REGION_SPEED, m->vmax * b / 4.0, m->vmax * (b + 1) / 4.0);
+    }
+    if (m->roles & FE_ROLE_POSITION) {
+        fe__add_region(m, FE_REGION_POSITION_NEGATIVE, 0, 0);
+        fe__add_region(m, FE_REGION_POSITION_POSITIVE, 0, 0);
+    }
+    if (m->roles & FE_ROLE_TEMPERATURE)
+        for (int b = 0; b < 4; b++)
+            fe__add_region(m, FE_REGION_TEMPERATURE, m->lo[2] + (m->hi[2] - m->lo[2]) * b / 4.0,
+                           m->lo[2] + (m->hi[2] - m->lo[2]) * (b + 1) / 4.0);
+    return FE_OK;
+}
+/* Start a residual map ends here */
+/* [[file:../literate/locate.org::Fold a row into the residual map][Fold a row into the residual map]] */
+static void fe__cell_add(fe_residual_cell *c, double t, int pair, double before, double after)
+{
+    if (c->n == 0) {
+        c->t0 = t;
+        c->pair = pair;
+    }
+    c->t1 = t;
+    c->pair1 = pair;
+    c->n += 1;
+    c->sum0 += before;
+    c->sq0 += before * before;
+    c->sum1 += after;
+    c->sq1 += after * after;
+}
+
+/* The band (0 .. bands - 1) of u in [lo, hi]. */
+static int fe__band(double u, double lo, double hi, int bands)
+{
+    double w = hi - lo;
+    int b = w > 0 ? (int)((u - lo) / w * bands) : 0;
+    return b < 0 ? 0 : b >= bands ? bands - 1 : b;
+}
+
+static int fe__in_region(const fe_residual_map *m, size_t g, const fe_sample *s)
+{
+    switch (m->region[g]) {
+    case FE_REGION_VELOCITY_NEGATIVE: return s->velocity < 0;
+    case FE_REGION_VELOCITY_POSITIVE: return s->velocity > 0;
+    case FE_REGION_VELOCITY_ZERO: return s->velocity == 0;
+    case FE_REGION_SPEED:
+        return s->velocity != 0
+               && fe__band(fabs(s->velocity), 0.0, m->vmax, 4)
+                      == fe__band(0.5 * (m->region_lo[g] + m->region_hi[g]), 0.0, m->vmax, 4);
+    case FE_REGION_POSITION_NEGATIVE: return s->position < 0;
+    case FE_REGION_POSITION_POSITIVE: return s->position > 0;
+    case FE_REGION_TEMPERATURE:
+        return fe__band(s->temperature, m->lo[2], m->hi[2], 4)
+               == fe__band(0.5 * (m->region_lo[g] + m->region_hi[g]), m->lo[2], m->hi[2], 4);
+    default: return 0;
+    }
+}
+
+int fe_residual_map_add(fe_residual_map *m, const fe_sample *s, double before, double after)
+{
+    uint64_t i;
+    size_t k, ncell = 0;
+    double x[3], at[1 + FE_RESIDUAL_REGIONS + 3];
+    fe_residual_cell *cell[1 + FE_RESIDUAL_REGIONS + 3];   /* the cells the row joins */
+    if (m == NULL || s == NULL)
+        return FE_EINVAL;
+    x[0] = s->position;
+    x[1] = s->velocity;
+    x[2] = s->temperature;
+    if (!isfinite(s->t) || !isfinite(before) || !isfinite(after))
+        return FE_ENONFINITE;
+    for (int v = 0; v < 3; v++)
+        if ((m->roles & (1u << v)) && !isfinite(x[v]))
+            return FE_ENONFINITE;
+    i = m->row0 + m->n;
+    k = i < m->fit ? (size_t)(i * m->blocks / m->fit) : m->blocks;
+    cell[ncell] = &m->block[k];
+    at[ncell++] = s->t;
+    for (size_t g = 0; g < m->nregions && i < m->fit; g++)
+        if (fe__in_region(m, g, s)) {
+            cell[ncell] = &m->cell[g];
+            at[ncell++] = s->t;
+        }
+    for (int v = 0; v < 3; v++)
+        if (m->roles & (1u << v)) {
+            cell[ncell] = &m->bin[v][fe__band(x[v], m->lo[v], m->hi[v], FE_RESIDUAL_BINS)];
+            at[ncell++] = x[v];
+        }
+    /* Finite values can have sums that are not: refuse the row, with the
+       map unchanged. */
+    for (size_t c = 0; c < ncell; c++)
+        if (!isfinite(cell[c]->sum0 + before) || !isfinite(cell[c]->sq0 + before * before)
+            || !isfinite(cell[c]->sum1 + after) || !isfinite(cell[c]->sq1 + after * after))
+            return FE_ENONFINITE;
+    for (size_t c = 0; c < ncell; c++)
+        fe__cell_add(cell[c], at[c], m->recording, before, after);
+    m->n++;
+    return FE_OK;
+}
+
+void fe_residual_map_break(fe_residual_map *m)
+{
+    if (m == NULL)
+        return;
+    if (m->n > 0)
+        m->recording++;
+    else
+        m->first_linked = 0;
+}
+/* Fold a row into the residual map ends here */
+/* [[file:../literate/locate.org::Merge residual maps][Merge residual maps]] */
+static void fe__cell_merge(fe_residual_cell *x, const fe_residual_cell *y, int shift)
+{
+    if (y->n == 0)
+        return;
+    if (x->n == 0) {
+        x->t0 = y->t0;
+        x->pair = y->pair + shift;
+    }
+    x->t1 = y->t1;
+    x->pair1 = y->pair1 + shift;
+    x->n += y->n;
+    x->sum0 += y->sum0;
+    x->sq0 += y->sq0;
+    x->sum1 += y->sum1;
+    x->sq1 += y->sq1;
+}
+
+int fe_residual_map_merge(fe_residual_map *a, const fe_residual_map *b)
+{
+    int shift;
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (a->blocks != b->blocks || a->fit != b->fit || a->roles != b->roles
+        || b->row0 != a->row0 + a->n || memcmp(a->lo, b->lo, sizeof a->lo) != 0
+        || memcmp(a->hi, b->hi, sizeof a->hi) != 0)
+        return FE_EMISMATCH;
+    if (b->n == 0)
+        return FE_OK;
+    shift = a->n == 0 ? a->recording : a->recording + (b->first_linked ? 0 : 1);
+    for (size_t k = 0; k <= a->blocks; k++)
+        fe__cell_merge(&a->block[k], &b->block[k], shift);
+    for (size_t g = 0; g < a->nregions; g++)
+        fe__cell_merge(&a->cell[g], &b->cell[g], shift);
+    for (int v = 0; v < 3; v++)
+        for (size_t j = 0; j < FE_RESIDUAL_BINS; j++)
+            fe__cell_merge(&a->bin[v][j], &b->bin[v][j], shift);
+    if (a->n == 0)
+        a->first_linked = b->first_linked;
+    a->recording = shift + b->recording;
+    a->n += b->n;
+    return FE_OK;
+}
+/* Merge residual maps ends here */
+/* [[file:../literate/locate.org::Locate in the residual map][Locate in the residual map]] */
+static int fe__cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The two-sided Bonferroni bound for `places` places, two statistics
+   each, at family-wise level alpha. */
+static double fe__bound(double alpha, size_t places)
+{
+    return -fe_normal_quantile(alpha / (double)(2 * places));
+}
+
+/* Which of a place's two statistics located it, and its p-value before
+   Bonferroni: the mean square's upper tail, or the mean's two tails. */
+static void fe__located_test(fe_located *l)
+{
+    int ms = l->z > fabs(l->t);
+    l->test = ms ? "residual_ms" : "residual_mean";
+    l->p_value = ms ? 0.5 * erfc(l->z / sqrt(2.0)) : erfc(fabs(l->t) / sqrt(2.0));
+}
+
+/* Fill a located place from a cell: its statistics against the yardstick
+   ms (mean square) and, for regions, the overall mean. */
+static void fe__located_cell(fe_located *l, const fe_residual_cell *b, double ms, double z,
+                             double t)
+{
+    l->t0 = b->t0;
+    l->t1 = b->t1;
+    l->pair = b->pair;
+    l->pair1 = b->pair1;
+    l->n = b->n;
+    l->z = z;
+    l->t = t;
+    fe__located_test(l);
+    l->mean_before = b->sum0 / b->n;
+    l->mean_after = b->sum1 / b->n;
+    l->ms_ratio_before = b->sq0 / b->n / ms;
+    l->ms_ratio_after = b->sq1 / b->n / ms;
+}
+
+int fe_residual_map_locate(const fe_residual_map *m, double worth, double alpha,
+                           fe_located *out, size_t max, size_t *nout)
+{
+    double ms[FE_DISCOVER_MAX_BLOCKS], sorted[FE_DISCOVER_MAX_BLOCKS], med, thr;
+    double all_n = 0, all_sq = 0, all_sum = 0;
+    size_t K, count = 0;
+    int open = 0;
+    fe_located cur;
+    if (m == NULL || nout == NULL || (max > 0 && out == NULL) || !(alpha > 0.0)
+        || !(alpha < 1.0) || !(worth > 0.0) || !(worth <= 1.0))
+        return FE_EINVAL;
+    K = m->blocks;
+    thr = fe__bound(alpha, K + m->nregions);
+    for (size_t k = 0; k < K; k++) {
+        ms[k] = m->block[k].n > 0 ? m->block[k].sq0 / m->block[k].n : 0.0;
+        all_n += m->block[k].n;
+        all_sq += m->block[k].sq0;
+        all_sum += m->block[k].sum0;
+    }
+    memcpy(sorted, ms, K * sizeof *sorted);
+    qsort(sorted, K, sizeof *sorted, fe__cmp_double);
+    med = K % 2 ? sorted[K / 2] : 0.5 * (sorted[K / 2 - 1] + sorted[K / 2]);
+    memset(&cur, 0, sizeof cur);
+    for (size_t k = 0; k <= K && med > 0; k++) {
+        const fe_residual_cell *b = k < K ? &m->block[k] : NULL;
+        double z = 0, t = 0;
+        int hit = 0;
+        if (b != NULL && b->n >= 2) {
+            double neff = b->n * worth;
+            z = (ms[k] / med - 1.0) / sqrt(2.0 / neff);
+            t = (b->sum0 / b->n) / sqrt(med / neff);
+            hit = z > thr || fabs(t) > thr;
+        }
+        if (open && (!hit || b->pair != cur.pair1)) {
+            if (count < max)
+                out[count] = cur;
+            count++;
+            open = 0;
+        }
+        if (!hit)
+            continue;
+        if (!open) {
+            memset(&cur, 0, sizeof cur);
+            cur.region = FE_REGION_TIME;
+            fe__located_cell(&cur, b, med, z, t);
+            open = 1;
+            continue;
+        }
+        {
+            double n = cur.n + b->n;
+            cur.mean_before = (cur.mean_before * cur.n + b->sum0) / n;
+            cur.mean_after = (cur.mean_after * cur.n + b->sum1) / n;
+            cur.ms_ratio_before = (cur.ms_ratio_before * cur.n * med + b->sq0) / (n * med);
+            cur.ms_ratio_after = (cur.ms_ratio_after * cur.n * med + b->sq1) / (n * med);
+            cur.n = n;
+            cur.t1 = b->t1;
+            cur.pair1 = b->pair1;
+            cur.z = z > cur.z ? z : cur.z;
+            cur.t = fabs(t) > fabs(cur.t) ? t : cur.t;
+            fe__located_test(&cur);
+        }
+    }
+    for (size_t g = 0; g < m->nregions && all_n > 0 && all_sq > 0; g++) {
+        const fe_residual_cell *b = &m->cell[g];
+        double msall = all_sq / all_n, neff, t, z;
+        if (b->n < 2 || b->n > all_n - 2)
+            continue;
+        neff = b->n * worth;
+        t = (b->sum0 / b->n - all_sum / all_n) / sqrt(msall / neff);
+        z = (b->sq0 / b->n / msall - 1.0) / sqrt(2.0 / neff);
+        if (fabs(t) > thr || z > thr) {
+            memset(&cur, 0, sizeof cur);
+            cur.region = m->region[g];
+            cur.lo = m->region_lo[g];
+            cur.hi = m->region_hi[g];
+            fe__located_cell(&cur, b, msall, z, t);
+            if (count < max)
+                out[count] = cur;
+            count++;
+        }
+    }
+    *nout = count;
+    return FE_OK;
+}
+/* Locate in the residual map ends here */
+/* [[file:../literate/locate.org::Test the residual after the terms][Test the residual after the terms]] */
+double fe_residual_map_largest_after(const fe_residual_map *m, double worth)
+{
+    double all_n = 0, all_sq = 0, all_sum = 0, worst = 0.0;
+    if (m == NULL)
+        return 0.0;
+    for (size_t k = 0; k < m->blocks; k++) {
+        all_n += m->block[k].n;
+        all_sq += m->block[k].sq1;
+        all_sum += m->block[k].sum1;
+    }
+    if (!(all_n > 0 && all_sq > 0))
+        return 0.0;
+    for (size_t g = 0; g < m->blocks + m->nregions; g++) {
+        const fe_residual_cell *b = g < m->blocks ? &m->block[g] : &m->cell[g - m->blocks];
+        double ms = all_sq / all_n, neff, t, z;
+        if (b->n < 2 || b->n > all_n - 2)
+            continue;
+        neff = b->n * worth;
+        t = (b->sum1 / b->n - all_sum / all_n) / sqrt(ms / neff);
+        z = (b->sq1 / b->n / ms - 1.0) / sqrt(2.0 / neff);
+        worst = fabs(t) > worst ? fabs(t) : worst;
+        worst = z > worst ? z : worst;
+    }
+    return worst;
+}
+/* Test the residual after the terms ends here */
+/* [[file:../literate/locate.org::Decide the verdict][Decide the verdict]] */
+fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_map *m,
+                               size_t nlocated, double alpha)
+{
+    if (r == NULL || m == NULL)
+        return FE_VERDICT_NO_MISMATCH;
+    if (r->steps == 0)
+        return nlocated > 0 ? FE_VERDICT_UNEXPLAINED : FE_VERDICT_NO_MISMATCH;
+    if (r->noise.kind == FE_DISCOVER_NOISE_AR && r->noise.portmanteau_p < 0.001)
+        return FE_VERDICT_NOT_WHITE;
+    if (fe_residual_map_largest_after(m, fe_discover_row_worth(&r->noise, r->final.n))
+        > fe__bound(alpha, m->blocks + m->nregions))
+        return FE_VERDICT_OUT_OF_LINE;
+    return FE_VERDICT_EXPLAINED;
+}
+
+const char *fe_verdict_text(fe_verdict v)
+{
+    switch (v) {
+    case FE_VERDICT_NO_MISMATCH: return "no significant mismatch";
+    case FE_VERDICT_EXPLAINED: return "mismatch explained";
+    default: return "mismatch not explained by the catalog";
+    }
+}
+
+const char *fe_verdict_why(fe_verdict v)
+{
+    switch (v) {
+    case FE_VERDICT_NOT_WHITE:
+        return "terms were found, but the residual left is not white noise: "
+               "something else is missing";
+    case FE_VERDICT_OUT_OF_LINE:
+        return "terms were found, but a time window or state region stays out of line "
+               "after them";
+    default: return NULL;
+    }
+}
+/* Decide the verdict ends here */

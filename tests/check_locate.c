@@ -74,7 +74,7 @@ START_TEST(a_missed_drag_is_located_where_it_acts)
         run_tracker(seed, 0.0005, &inn);
         ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, loc, 8, &n), FE_OK);
         for (size_t i = 0; i < n && i < 8; i++) {
-            ck_assert(loc[i].is_time);
+            ck_assert_int_eq(loc[i].region, FE_REGION_TIME);
             if (loc[i].t0 <= t_on + blen && loc[i].t1 >= t_off - blen) {
                 cover = 1;
                 ck_assert(loc[i].mean_nis > 1.0 && loc[i].lag1 > 0.0);
@@ -148,7 +148,7 @@ START_TEST(block_statistics_match_a_direct_computation)
     ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, NULL, 0, &n), FE_OK);
     ck_assert_int_eq(fe_innovations_locate(&inn, 0.0, NULL, 0, &n), FE_EINVAL);
     memset(&l, 0, sizeof l);
-    l.is_time = 1;
+    l.region = FE_REGION_TIME;
     l.test = "nis";
     l.t0 = 1.5;
     l.t1 = 2.5;
@@ -395,6 +395,436 @@ START_TEST(arguments_merges_that_do_not_fit_and_json)
 }
 END_TEST
 
+
+/* ---------------------------------------------------------------- residual map */
+
+enum { MAP_ROWS = 600, MAP_BLOCKS = 10, MAP_FIT = 480 };
+
+/* Row i of three recordings (breaks before rows 200 and 350): time, a
+   state that crosses zero, and residuals before and after. */
+static void map_row(int i, fe_sample *s, double *before, double *after)
+{
+    memset(s, 0, sizeof *s);
+    s->t = 0.01 * i + (i >= 200 ? 100 : 0) + (i >= 350 ? 100 : 0);
+    s->position = sin(0.05 * i);
+    s->velocity = i % 37 == 0 ? 0.0 : cos(0.031 * i) * 2.0;
+    s->temperature = 20.0 + 5.0 * sin(0.007 * i);
+    *before = 0.3 * sin(1.7 * i) + (s->velocity < 0 ? 0.2 : 0.0);
+    *after = 0.3 * sin(1.7 * i);
+}
+
+static const double map_lo[3] = {-1.0, -2.0, 15.0}, map_hi[3] = {1.0, 2.0, 25.0};
+static const unsigned map_roles = FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE;
+
+/* Fold rows [from, to) into m (a part starting at row `from`). */
+static void map_fold(fe_residual_map *m, int from, int to)
+{
+    ck_assert_int_eq(fe_residual_map_init(m, MAP_BLOCKS, MAP_FIT, (uint64_t)from, map_roles,
+                                          map_lo, map_hi), FE_OK);
+    for (int i = from; i < to; i++) {
+        fe_sample s;
+        double b, a;
+        map_row(i, &s, &b, &a);
+        if (i > from && (i == 200 || i == 350))
+            fe_residual_map_break(m);
+        if (i == from && (i == 200 || i == 350))
+            fe_residual_map_break(m);
+        ck_assert_int_eq(fe_residual_map_add(m, &s, b, a), FE_OK);
+    }
+}
+
+START_TEST(residual_map_cells_equal_sums_over_the_rows)
+{
+    /* Every block, region and bin against a direct sum over the rows that
+       belong to it by definition (block floor(i K / fit), the held-out rows
+       in block K; regions of fitted rows only; bins of every row). */
+    fe_residual_map m;
+    double blk[MAP_BLOCKS + 1][3] = {{0}}, neg[3] = {0}, zero[3] = {0}, tb[4][3] = {{0}};
+    double sb[4] = {0}, pb[FE_RESIDUAL_BINS] = {0};
+    map_fold(&m, 0, MAP_ROWS);
+    ck_assert_uint_eq(m.nregions, 13);
+    for (int i = 0; i < MAP_ROWS; i++) {
+        fe_sample s;
+        double b, a, u;
+        int k = i < MAP_FIT ? i * MAP_BLOCKS / MAP_FIT : MAP_BLOCKS, band;
+        map_row(i, &s, &b, &a);
+        blk[k][0] += 1;
+        blk[k][1] += b;
+        blk[k][2] += a * a;
+        u = (s.position + 1.0) / 2.0 * FE_RESIDUAL_BINS;
+        pb[u >= FE_RESIDUAL_BINS ? FE_RESIDUAL_BINS - 1 : (int)u] += 1;
+        if (i >= MAP_FIT)
+            continue;
+        if (s.velocity < 0) {
+            neg[0] += 1;
+            neg[1] += b;
+            neg[2] += b * b;
+        }
+        if (s.velocity == 0) {
+            zero[0] += 1;
+            zero[1] += a;
+        }
+        if (s.velocity != 0) {
+            band = (int)(fabs(s.velocity) / 2.0 * 4);
+            sb[band > 3 ? 3 : band] += 1;
+        }
+        band = (int)((s.temperature - 15.0) / 10.0 * 4);
+        tb[band > 3 ? 3 : band][0] += 1;
+        tb[band > 3 ? 3 : band][1] += b * b;
+    }
+    for (int k = 0; k <= MAP_BLOCKS; k++) {
+        ck_assert_double_eq(m.block[k].n, blk[k][0]);
+        ck_assert_double_eq_tol(m.block[k].sum0, blk[k][1], 1e-12);
+        ck_assert_double_eq_tol(m.block[k].sq1, blk[k][2], 1e-12);
+    }
+    ck_assert_int_eq(m.region[0], FE_REGION_VELOCITY_NEGATIVE);
+    ck_assert_double_eq(m.cell[0].n, neg[0]);
+    ck_assert_double_eq_tol(m.cell[0].sum0, neg[1], 1e-12);
+    ck_assert_double_eq_tol(m.cell[0].sq0, neg[2], 1e-12);
+    ck_assert_int_eq(m.region[2], FE_REGION_VELOCITY_ZERO);
+    ck_assert_double_eq(m.cell[2].n, zero[0]);
+    ck_assert_double_eq_tol(m.cell[2].sum1, zero[1], 1e-12);
+    for (int b = 0; b < 4; b++) {
+        ck_assert_int_eq(m.region[3 + b], FE_REGION_SPEED);
+        ck_assert_double_eq_tol(m.region_lo[3 + b], 0.5 * b, 1e-15);
+        ck_assert_double_eq(m.cell[3 + b].n, sb[b]);
+        ck_assert_int_eq(m.region[9 + b], FE_REGION_TEMPERATURE);
+        ck_assert_double_eq_tol(m.region_hi[9 + b], 15.0 + 2.5 * (b + 1), 1e-12);
+        ck_assert_double_eq(m.cell[9 + b].n, tb[b][0]);
+        ck_assert_double_eq_tol(m.cell[9 + b].sq0, tb[b][1], 1e-12);
+    }
+    for (int j = 0; j < FE_RESIDUAL_BINS; j++)
+        ck_assert_double_eq(m.bin[0][j].n, pb[j]);
+    /* The recordings of the blocks: block 3 (rows 144..191) is in the
+       first, block 4 (rows 192..239) runs from the first into the second. */
+    ck_assert_int_eq(m.block[3].pair1, 0);
+    ck_assert_int_eq(m.block[4].pair, 0);
+    ck_assert_int_eq(m.block[4].pair1, 1);
+    ck_assert_int_eq(m.block[MAP_BLOCKS].pair1, 2);
+}
+END_TEST
+
+START_TEST(residual_map_merge_of_parts_equals_whole)
+{
+    /* Cut anywhere (inside a recording, at a break, next to one, in the
+       held-out rows): the merged map equals the whole fold in every cell,
+       recordings included. */
+    static const int cuts[][2] = {{1, 599}, {200, 350}, {199, 351}, {480, 481}, {57, 520}};
+    fe_residual_map whole;
+    map_fold(&whole, 0, MAP_ROWS);
+    for (size_t c = 0; c < sizeof cuts / sizeof cuts[0]; c++) {
+        fe_residual_map p0, p1, p2;
+        map_fold(&p0, 0, cuts[c][0]);
+        map_fold(&p1, cuts[c][0], cuts[c][1]);
+        map_fold(&p2, cuts[c][1], MAP_ROWS);
+        ck_assert_int_eq(fe_residual_map_merge(&p1, &p2), FE_OK);
+        ck_assert_int_eq(fe_residual_map_merge(&p0, &p1), FE_OK);
+        ck_assert_uint_eq(p0.n, whole.n);
+        ck_assert_int_eq(p0.recording, whole.recording);
+        for (size_t k = 0; k <= MAP_BLOCKS; k++) {
+            const fe_residual_cell *x = &p0.block[k], *y = &whole.block[k];
+            ck_assert_double_eq(x->n, y->n);
+            ck_assert_double_eq_tol(x->sum0, y->sum0, 1e-12);
+            ck_assert_double_eq_tol(x->sq0, y->sq0, 1e-12);
+            ck_assert_double_eq_tol(x->sum1, y->sum1, 1e-12);
+            ck_assert_double_eq_tol(x->sq1, y->sq1, 1e-12);
+            ck_assert_double_eq(x->t0, y->t0);
+            ck_assert_double_eq(x->t1, y->t1);
+            ck_assert_int_eq(x->pair, y->pair);
+            ck_assert_int_eq(x->pair1, y->pair1);
+        }
+        for (size_t g = 0; g < whole.nregions; g++) {
+            ck_assert_double_eq(p0.cell[g].n, whole.cell[g].n);
+            ck_assert_double_eq_tol(p0.cell[g].sq0, whole.cell[g].sq0, 1e-12);
+            ck_assert_int_eq(p0.cell[g].pair, whole.cell[g].pair);
+            ck_assert_int_eq(p0.cell[g].pair1, whole.cell[g].pair1);
+        }
+        for (int v = 0; v < 3; v++)
+            for (size_t j = 0; j < FE_RESIDUAL_BINS; j++) {
+                ck_assert_double_eq(p0.bin[v][j].n, whole.bin[v][j].n);
+                ck_assert_double_eq_tol(p0.bin[v][j].sum1, whole.bin[v][j].sum1, 1e-12);
+            }
+    }
+    {
+        /* Parts out of order, or cut from other ranges, do not merge. */
+        fe_residual_map a, b, keep;
+        double lo2[3] = {-1.0, -2.0, 14.0};
+        map_fold(&a, 0, 100);
+        map_fold(&b, 101, 200);
+        memcpy(&keep, &a, sizeof a);
+        ck_assert_int_eq(fe_residual_map_merge(&a, &b), FE_EMISMATCH);
+        ck_assert_int_eq(fe_residual_map_init(&b, MAP_BLOCKS, MAP_FIT, 100, map_roles, lo2,
+                                              map_hi), FE_OK);
+        ck_assert_int_eq(fe_residual_map_merge(&a, &b), FE_EMISMATCH);
+        ck_assert_mem_eq(&a, &keep, sizeof a);
+        ck_assert_int_eq(fe_residual_map_merge(NULL, &b), FE_EINVAL);
+    }
+}
+END_TEST
+
+/* A map of white noise (fixed seed), with `step` added to the residual
+   before in fitted rows [from, to) and `vstep` where v < 0. */
+static void map_noise(fe_residual_map *m, double step, int from, int to, double vstep)
+{
+    fe_rng rng = fe_rng_seed(11);
+    const unsigned roles = FE_ROLE_VELOCITY;
+    const double lo[3] = {0, -1, 0}, hi[3] = {0, 1, 0};
+    ck_assert_int_eq(fe_residual_map_init(m, 20, 4000, 0, roles, lo, hi), FE_OK);
+    for (int i = 0; i < 5000; i++) {
+        fe_sample s = {0};
+        double e = fe_rng_normal(&rng), b = e;
+        s.t = i;
+        s.velocity = sin(0.01 * i);
+        if (i >= from && i < to)
+            b += step;
+        if (s.velocity < 0)
+            b += vstep;
+        ck_assert_int_eq(fe_residual_map_add(m, &s, b, e), FE_OK);
+    }
+}
+
+START_TEST(residual_map_locates_a_window_and_a_region)
+{
+    fe_residual_map m;
+    fe_located loc[8];
+    size_t n;
+    /* Nothing in white noise: every statistic below the Bonferroni bound
+       (27 places, two statistics: 3.11 at 0.05); here the largest is far
+       below it. */
+    map_noise(&m, 0.0, 0, 0, 0.0);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, loc, 8, &n), FE_OK);
+    ck_assert_uint_eq(n, 0);
+    ck_assert_double_lt(fe_residual_map_largest_after(&m, 1.0), -fe_normal_quantile(0.05 / 54));
+    /* A step of 0.6 sd over rows 1000..1399 (blocks 5 to 6, 200 rows each):
+       one window, exactly those blocks, t = 0.6 sqrt(200) = 8.5 each. */
+    map_noise(&m, 0.6, 1000, 1400, 0.0);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, loc, 8, &n), FE_OK);
+    ck_assert_uint_eq(n, 1);
+    ck_assert_int_eq(loc[0].region, FE_REGION_TIME);
+    ck_assert_double_eq(loc[0].t0, 1000);
+    ck_assert_double_eq(loc[0].t1, 1399);
+    ck_assert_double_eq(loc[0].n, 400);
+    ck_assert_str_eq(loc[0].test, "residual_mean");
+    ck_assert_double_gt(loc[0].t, 6.0);
+    ck_assert_double_lt(fabs(loc[0].mean_after), 0.2);
+    /* Worth a twentieth of a row each (a strongly coloured noise), the same step
+       is no longer out of line in time: t falls by sqrt(20), below 2.5. */
+    ck_assert_int_eq(fe_residual_map_locate(&m, 0.05, 0.05, loc, 8, &n), FE_OK);
+    for (size_t i = 0; i < n && i < 8; i++)
+        ck_assert_int_ne(loc[i].region, FE_REGION_TIME);
+    /* A shift where v < 0: that region and its complement v > 0. */
+    map_noise(&m, 0.0, 0, 0, 0.3);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, loc, 8, &n), FE_OK);
+    ck_assert_uint_ge(n, 1);
+    {
+        int found = 0;
+        char words[64];
+        for (size_t i = 0; i < n && i < 8; i++)
+            if (loc[i].region == FE_REGION_VELOCITY_NEGATIVE) {
+                found = 1;
+                ck_assert_double_gt(loc[i].t, 0);
+                ck_assert_int_eq(fe_region_describe(&loc[i], words, sizeof words), FE_OK);
+                ck_assert_str_eq(words, "v < 0");
+                ck_assert_str_eq(fe_region_variable(loc[i].region), "velocity");
+            }
+        ck_assert(found);
+    }
+    ck_assert_int_eq(fe_residual_map_locate(&m, 0.0, 0.05, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.5, 0.05, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 1.0, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, NULL, 8, &n), FE_EINVAL);
+}
+END_TEST
+
+START_TEST(residual_map_statistics_by_hand)
+{
+    /* Two blocks of 10 rows with known sums: the statistics of the
+       residual map's tests computed from their formulas. */
+    fe_residual_map m;
+    fe_located loc[4];
+    size_t n;
+    const double lo[3] = {0}, hi[3] = {0};
+    ck_assert_int_eq(fe_residual_map_init(&m, 3, 30, 0, 0, lo, hi), FE_OK);
+    for (int i = 0; i < 30; i++) {
+        fe_sample s = {0};
+        double e = i % 2 ? 1.0 : -1.0;
+        s.t = i;
+        if (i >= 20)
+            e = i % 2 ? 6.0 : -2.0;     /* block 2: mean 2, mean square 20 */
+        ck_assert_int_eq(fe_residual_map_add(&m, &s, e, e), FE_OK);
+    }
+    /* Mean squares 1, 1, 20: median 1.  Block 2: z = (20 - 1) / sqrt(2 /
+       (10 w)), t = 2 / sqrt(1 / (10 w)); with w = 0.5, z = 42.49, t = 4.47,
+       both above the bound for 3 places at 0.05 (2.394). */
+    ck_assert_int_eq(fe_residual_map_locate(&m, 0.5, 0.05, loc, 4, &n), FE_OK);
+    ck_assert_uint_eq(n, 1);
+    ck_assert_double_eq_tol(loc[0].z, 19.0 / sqrt(2.0 / 5.0), 1e-12);
+    ck_assert_double_eq_tol(loc[0].t, 2.0 / sqrt(1.0 / 5.0), 1e-12);
+    ck_assert_double_eq_tol(loc[0].ms_ratio_before, 20.0, 1e-12);
+    ck_assert_double_eq_tol(loc[0].p_value, 0.5 * erfc(loc[0].z / sqrt(2.0)), 1e-300);
+    /* After the terms, against all 30 rows: mean 2/3, mean square 22/3.
+       Block 2: t = (2 - 2/3) / sqrt((22/3) / (10 w)), z = (20 / (22/3) - 1)
+       / sqrt(2 / (10 w)); blocks 0 and 1: t = (0 - 2/3) / ..., z = (3/22 -
+       1) / ...; the largest is block 2's z. */
+    {
+        double w = 0.5, ms = 22.0 / 3.0;
+        double z2 = (20.0 / ms - 1.0) / sqrt(2.0 / (10 * w));
+        ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), z2, 1e-12);
+    }
+    /* The bound is two-sided Bonferroni over the 3 places: block 2's z =
+       19 sqrt(5 w) crosses b = -Phi^-1(0.05 / 6) at w = (b / 19)^2 / 5
+       (its t, 0.15 b there, does not count). */
+    {
+        double b = -fe_normal_quantile(0.05 / 6.0), w = b * b / (19.0 * 19.0) / 5.0;
+        ck_assert_int_eq(fe_residual_map_locate(&m, w * 1.001, 0.05, loc, 4, &n), FE_OK);
+        ck_assert_uint_eq(n, 1);
+        ck_assert_int_eq(fe_residual_map_locate(&m, w * 0.999, 0.05, loc, 4, &n), FE_OK);
+        ck_assert_uint_eq(n, 0);
+    }
+}
+END_TEST
+
+START_TEST(residual_map_refusals_at_their_edges)
+{
+    fe_residual_map m, keep;
+    fe_sample s = {0};
+    double lo[3] = {0, -1, 10}, hi[3] = {1, 1, 20};
+    const unsigned all = FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE;
+    ck_assert_int_eq(fe_residual_map_init(NULL, 2, 4, 0, 0, lo, hi), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_init(&m, 1, 100, 0, 0, lo, hi), FE_ESIZE);
+    ck_assert_int_eq(fe_residual_map_init(&m, FE_DISCOVER_MAX_BLOCKS + 1, 1000, 0, 0, lo, hi),
+                     FE_ESIZE);
+    ck_assert_int_eq(fe_residual_map_init(&m, FE_DISCOVER_MAX_BLOCKS, 1000, 0, 0, lo, hi),
+                     FE_OK);
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 19, 0, 0, lo, hi), FE_ETOOFEW);
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, 0, lo, hi), FE_OK);
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, all, NULL, hi), FE_EINVAL);
+    hi[2] = 9.0;                        /* lo > hi */
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, all, lo, hi), FE_EINVAL);
+    /* ... but a variable the rows do not carry is not read */
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+    hi[2] = 10.0;                       /* lo == hi: one band */
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, all, lo, hi), FE_OK);
+    lo[0] = NAN;
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, all, lo, hi), FE_ENONFINITE);
+    lo[0] = 0;
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, all, lo, hi), FE_OK);
+    s.temperature = 10;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_OK);
+    memcpy(&keep, &m, sizeof m);
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, NAN, 0.5), FE_ENONFINITE);
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, INFINITY), FE_ENONFINITE);
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1e200, 0.5), FE_ENONFINITE);
+    s.velocity = NAN;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_ENONFINITE);
+    s.velocity = 0;
+    s.t = INFINITY;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_ENONFINITE);
+    ck_assert_int_eq(fe_residual_map_add(NULL, &s, 1.0, 0.5), FE_EINVAL);
+    ck_assert_mem_eq(&m, &keep, sizeof m);
+    ck_assert_double_eq(fe_residual_map_largest_after(NULL, 1.0), 0.0);
+}
+END_TEST
+
+START_TEST(verdict_and_row_worth)
+{
+    fe_residual_map m;
+    fe_discover_result *r = calloc(1, sizeof *r);
+    fe_discover_noise nz;
+    ck_assert_ptr_nonnull(r);
+    map_noise(&m, 0.0, 0, 0, 0.0);
+    /* What a row is worth: n_eff / n, over R when a long range was found,
+       clamped to [1e-6, 1]. */
+    memset(&nz, 0, sizeof nz);
+    nz.n_eff = 250;
+    ck_assert_double_eq_tol(fe_discover_row_worth(&nz, 1000), 0.25, 1e-15);
+    nz.long_range = 1;
+    nz.block_ratio = 5;
+    ck_assert_double_eq_tol(fe_discover_row_worth(&nz, 1000), 0.05, 1e-15);
+    nz.n_eff = 2000;
+    nz.long_range = 0;
+    ck_assert_double_eq(fe_discover_row_worth(&nz, 1000), 1.0);
+    nz.n_eff = 1e-9;
+    ck_assert_double_eq(fe_discover_row_worth(&nz, 1000), 1e-6);
+    ck_assert_double_eq(fe_discover_row_worth(NULL, 1000), 1.0);
+    /* The verdicts. */
+    r->steps = 0;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 0, 0.05), FE_VERDICT_NO_MISMATCH);
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_UNEXPLAINED);
+    r->steps = 1;
+    r->final.n = 4000;
+    r->noise.kind = FE_DISCOVER_NOISE_AR;
+    r->noise.n_eff = 4000;
+    r->noise.portmanteau_p = 0.000999;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_NOT_WHITE);
+    r->noise.portmanteau_p = 0.001;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    r->noise.kind = FE_DISCOVER_NOISE_BATCH;
+    r->noise.portmanteau_p = 0.0;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    /* A residual after the terms that still has the step: out of line. */
+    {
+        fe_residual_map s;
+        fe_rng rng = fe_rng_seed(3);
+        const double lo[3] = {0}, hi[3] = {0};
+        ck_assert_int_eq(fe_residual_map_init(&s, 20, 4000, 0, 0, lo, hi), FE_OK);
+        for (int i = 0; i < 4000; i++) {
+            fe_sample x = {0};
+            double e = fe_rng_normal(&rng) + (i >= 2000 && i < 2200 ? 0.6 : 0.0);
+            x.t = i;
+            ck_assert_int_eq(fe_residual_map_add(&s, &x, e, e), FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_verdict(r, &s, 1, 0.05), FE_VERDICT_OUT_OF_LINE);
+        /* ... unless the noise model says the rows are worth a tenth each */
+        r->noise.n_eff = 400;
+        ck_assert_int_eq(fe_discover_verdict(r, &s, 1, 0.05), FE_VERDICT_EXPLAINED);
+    }
+    ck_assert_str_eq(fe_verdict_text(FE_VERDICT_EXPLAINED), "mismatch explained");
+    ck_assert_str_eq(fe_verdict_text(FE_VERDICT_NO_MISMATCH), "no significant mismatch");
+    ck_assert_str_eq(fe_verdict_text(FE_VERDICT_OUT_OF_LINE),
+                     "mismatch not explained by the catalog");
+    ck_assert_ptr_null(fe_verdict_why(FE_VERDICT_EXPLAINED));
+    ck_assert_ptr_nonnull(strstr(fe_verdict_why(FE_VERDICT_NOT_WHITE), "not white"));
+    ck_assert_int_eq(fe_discover_verdict(NULL, &m, 1, 0.05), FE_VERDICT_NO_MISMATCH);
+    free(r);
+}
+END_TEST
+
+START_TEST(located_regions_in_json_and_words)
+{
+    fe_located l;
+    char json[1024], words[64];
+    memset(&l, 0, sizeof l);
+    l.region = FE_REGION_SPEED;
+    l.lo = 0.5;
+    l.hi = 1;
+    l.n = 120;
+    l.z = 1.0;
+    l.t = -4.25;
+    l.test = "residual_mean";
+    l.p_value = 2.1e-5;
+    l.mean_before = 0.1;
+    l.mean_after = 0.1 + 0.2;           /* 0.30000000000000004: 17 digits */
+    ck_assert_int_eq(fe_region_describe(&l, words, sizeof words), FE_OK);
+    ck_assert_str_eq(words, "|v| 0.5 to 1");
+    ck_assert_int_eq(fe_region_describe(&l, words, 5), FE_ESIZE);
+    ck_assert_int_eq(fe_located_json(&l, json, sizeof json), FE_OK);
+    ck_assert_ptr_nonnull(strstr(json, "{\"kind\": \"state\", \"variable\": \"speed\", "
+                                       "\"region\": \"|v| 0.5 to 1\", \"rows\": 120, "
+                                       "\"statistic\": -4.25, \"test\": \"residual_mean\", "
+                                       "\"p_value\": 2.1e-05"));
+    ck_assert_ptr_nonnull(strstr(json, "\"mean_residual_after\": 0.30000000000000004"));
+    ck_assert_ptr_null(strstr(json, "nis"));
+    l.region = FE_REGION_TEMPERATURE;
+    l.lo = 20;
+    l.hi = 22.5;
+    ck_assert_int_eq(fe_region_describe(&l, words, sizeof words), FE_OK);
+    ck_assert_str_eq(words, "20 to 22.5");
+    ck_assert_str_eq(fe_region_variable(FE_REGION_POSITION_POSITIVE), "position");
+    ck_assert_str_eq(fe_region_variable((fe_region)99), "");
+}
+END_TEST
+
 Suite *fe_locate_suite(void)
 {
     Suite *s = suite_create("locate");
@@ -409,6 +839,13 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, json_of_every_length_is_whole_or_refused);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);
+    tcase_add_test(t, residual_map_cells_equal_sums_over_the_rows);
+    tcase_add_test(t, residual_map_merge_of_parts_equals_whole);
+    tcase_add_test(t, residual_map_locates_a_window_and_a_region);
+    tcase_add_test(t, residual_map_statistics_by_hand);
+    tcase_add_test(t, residual_map_refusals_at_their_edges);
+    tcase_add_test(t, verdict_and_row_worth);
+    tcase_add_test(t, located_regions_in_json_and_words);
     suite_add_tcase(s, t);
     return s;
 }

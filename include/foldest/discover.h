@@ -280,6 +280,13 @@ typedef struct fe_discover_noise {
 int fe_discover_noise_fit(const double *q, double n, size_t maxp,
                           fe_discover_noise *noise);
 
+/* fe_discover_row_worth: what one of the n rows of a series with noise
+   model nz is worth in independent rows, n_eff / n, divided by the block
+   ratio R when a long range was found; within [1e-6, 1] (1 for white
+   noise, or NULL).  A block of n_k rows weighs n_k times it, which is how
+   the located windows and regions are tested under the noise model. */
+double fe_discover_row_worth(const fe_discover_noise *nz, double n);
+
 /* One candidate's test at one step. */
 typedef struct fe_discover_rank {
     size_t group;

@@ -9,7 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-enum { FE__MAX_PAIRS = 64, FE__ROLES = 5, FE__PLOT_POINTS = 4000 };
+enum { FE__MAX_PAIRS = 64, FE__ROLES = 5, FE__PLOT_POINTS = 4000, FE__MAX_LOCATED = 128 };
 
 static const char *const fe__role_names[FE__ROLES] = {
     "position", "velocity", "temperature", "ambient", "input"};
@@ -258,43 +258,7 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
     return rc;
 }
 /* Align a recording with its simulation ends here */
-/* [[file:../../literate/cli_discover.org::Region statistics][Region statistics]] */
-typedef struct fe__stat {
-    double n, sum0, sq0, sum1, sq1;
-    double t0, t1;              /* first and last time */
-    int pair, pair1;            /* recordings of the first and last rows */
-} fe__stat;
-
-static void fe__stat_add(fe__stat *s, double t, int pair, double before, double after)
-{
-    if (s->n == 0) {
-        s->t0 = t;
-        s->pair = pair;
-    }
-    s->t1 = t;
-    s->pair1 = pair;
-    s->n += 1;
-    s->sum0 += before;
-    s->sq0 += before * before;
-    s->sum1 += after;
-    s->sq1 += after * after;
-}
-
-static int fe__cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-typedef struct fe__located {
-    int is_time;
-    double t0, t1;
-    int pair, pair1;
-    const char *variable;
-    char region[64];
-    double n, z, t, mean_before, mean_after, ms_ratio_before, ms_ratio_after;
-} fe__located;
-
+/* [[file:../../literate/cli_discover.org::A panel of rows][A panel of rows]] */
 /* Rows waiting to be folded, with where each came from. */
 typedef struct fe__panel {
     size_t n;
@@ -315,47 +279,7 @@ static int fe__flush_panel(fe_discover_acc *acc, fe__panel *p)
     p->n = rc == FE_OK ? 0 : done;
     return rc;
 }
-
-/* What one row is worth in independent rows under a noise model: n_eff / n,
-   at most 1, so that a block of n_k rows weighs n_k times it; divided by
-   the block ratio R when slow variation beyond the autoregression was
-   found (the blocks' means then vary R times more). */
-static double fe__row_worth(const fe_discover_noise *nz, double n)
-{
-    double w = n > 0 ? nz->n_eff / n : 1.0;
-    if (nz->long_range)
-        w /= nz->block_ratio;
-    return w > 1.0 ? 1.0 : w < 1e-6 ? 1e-6 : w;
-}
-
-/* The largest |t| (mean) or z (mean square) of any fitted block or
-   region, for the residual after the final model (sum1, sq1), under the
-   final noise model. */
-static double fe__largest_after(const fe__stat *blocks, size_t K, const fe__stat *regions,
-                                size_t nregions, double worth)
-{
-    double all_n = 0, all_sq = 0, all_sum = 0, worst = 0.0;
-    for (size_t k = 0; k < K; k++) {
-        all_n += blocks[k].n;
-        all_sq += blocks[k].sq1;
-        all_sum += blocks[k].sum1;
-    }
-    if (!(all_n > 0 && all_sq > 0))
-        return 0.0;
-    for (size_t g = 0; g < K + nregions; g++) {
-        const fe__stat *b = g < K ? &blocks[g] : &regions[g - K];
-        double ms = all_sq / all_n, neff, t, z;
-        if (b->n < 2 || b->n > all_n - 2)
-            continue;
-        neff = b->n * worth;
-        t = (b->sum1 / b->n - all_sum / all_n) / sqrt(ms / neff);
-        z = (b->sq1 / b->n / ms - 1.0) / sqrt(2.0 / neff);
-        worst = fabs(t) > worst ? fabs(t) : worst;
-        worst = z > worst ? z : worst;
-    }
-    return worst;
-}
-/* Region statistics ends here */
+/* A panel of rows ends here */
 /* [[file:../../literate/cli_discover.org::Discover Options][Discover Options]] */
 static const char fe__discover_help[] =
     "usage: foldest discover --real REAL.csv --sim SIM.csv --channel NAME [options]\n"
@@ -636,15 +560,12 @@ typedef struct fe__outcome {
     size_t rows, skipped, fit, heldout, blocks;
     size_t outside[3];                          /* skipped, by reason */
     double alpha;
-    fe__located located[128];
+    fe_located located[FE__MAX_LOCATED];
     size_t nlocated;
     const char *verdict;
     const char *why;                            /* why not "explained", or NULL */
+    const fe_residual_map *map;                 /* residuals by block and region */
     /* The final model refitted on each recording alone (classical errors). */
-    const fe__stat *regions;
-    const char *const *region_var;
-    const char (*region_name)[64];
-    size_t nregions;
     size_t npairs;
     double *per_coef, *per_se;                  /* npairs x ncols */
     double *per_rows, *per_held;                /* rows, held-out rows of each */
@@ -767,24 +688,9 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     fe__json_path(f, o);
     fprintf(f, ", \"located\": [");
     for (size_t i = 0; i < o->nlocated; i++) {
-        const fe__located *l = &o->located[i];
-        fprintf(f, "%s{\"kind\": \"%s\", ", i ? ", " : "", l->is_time ? "time" : "state");
-        if (l->is_time) {
-            fprintf(f, "\"recording\": %d, \"end_recording\": %d, \"start\": ", l->pair + 1,
-                    l->pair1 + 1);
-            fe__json_number(f, l->t0);
-            fe__json_pair(f, "end", l->t1);
-        } else {
-            fprintf(f, "\"variable\": \"%s\", \"region\": ", l->variable);
-            fe_cli_json_string(f, l->region);
-        }
-        fprintf(f, ", \"rows\": %.0f, \"statistic\": ", l->n);
-        fe__json_number(f, fabs(l->z) > fabs(l->t) ? l->z : l->t);
-        fe__json_pair(f, "mean_residual_before", l->mean_before);
-        fe__json_pair(f, "mean_residual_after", l->mean_after);
-        fe__json_pair(f, "ms_ratio_before", l->ms_ratio_before);
-        fe__json_pair(f, "ms_ratio_after", l->ms_ratio_after);
-        fprintf(f, "}");
+        char obj[1024];
+        if (fe_located_json(&o->located[i], obj, sizeof obj) == FE_OK)
+            fprintf(f, "%s%s", i ? ", " : "", obj);
     }
     fprintf(f, "], \"discovered\": [");
     for (size_t s = 0; s < r->steps; s++) {
@@ -888,6 +794,36 @@ static void fe__story_path(FILE *f, const fe__outcome *o)
     }
 }
 
+/* Where the discovered terms help: each band of speed, position and
+   temperature (the bands of one variable cover the rows once), with its
+   share of the drop in the residual's sum of squares. */
+static void fe__story_regions(FILE *f, const fe_residual_map *m)
+{
+    double total = 0.0;
+    for (size_t g = 0; g < m->nregions; g++)
+        if (strcmp(fe_region_variable(m->region[g]), "velocity") != 0)
+            total += m->cell[g].sq0 - m->cell[g].sq1;
+    fprintf(f, "\nwhere the discovered terms help (share of the drop in the residual's sum "
+               "of squares, fitted rows):\n");
+    for (size_t g = 0; g < m->nregions; g++) {
+        const fe_residual_cell *b = &m->cell[g];
+        fe_located l;
+        char words[96];
+        if (strcmp(fe_region_variable(m->region[g]), "velocity") == 0 || b->n == 0
+            || !(total > 0))
+            continue;
+        memset(&l, 0, sizeof l);
+        l.region = m->region[g];
+        l.lo = m->region_lo[g];
+        l.hi = m->region_hi[g];
+        if (fe_region_describe(&l, words, sizeof words) != FE_OK)
+            continue;
+        fprintf(f, "  %-12s %-24s %6.0f rows  %5.1f%%   RMS %.4g -> %.4g\n",
+                fe_region_variable(m->region[g]), words, b->n,
+                100.0 * (b->sq0 - b->sq1) / total, sqrt(b->sq0 / b->n), sqrt(b->sq1 / b->n));
+    }
+}
+
 static void fe__print_story(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
@@ -909,14 +845,15 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     if (o->nlocated == 0)
         fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
     for (size_t i = 0; i < o->nlocated; i++) {
-        const fe__located *l = &o->located[i];
-        if (l->is_time && l->pair == l->pair1)
+        const fe_located *l = &o->located[i];
+        char words[96];
+        if (l->region == FE_REGION_TIME && l->pair == l->pair1)
             fprintf(f, "  recording %d, time %.4g to %.4g:", l->pair + 1, l->t0, l->t1);
-        else if (l->is_time)
+        else if (l->region == FE_REGION_TIME)
             fprintf(f, "  recording %d time %.4g to recording %d time %.4g:", l->pair + 1,
                     l->t0, l->pair1 + 1, l->t1);
-        else
-            fprintf(f, "  %s %s (%.0f rows):", l->variable, l->region, l->n);
+        else if (fe_region_describe(l, words, sizeof words) == FE_OK)
+            fprintf(f, "  %s %s (%.0f rows):", fe_region_variable(l->region), words, l->n);
         fprintf(f, " mean residual %+.3g, mean square %.2fx typical (z = %.1f, t = %.1f);"
                    " after: %+.3g, %.2fx\n", l->mean_before, l->ms_ratio_before, l->z, l->t,
                 l->mean_after, l->ms_ratio_after);
@@ -971,22 +908,8 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             fprintf(f, "\n");
         }
     }
-    if (r->steps > 0 && o->nregions > 0) {
-        double total = 0.0;
-        for (size_t g = 0; g < o->nregions; g++)
-            if (strcmp(o->region_var[g], "velocity") != 0)
-                total += o->regions[g].sq0 - o->regions[g].sq1;
-        fprintf(f, "\nwhere the discovered terms help (share of the drop in the residual's sum "
-                   "of squares, fitted rows):\n");
-        for (size_t g = 0; g < o->nregions; g++) {
-            const fe__stat *b = &o->regions[g];
-            if (strcmp(o->region_var[g], "velocity") == 0 || b->n == 0 || !(total > 0))
-                continue;
-            fprintf(f, "  %-12s %-24s %6.0f rows  %5.1f%%   RMS %.4g -> %.4g\n", o->region_var[g],
-                    o->region_name[g], b->n, 100.0 * (b->sq0 - b->sq1) / total,
-                    sqrt(b->sq0 / b->n), sqrt(b->sq1 / b->n));
-        }
-    }
+    if (r->steps > 0 && o->map->nregions > 0)
+        fe__story_regions(f, o->map);
     rel = r->baseline.rms > 0 ? 100.0 * (r->final.rms / r->baseline.rms - 1.0) : 0.0;
     fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f\n",
             r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
@@ -1051,7 +974,7 @@ static void fe__report_pending(const char *dir, int made)
 
 /* Write per-block and per-bin means: what the eye needs to see a concealed
    effect that the cloud of points hides. */
-static int fe__write_means(const char *path, const fe__stat *s, size_t n, int use_index)
+static int fe__write_means(const char *path, const fe_residual_cell *s, size_t n, int use_index)
 {
     FILE *f = fopen(path, "w");
     if (f == NULL)
@@ -1140,505 +1063,429 @@ static const fe_cli_option fe__discover_options[] = {
     {"--alpha", 1},
     {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
 
-int fe_cli_discover(int argc, char **argv)
-{
+/* Everything one run of the command holds, from the arguments to the
+   outcome; released by fe__run_free on every path. */
+typedef struct fe__run {
     fe__discover_args a;
     fe__stream st;
     fe_catalog cat;
-    fe_catalog_scale scale = {0};
+    fe_catalog_scale scale;
+    unsigned roles;
+    int kelvin[FE__ROLES];
+    double lo[3], hi[3];                /* position, velocity, temperature */
+    size_t rows;
+    size_t base[FE_DISCOVER_MAX_GROUPS], nbase;
     fe_discover_acc acc;
-    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
-    fe_discover_options opt = fe_discover_default_options();
-    fe_discover_result *res = NULL;
+    double *storage, *work;
+    size_t nwork;
+    fe__panel *panel;
+    fe_discover_result *res;
+    fe_residual_map *map;
+    fe_lsq *per;
+    double *per_g;
+    FILE *pts;
+    char points[4200];
     fe__outcome out;
-    fe__stat *blocks = NULL, regions[16];
-    const char *region_var[16];
-    char region_name[16][64];
-    size_t nregions = 0;
-    enum { FE__BINS = 40 };
-    fe__stat bins[3][FE__BINS];
-    double *storage = NULL, *work = NULL, phi[FE_DISCOVER_MAX_COLUMNS];
-    double rmin[FE__ROLES], rmax[FE__ROLES];
-    size_t base[FE_DISCOVER_MAX_GROUPS], nbase = 0, rows = 0, nwork, nst;
-    unsigned roles = 0;
-    int kelvin[FE__ROLES] = {0}, rc, new_pair, pair_index;
-    char err[2048], points[4200] = "";
+    char err[2048];
+} fe__run;
+
+static void fe__run_free(fe__run *u)
+{
+    if (u->pts != NULL)
+        fclose(u->pts);
+    for (size_t i = 0; i < u->a.npairs; i++) {
+        fe_cli_table_close(&u->a.pairs[i].real);
+        fe_cli_table_close(&u->a.pairs[i].sim);
+    }
+    free(u->a.pairs);
+    free(u->storage);
+    free(u->work);
+    free(u->panel);
+    free(u->res);
+    free(u->map);
+    free(u->per);
+    free(u->per_g);
+    free(u->out.per_coef);
+    free(u->out.per_se);
+    free(u->out.per_rows);
+    free(u->out.per_held);
+}
+
+#define FE__OOM(u) (snprintf((u)->err, sizeof (u)->err, "out of memory or internal error"), \
+                    FE_CLI_IO)
+
+/* Pass 1: the catalog's scale, the state's ranges, the rows compared. */
+static int fe__run_scan(fe__run *u)
+{
     fe_sample s;
-    FILE *pts = NULL;
-    fe_lsq *per = NULL;
-    double *per_g = NULL;
-    fe__panel *panel = NULL;
-
-    memset(&out, 0, sizeof out);
-    rc = fe_cli_options("discover", fe__discover_options, &argc, &argv);
-    if (rc != FE_CLI_OK)
-        return rc < 0 ? FE_CLI_OK : rc;
-    for (int i = 1; i < argc; i++)
-        if (strcmp(argv[i], "--sphere") == 0)
-            return fe__discover_sphere_main(argc, argv);
-    rc = fe__discover_parse(argc, argv, &a, err, sizeof err);
-    if (rc == -1) {
-        fe__discover_usage(stdout);
-        free(a.pairs);
-        return FE_CLI_OK;
+    int rc, new_pair;
+    for (int v = 0; v < 3; v++) {
+        u->lo[v] = INFINITY;
+        u->hi[v] = -INFINITY;
     }
-    if (rc != FE_CLI_OK) {
-        fprintf(stderr, "foldest discover: %s\n", err);
-        if (rc == FE_CLI_USAGE)
-            fprintf(stderr, "'foldest discover --help' for usage\n");
-        free(a.pairs);
-        return rc;
-    }
-    for (size_t i = 0; i < a.npairs; i++) {
-        unsigned r;
-        rc = fe__pair_open(&a.pairs[i], &a, &r, kelvin, err, sizeof err);
-        if (rc != FE_CLI_OK)
-            goto fail;
-        roles = r;
-    }
-    st.a = &a;
-    st.cur = 0;
-    st.skipped = 0;
-    memset(st.outside, 0, sizeof st.outside);
-
-    /* Pass 1: scale and ranges. */
-    for (int r = 0; r < FE__ROLES; r++) {
-        rmin[r] = INFINITY;
-        rmax[r] = -INFINITY;
-    }
-    while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
-        fe_catalog_scale_add(&scale, &s);
-        for (int r = 0; r < FE__ROLES; r++) {
-            double v = *fe__role(&s, r);
-            rmin[r] = v < rmin[r] ? v : rmin[r];
-            rmax[r] = v > rmax[r] ? v : rmax[r];
+    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+        fe_catalog_scale_add(&u->scale, &s);
+        for (int v = 0; v < 3; v++) {
+            double x = *fe__role(&s, v);    /* position, velocity, temperature */
+            u->lo[v] = x < u->lo[v] ? x : u->lo[v];
+            u->hi[v] = x > u->hi[v] ? x : u->hi[v];
         }
-        rows++;
+        u->rows++;
     }
     if (rc != FE_END)
-        goto fail;
+        return rc;
     /* A file with a header and no rows is malformed input (status 3), not
        a comparison with too few rows (a refusal). */
-    for (size_t i = 0; i < a.npairs; i++) {
-        const fe_cli_table *empty = a.pairs[i].real.rows == 0 ? &a.pairs[i].real
-                                  : a.pairs[i].sim.rows == 0 ? &a.pairs[i].sim : NULL;
+    for (size_t i = 0; i < u->a.npairs; i++) {
+        const fe_cli_table *empty = u->a.pairs[i].real.rows == 0 ? &u->a.pairs[i].real
+                                  : u->a.pairs[i].sim.rows == 0 ? &u->a.pairs[i].sim : NULL;
         if (empty != NULL) {
-            fprintf(stderr, "foldest discover: %s: no data rows\n", empty->name);
-            rc = FE_CLI_INPUT;
-            goto cleanup;
+            snprintf(u->err, sizeof u->err, "%.1000s: no data rows", empty->name);
+            return FE_CLI_INPUT;
         }
     }
-    out.skipped = st.skipped;
-    memcpy(out.outside, st.outside, sizeof out.outside);
-    scale.temperature_kelvin = kelvin[2];
-    scale.ambient_kelvin = kelvin[3];
-    if (fe_catalog_init(&cat, roles, &scale) != FE_OK)
-        goto internal;
-    out.rows = rows;
-    out.heldout = (size_t)floor(a.holdout * (double)rows);
-    out.fit = rows - out.heldout;
-    if (out.fit < 2 * (size_t)a.blocks + 10) {
-        fprintf(stderr, "foldest discover: only %zu rows compared (%zu outside the simulation): "
-                        "too few for %ld blocks\n", rows, st.skipped, a.blocks);
-        rc = FE_CLI_REFUSED;
-        goto cleanup;
+    u->out.skipped = u->st.skipped;
+    memcpy(u->out.outside, u->st.outside, sizeof u->out.outside);
+    u->scale.temperature_kelvin = u->kelvin[2];
+    u->scale.ambient_kelvin = u->kelvin[3];
+    if (fe_catalog_init(&u->cat, u->roles, &u->scale) != FE_OK)
+        return FE__OOM(u);
+    u->out.rows = u->rows;
+    u->out.heldout = (size_t)floor(u->a.holdout * (double)u->rows);
+    u->out.fit = u->rows - u->out.heldout;
+    if (u->out.fit < 2 * (size_t)u->a.blocks + 10) {
+        snprintf(u->err, sizeof u->err, "only %zu rows compared (%zu outside the simulation): "
+                 "too few for %ld blocks", u->rows, u->st.skipped, u->a.blocks);
+        return FE_CLI_REFUSED;
     }
-    /* The base terms. */
-    if (a.base != NULL) {
-        char *list = malloc(strlen(a.base) + 1), *items[FE_DISCOVER_MAX_GROUPS];
-        int n;
-        if (list == NULL)
-            goto internal;
-        strcpy(list, a.base);
-        n = fe_cli_split_list(list, items, FE_DISCOVER_MAX_GROUPS);
-        for (int i = 0; i < n; i++) {
-            long j = fe_catalog_find(&cat, items[i]);
-            if (j < 0) {
-                fprintf(stderr, "foldest discover: --base: no term '%s' (with these roles)\n",
-                        items[i]);
-                free(list);
-                rc = FE_CLI_USAGE;
-                goto cleanup;
-            }
-            base[nbase++] = (size_t)j;
-        }
-        free(list);
-    }
+    return FE_CLI_OK;
+}
 
-    /* Pass 2: accumulate. */
-    nst = fe_discover_acc_doubles(cat.count, (size_t)a.blocks);
-    nwork = fe_discover_workspace_doubles(cat.count, (size_t)a.blocks);
-    storage = malloc(nst * sizeof *storage);
-    work = malloc(nwork * sizeof *work);
-    res = malloc(sizeof *res);
-    blocks = calloc((size_t)a.blocks + 1, sizeof *blocks);
-    if (storage == NULL || work == NULL || res == NULL || blocks == NULL)
-        goto internal;
-    if (fe_discover_acc_init(&acc, cat.count, (size_t)a.blocks, out.fit, 0, storage, nst) != FE_OK
-        || fe_discover_set_lags(&acc, (size_t)a.lags) != FE_OK)
-        goto internal;
-    if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
-        goto fail;
-    /* Rows are folded a panel at a time (fe_discover_add_rows: the lagged
-       products by matrix products), the panel flushed before a break. */
-    panel = malloc(sizeof *panel);
-    if (panel == NULL)
-        goto internal;
-    panel->n = 0;
-    while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
-        size_t k = panel->n;
-        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS)
-            && fe__flush_panel(&acc, panel) != FE_OK)
-            break;                              /* panel->n: the refused row */
+/* The base terms named by --base, as catalog columns. */
+static int fe__run_base(fe__run *u)
+{
+    char *list, *items[FE_DISCOVER_MAX_GROUPS];
+    int n;
+    if (u->a.base == NULL)
+        return FE_CLI_OK;
+    if ((list = malloc(strlen(u->a.base) + 1)) == NULL)
+        return FE__OOM(u);
+    strcpy(list, u->a.base);
+    n = fe_cli_split_list(list, items, FE_DISCOVER_MAX_GROUPS);
+    for (int i = 0; i < n; i++) {
+        long j = fe_catalog_find(&u->cat, items[i]);
+        if (j < 0) {
+            snprintf(u->err, sizeof u->err, "--base: no term '%.200s' (with these roles)",
+                     items[i]);
+            free(list);
+            return FE_CLI_USAGE;
+        }
+        u->base[u->nbase++] = (size_t)j;
+    }
+    free(list);
+    return FE_CLI_OK;
+}
+
+/* Pass 2: every candidate term of every row into the engine's
+   accumulation, a panel at a time (fe_discover_add_rows: the lagged
+   products by matrix products), the panel flushed before a break. */
+static int fe__run_fold(fe__run *u)
+{
+    size_t nst = fe_discover_acc_doubles(u->cat.count, (size_t)u->a.blocks);
+    fe__panel *p;
+    fe_sample s;
+    int rc, new_pair;
+    u->nwork = fe_discover_workspace_doubles(u->cat.count, (size_t)u->a.blocks);
+    u->storage = malloc(nst * sizeof *u->storage);
+    u->work = malloc(u->nwork * sizeof *u->work);
+    u->panel = p = malloc(sizeof *u->panel);
+    if (u->storage == NULL || u->work == NULL || p == NULL)
+        return FE__OOM(u);
+    if (fe_discover_acc_init(&u->acc, u->cat.count, (size_t)u->a.blocks, u->out.fit, 0,
+                             u->storage, nst) != FE_OK
+        || fe_discover_set_lags(&u->acc, (size_t)u->a.lags) != FE_OK)
+        return FE__OOM(u);
+    if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
+    p->n = 0;
+    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+        size_t k = p->n;
+        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS) && fe__flush_panel(&u->acc, p) != FE_OK)
+            break;                              /* p->n: the refused row */
         if (new_pair)
-            fe_discover_break(&acc);
-        k = panel->n;
-        panel->r[k] = s.real - s.sim;
-        panel->line[k] = a.pairs[st.cur].real.line;
-        panel->file[k] = a.pairs[st.cur].real.name;
-        panel->t[k] = s.t;
-        if (fe_catalog_eval(&cat, &s, panel->phi[k]) != FE_OK)
+            fe_discover_break(&u->acc);
+        k = p->n;
+        p->r[k] = s.real - s.sim;
+        p->line[k] = u->a.pairs[u->st.cur].real.line;
+        p->file[k] = u->a.pairs[u->st.cur].real.name;
+        p->t[k] = s.t;
+        if (fe_catalog_eval(&u->cat, &s, p->phi[k]) != FE_OK)
             break;
-        panel->n++;
+        p->n++;
     }
-    if (rc == FE_OK || (rc == FE_END && fe__flush_panel(&acc, panel) != FE_OK)) {
-        size_t k = panel->n;
-        fprintf(stderr, "foldest discover: %s:%zu: a term is not finite at t = %g\n",
-                panel->file[k], panel->line[k], panel->t[k]);
-        rc = FE_CLI_INPUT;
-        goto cleanup;
+    if (rc == FE_OK || (rc == FE_END && fe__flush_panel(&u->acc, p) != FE_OK)) {
+        snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
+                 p->file[p->n], p->line[p->n], p->t[p->n]);
+        return FE_CLI_INPUT;
     }
-    if (rc != FE_END)
-        goto fail;
-    fe_catalog_groups(&cat, groups);
-    opt.alpha = a.alpha;
-    opt.base = base;
-    opt.nbase = nbase;
-    opt.noise = a.noise;
-    rc = fe_discover_select(&acc, groups, cat.count, &opt, res, work, nwork);
+    return rc == FE_END ? FE_CLI_OK : rc;
+}
+
+/* Select the terms (discover.org). */
+static int fe__run_select(fe__run *u)
+{
+    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
+    fe_discover_options opt = fe_discover_default_options();
+    int rc;
+    if ((u->res = malloc(sizeof *u->res)) == NULL)
+        return FE__OOM(u);
+    fe_catalog_groups(&u->cat, groups);
+    opt.alpha = u->a.alpha;
+    opt.base = u->base;
+    opt.nbase = u->nbase;
+    opt.noise = u->a.noise;
+    rc = fe_discover_select(&u->acc, groups, u->cat.count, &opt, u->res, u->work, u->nwork);
     if (rc != FE_OK) {
-        fprintf(stderr, "foldest discover: %s%s\n", fe_strerror(rc),
-                rc == FE_ESINGULAR ? ": the base terms are collinear on these data"
-                : rc == FE_ETOOFEW ? ": a time block has no rows" : "");
-        rc = FE_CLI_REFUSED;
-        goto cleanup;
+        snprintf(u->err, sizeof u->err, "%s%s", fe_strerror(rc),
+                 rc == FE_ESINGULAR ? ": the base terms are collinear on these data"
+                 : rc == FE_ETOOFEW ? ": a time block has no rows" : "");
+        return FE_CLI_REFUSED;
     }
-    memcpy(out.baseline_coef, res->path[0].coef, nbase * sizeof *out.baseline_coef);
+    memcpy(u->out.baseline_coef, u->res->path[0].coef,
+           u->nbase * sizeof *u->out.baseline_coef);
+    return FE_CLI_OK;
+}
 
-    /* Regions of the state to test. */
-    if (roles & FE_ROLE_VELOCITY) {
-        double vmax = scale.vmax;
-        region_var[nregions] = "velocity";
-        strcpy(region_name[nregions++], "v < 0");
-        region_var[nregions] = "velocity";
-        strcpy(region_name[nregions++], "v > 0");
-        region_var[nregions] = "velocity";
-        strcpy(region_name[nregions++], "v = 0");
-        for (int b = 0; b < 4; b++) {
-            region_var[nregions] = "speed";
-            snprintf(region_name[nregions++], 64, "|v| %.3g to %.3g", vmax * b / 4.0,
-                     vmax * (b + 1) / 4.0);
-        }
+/* The report folder, and the file of residual points in it. */
+static int fe__run_open_report(fe__run *u)
+{
+    int made;
+    if (u->a.report == NULL)
+        return FE_CLI_OK;
+    made = mkdir(u->a.report, 0777) == 0;
+    if (!made && errno != EEXIST) {
+        snprintf(u->err, sizeof u->err, "%.1000s: cannot create: %s", u->a.report,
+                 strerror(errno));
+        return FE_CLI_IO;
     }
-    if (roles & FE_ROLE_POSITION) {
-        region_var[nregions] = "position";
-        strcpy(region_name[nregions++], "x < 0");
-        region_var[nregions] = "position";
-        strcpy(region_name[nregions++], "x > 0");
+    fe__report_pending(u->a.report, made);
+    snprintf(u->points, sizeof u->points, "%s/residuals.dat", u->a.report);
+    if ((u->pts = fopen(u->points, "w")) == NULL) {
+        snprintf(u->err, sizeof u->err, "%.1000s: cannot write: %s", u->points,
+                 strerror(errno));
+        return FE_CLI_IO;
     }
-    if (roles & FE_ROLE_TEMPERATURE)
-        for (int b = 0; b < 4; b++) {
-            double lo = rmin[2] + (rmax[2] - rmin[2]) * b / 4.0;
-            double hi = rmin[2] + (rmax[2] - rmin[2]) * (b + 1) / 4.0;
-            region_var[nregions] = "temperature";
-            snprintf(region_name[nregions++], 64, "%.4g to %.4g", lo, hi);
-        }
-    memset(regions, 0, sizeof regions);
-    memset(bins, 0, sizeof bins);
+    return FE_CLI_OK;
+}
 
-    /* Pass 3: residuals before and after, by block and by region. */
-    if (a.report != NULL) {
-        int made = mkdir(a.report, 0777) == 0;
-        if (!made && errno != EEXIST) {
-            snprintf(err, sizeof err, "%.1000s: cannot create: %s", a.report, strerror(errno));
-            rc = FE_CLI_IO;
-            goto fail;
-        }
-        fe__report_pending(a.report, made);
-        snprintf(points, sizeof points, "%s/residuals.dat", a.report);
-        pts = fopen(points, "w");
-        if (pts == NULL) {
-            snprintf(err, sizeof err, "%.1000s: cannot write: %s", points, strerror(errno));
-            rc = FE_CLI_IO;
-            goto fail;
-        }
-    }
-    if ((rc = fe__stream_rewind(&st, err, sizeof err)) != FE_CLI_OK)
-        goto fail;
-    out.npairs = a.npairs;
-    per = calloc(a.npairs, sizeof *per);
-    per_g = calloc(a.npairs * fe_lsq_storage(res->ncols), sizeof *per_g);
-    out.per_coef = calloc(a.npairs * (res->ncols + 1), sizeof *out.per_coef);
-    out.per_se = calloc(a.npairs * (res->ncols + 1), sizeof *out.per_se);
-    out.per_rows = calloc(a.npairs, sizeof *out.per_rows);
-    out.per_held = calloc(a.npairs, sizeof *out.per_held);
-    if (per == NULL || per_g == NULL || out.per_coef == NULL || out.per_se == NULL
-        || out.per_rows == NULL || out.per_held == NULL)
-        goto internal;
-    for (size_t q = 0; q < a.npairs && res->ncols > 0; q++)
-        fe_lsq_init(&per[q], res->ncols, per_g + q * fe_lsq_storage(res->ncols));
-    {
-        size_t i = 0, stride = rows / FE__PLOT_POINTS + 1;
-        pair_index = 0;
-        while ((rc = fe__stream_next(&st, &s, &new_pair, err, sizeof err)) == FE_OK) {
-            double before = s.real - s.sim, after = before;
-            size_t k = i < out.fit ? (size_t)((double)i * (double)a.blocks / (double)out.fit)
-                                   : (size_t)a.blocks;
-            pair_index += new_pair;
-            if (i >= out.fit)
-                out.per_held[pair_index] += 1.0;
-            fe_catalog_eval(&cat, &s, phi);
-            for (size_t j = 0; j < nbase; j++)
-                before -= out.baseline_coef[j] * phi[base[j]];
-            for (size_t j = 0; j < res->ncols; j++)
-                after -= res->coef[j] * phi[res->cols[j]];
-            fe__stat_add(&blocks[k], s.t, pair_index, before, after);
-            if (res->ncols > 0) {
-                double row[FE_DISCOVER_MAX_COLUMNS];
-                for (size_t j = 0; j < res->ncols; j++)
-                    row[j] = phi[res->cols[j]];
-                fe_lsq_add(&per[pair_index], row, s.real - s.sim, 1.0);
-            }
-            for (size_t g = 0; g < nregions && i < out.fit; g++) {
-                int in = 0;
-                if (strcmp(region_var[g], "velocity") == 0)
-                    in = region_name[g][2] == '<' ? s.velocity < 0
-                         : region_name[g][2] == '>' ? s.velocity > 0 : s.velocity == 0;
-                else if (strcmp(region_var[g], "speed") == 0) {
-                    int b = (int)(fabs(s.velocity) / (scale.vmax + 1e-300) * 4.0);
-                    size_t first = (size_t)(strcmp(region_var[0], "velocity") == 0 ? 3 : 0);
-                    in = s.velocity != 0 && (b > 3 ? 3 : b) == (int)(g - first);
-                }
-                else if (strcmp(region_var[g], "position") == 0)
-                    in = region_name[g][2] == '<' ? s.position < 0 : s.position > 0;
-                else {
-                    int b = (int)((s.temperature - rmin[2]) / (rmax[2] - rmin[2] + 1e-300) * 4.0);
-                    in = (b > 3 ? 3 : b) == (int)(g - (nregions - 4));
-                }
-                if (in)
-                    fe__stat_add(&regions[g], s.t, pair_index, before, after);
-            }
-            for (int v = 0; v < 3; v++) {       /* position, velocity, temperature */
-                int r = v == 2 ? 2 : v;
-                double x = *fe__role(&s, r), w = rmax[r] - rmin[r];
-                int b = w > 0 ? (int)((x - rmin[r]) / w * FE__BINS) : 0;
-                b = b < 0 ? 0 : b >= FE__BINS ? FE__BINS - 1 : b;
-                if (roles & (1u << r))
-                    fe__stat_add(&bins[v][b], x, pair_index, before, after);
-            }
-            if (pts != NULL && i % stride == 0)
-                fprintf(pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
-                        s.position, s.velocity, s.temperature);
-            i++;
-        }
-        if (rc != FE_END)
-            goto fail;
-    }
+/* Room for the final model refitted on each recording alone. */
+static int fe__run_per_alloc(fe__run *u)
+{
+    size_t m = u->res->ncols, np = u->a.npairs;
+    u->out.npairs = np;
+    u->per = calloc(np, sizeof *u->per);
+    u->per_g = calloc(np * fe_lsq_storage(m), sizeof *u->per_g);
+    u->out.per_coef = calloc(np * (m + 1), sizeof *u->out.per_coef);
+    u->out.per_se = calloc(np * (m + 1), sizeof *u->out.per_se);
+    u->out.per_rows = calloc(np, sizeof *u->out.per_rows);
+    u->out.per_held = calloc(np, sizeof *u->out.per_held);
+    if (u->per == NULL || u->per_g == NULL || u->out.per_coef == NULL
+        || u->out.per_se == NULL || u->out.per_rows == NULL || u->out.per_held == NULL)
+        return FE__OOM(u);
+    for (size_t q = 0; q < np && m > 0; q++)
+        fe_lsq_init(&u->per[q], m, u->per_g + q * fe_lsq_storage(m));
+    return FE_CLI_OK;
+}
 
-    /* Refit the final model on each recording alone. */
-    for (size_t q = 0; q < a.npairs && res->ncols > 0; q++) {
-        double *cov = malloc(res->ncols * res->ncols * sizeof *cov);
-        double *w = malloc(fe_lsq_solve_work(res->ncols) * sizeof *w), rss;
-        out.per_rows[q] = per[q].n;
+/* Pass 3: each row's residual before the discovered terms (simulation and
+   base) and after them, into the residual map (locate.org), the
+   per-recording fits, and every few rows into the plot's points. */
+static int fe__run_map(fe__run *u)
+{
+    const fe_discover_result *r = u->res;
+    size_t i = 0, stride = u->rows / FE__PLOT_POINTS + 1;
+    int rc, new_pair, pair = 0;
+    fe_sample s;
+    double phi[FE_DISCOVER_MAX_COLUMNS];
+    if ((u->map = malloc(sizeof *u->map)) == NULL)
+        return FE__OOM(u);
+    if (fe_residual_map_init(u->map, (size_t)u->a.blocks, u->out.fit, 0, u->roles, u->lo,
+                             u->hi) != FE_OK)
+        return FE__OOM(u);
+    if ((rc = fe__run_open_report(u)) != FE_CLI_OK || (rc = fe__run_per_alloc(u)) != FE_CLI_OK
+        || (rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
+    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+        double before = s.real - s.sim, after;
+        for (; new_pair && pair < (int)u->st.cur; pair++)     /* a recording ends */
+            if (i > 0)
+                fe_residual_map_break(u->map);
+        pair = (int)u->st.cur;
+        if (i >= u->out.fit)
+            u->out.per_held[pair] += 1.0;
+        fe_catalog_eval(&u->cat, &s, phi);
+        for (size_t j = 0; j < u->nbase; j++)
+            before -= u->out.baseline_coef[j] * phi[u->base[j]];
+        after = s.real - s.sim;
+        for (size_t j = 0; j < r->ncols; j++)
+            after -= r->coef[j] * phi[r->cols[j]];
+        if (fe_residual_map_add(u->map, &s, before, after) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "a residual is not finite at t = %g", s.t);
+            return FE_CLI_INPUT;
+        }
+        if (r->ncols > 0) {
+            double row[FE_DISCOVER_MAX_COLUMNS];
+            for (size_t j = 0; j < r->ncols; j++)
+                row[j] = phi[r->cols[j]];
+            fe_lsq_add(&u->per[pair], row, s.real - s.sim, 1.0);
+        }
+        if (u->pts != NULL && i % stride == 0)
+            fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
+                    s.position, s.velocity, s.temperature);
+        i++;
+    }
+    return rc == FE_END ? FE_CLI_OK : rc;
+}
+
+/* The final model refitted on each recording alone (classical errors). */
+static void fe__run_per_recording(fe__run *u)
+{
+    size_t m = u->res->ncols;
+    for (size_t q = 0; q < u->a.npairs && m > 0; q++) {
+        double *cov = malloc(m * m * sizeof *cov);
+        double *w = malloc(fe_lsq_solve_work(m) * sizeof *w), rss;
+        u->out.per_rows[q] = u->per[q].n;
         if (cov != NULL && w != NULL
-            && fe_lsq_solve(&per[q], NULL, res->ncols, out.per_coef + q * res->ncols, &rss,
-                            cov, w) == FE_OK)
-            for (size_t j = 0; j < res->ncols; j++)
-                out.per_se[q * res->ncols + j] = sqrt(cov[j * res->ncols + j]);
+            && fe_lsq_solve(&u->per[q], NULL, m, u->out.per_coef + q * m, &rss, cov, w) == FE_OK)
+            for (size_t j = 0; j < m; j++)
+                u->out.per_se[q * m + j] = sqrt(cov[j * m + j]);
         else
-            for (size_t j = 0; j < res->ncols; j++)
-                out.per_coef[q * res->ncols + j] = NAN;
+            for (size_t j = 0; j < m; j++)
+                u->out.per_coef[q * m + j] = NAN;
         free(cov);
         free(w);
     }
+}
 
-    /* Locate: time blocks, then regions. */
-    {
-        double ms[FE_DISCOVER_MAX_BLOCKS] = {0}, med, all_n = 0, all_sq = 0;
-        double infl = fe__row_worth(&res->path[0].noise, res->baseline.n);
-        size_t K = (size_t)a.blocks;
-        double thr = fe_student_t_quantile(a.alpha / (double)(2 * (K + nregions)), 1e6);
-        for (size_t k = 0; k < K; k++) {
-            ms[k] = blocks[k].n > 0 ? blocks[k].sq0 / blocks[k].n : 0.0;
-            all_n += blocks[k].n;
-            all_sq += blocks[k].sq0;
-        }
-        {
-            double sorted[FE_DISCOVER_MAX_BLOCKS];
-            memcpy(sorted, ms, K * sizeof *sorted);
-            qsort(sorted, K, sizeof *sorted, fe__cmp_double);
-            med = K % 2 ? sorted[K / 2] : 0.5 * (sorted[K / 2 - 1] + sorted[K / 2]);
-        }
-        for (size_t k = 0; k < K && med > 0; k++) {
-            const fe__stat *b = &blocks[k];
-            double neff = b->n * infl, z, t;
-            if (b->n < 2)
-                continue;
-            z = (ms[k] / med - 1.0) / sqrt(2.0 / neff);
-            t = (b->sum0 / b->n) / sqrt(med / neff);
-            if (z > thr || fabs(t) > thr) {
-                fe__located *l = out.nlocated > 0 ? &out.located[out.nlocated - 1] : NULL;
-                if (l != NULL && l->is_time && l->pair1 == b->pair && l->t1 <= b->t0
-                    && k > 0 && blocks[k - 1].t1 == l->t1) {
-                    /* extend the window */
-                    double n = l->n + b->n;
-                    l->mean_before = (l->mean_before * l->n + b->sum0) / n;
-                    l->mean_after = (l->mean_after * l->n + b->sum1) / n;
-                    l->ms_ratio_before = (l->ms_ratio_before * l->n * med + b->sq0) / (n * med);
-                    l->ms_ratio_after = (l->ms_ratio_after * l->n * med + b->sq1) / (n * med);
-                    l->n = n;
-                    l->t1 = b->t1;
-                    l->pair1 = b->pair1;
-                    l->z = z > l->z ? z : l->z;
-                    l->t = fabs(t) > fabs(l->t) ? t : l->t;
-                } else if (out.nlocated < 128) {
-                    l = &out.located[out.nlocated++];
-                    memset(l, 0, sizeof *l);
-                    l->is_time = 1;
-                    l->t0 = b->t0;
-                    l->t1 = b->t1;
-                    l->pair = b->pair;
-                    l->pair1 = b->pair1;
-                    l->n = b->n;
-                    l->z = z;
-                    l->t = t;
-                    l->mean_before = b->sum0 / b->n;
-                    l->mean_after = b->sum1 / b->n;
-                    l->ms_ratio_before = ms[k] / med;
-                    l->ms_ratio_after = b->sq1 / b->n / med;
-                }
-            }
-        }
-        for (size_t g = 0; g < nregions && all_n > 0; g++) {
-            const fe__stat *b = &regions[g];
-            double msall = all_sq / all_n, mean_all = 0, neff, t, z;
-            for (size_t k = 0; k < K; k++)
-                mean_all += blocks[k].sum0 / all_n;
-            if (b->n < 2 || b->n > all_n - 2)
-                continue;
-            neff = b->n * infl;
-            t = (b->sum0 / b->n - mean_all) / sqrt(msall / neff);
-            z = (b->sq0 / b->n / msall - 1.0) / sqrt(2.0 / neff);
-            if ((fabs(t) > thr || z > thr) && out.nlocated < 128) {
-                fe__located *l = &out.located[out.nlocated++];
-                memset(l, 0, sizeof *l);
-                l->variable = region_var[g];
-                snprintf(l->region, sizeof l->region, "%s", region_name[g]);
-                l->n = b->n;
-                l->t = t;
-                l->z = z;
-                l->mean_before = b->sum0 / b->n;
-                l->mean_after = b->sum1 / b->n;
-                l->ms_ratio_before = b->sq0 / b->n / msall;
-                l->ms_ratio_after = b->sq1 / b->n / msall;
-            }
-        }
+/* Locate under the baseline's noise model, and decide the verdict
+   (locate.org). */
+static void fe__run_locate(fe__run *u)
+{
+    const fe_discover_result *r = u->res;
+    fe_verdict v;
+    fe_residual_map_locate(u->map, fe_discover_row_worth(&r->path[0].noise, r->baseline.n),
+                           u->a.alpha, u->out.located, FE__MAX_LOCATED, &u->out.nlocated);
+    if (u->out.nlocated > FE__MAX_LOCATED)
+        u->out.nlocated = FE__MAX_LOCATED;
+    v = fe_discover_verdict(r, u->map, u->out.nlocated, u->a.alpha);
+    u->out.verdict = fe_verdict_text(v);
+    u->out.why = fe_verdict_why(v);
+    u->out.c = &u->cat;
+    u->out.r = r;
+    u->out.map = u->map;
+    u->out.blocks = (size_t)u->a.blocks;
+    u->out.alpha = u->a.alpha;
+    u->out.base = u->base;
+    u->out.nbase = u->nbase;
+}
+
+/* The report: the plot data and report.md (with plots when gnuplot is
+   there).  The state variable plotted is the first located region's, else
+   velocity, temperature or position, whichever the rows carry. */
+static int fe__run_report(fe__run *u)
+{
+    const char *var = NULL;
+    int col = 0, rc = FE_CLI_OK;
+    char bp[4200];
+    fclose(u->pts);
+    u->pts = NULL;
+    for (size_t i = 0; i < u->out.nlocated && var == NULL; i++)
+        if (u->out.located[i].region != FE_REGION_TIME)
+            var = fe_region_variable(u->out.located[i].region);
+    if (var != NULL && strcmp(var, "speed") == 0)
+        var = "velocity";
+    if (var == NULL)
+        var = u->roles & FE_ROLE_VELOCITY ? "velocity"
+              : u->roles & FE_ROLE_TEMPERATURE ? "temperature"
+              : u->roles & FE_ROLE_POSITION ? "position" : NULL;
+    if (var != NULL)
+        col = strcmp(var, "position") == 0 ? 4 : strcmp(var, "velocity") == 0 ? 5 : 6;
+    snprintf(bp, sizeof bp, "%s/blocks.dat", u->a.report);
+    if (fe__write_means(bp, u->map->block, (size_t)u->a.blocks + 1, 1) != 0)
+        rc = FE_CLI_IO;
+    snprintf(bp, sizeof bp, "%s/bins.dat", u->a.report);
+    if (var != NULL && fe__write_means(bp, u->map->bin[col - 4], FE_RESIDUAL_BINS, 0) != 0)
+        rc = FE_CLI_IO;
+    if (rc == FE_CLI_IO) {
+        snprintf(u->err, sizeof u->err, "%.1000s: cannot write the plot data", u->a.report);
+        return rc;
     }
-    out.c = &cat;
-    out.r = res;
-    out.regions = regions;
-    out.region_var = region_var;
-    out.region_name = (const char (*)[64])region_name;
-    out.nregions = nregions;
-    out.blocks = (size_t)a.blocks;
-    out.alpha = a.alpha;
-    out.base = base;
-    out.nbase = nbase;
-    {
-        double worst = fe__largest_after(blocks, (size_t)a.blocks, regions, nregions,
-                                         fe__row_worth(&res->noise, res->final.n));
-        double thr = fe_student_t_quantile(a.alpha / (double)(2 * ((size_t)a.blocks + nregions)), 1e6);
-        out.why = NULL;
-        if (res->steps == 0)
-            out.verdict = out.nlocated > 0 ? "mismatch not explained by the catalog"
-                                           : "no significant mismatch";
-        else if (res->noise.kind == FE_DISCOVER_NOISE_AR && res->noise.portmanteau_p < 0.001) {
-            out.verdict = "mismatch not explained by the catalog";
-            out.why = "terms were found, but the residual left is not white noise: "
-                      "something else is missing";
-        } else if (worst > thr) {
-            out.verdict = "mismatch not explained by the catalog";
-            out.why = "terms were found, but a time window or state region stays out of line "
-                      "after them";
-        } else
-            out.verdict = "mismatch explained";
-    }
-    if (a.json)
-        fe__print_json(stdout, &out);
-    else
-        fe__print_story(stdout, &out);
-    if (pts != NULL) {
-        const char *var = NULL;
-        int col = 0;
-        fclose(pts);
-        pts = NULL;
-        for (size_t i = 0; i < out.nlocated; i++)
-            if (!out.located[i].is_time) {
-                var = out.located[i].variable;
-                break;
-            }
-        if (var == NULL)
-            var = roles & FE_ROLE_VELOCITY ? "velocity"
-                  : roles & FE_ROLE_TEMPERATURE ? "temperature"
-                  : roles & FE_ROLE_POSITION ? "position" : NULL;
-        if (var != NULL)
-            col = strcmp(var, "position") == 0 ? 4 : strcmp(var, "velocity") == 0 ? 5 : 6;
-        {
-            char bp[4200];
-            snprintf(bp, sizeof bp, "%s/blocks.dat", a.report);
-            if (fe__write_means(bp, blocks, (size_t)a.blocks + 1, 1) != 0)
-                rc = FE_CLI_IO;
-            snprintf(bp, sizeof bp, "%s/bins.dat", a.report);
-            if (var != NULL && fe__write_means(bp, bins[col - 4], FE__BINS, 0) != 0)
-                rc = FE_CLI_IO;
-            if (rc == FE_CLI_IO) {
-                snprintf(err, sizeof err, "%.1000s: cannot write the plot data", a.report);
-                goto fail;
-            }
-        }
-        rc = fe__write_report(a.report, &out, points, var, col, err, sizeof err);
+    rc = fe__write_report(u->a.report, &u->out, u->points, var, col, u->err, sizeof u->err);
+    if (rc != FE_CLI_OK)
+        return rc;
+    fe_cli_pending_clear();
+    if (!u->a.json)
+        printf("report: %s/report.md\n", u->a.report);
+    return FE_CLI_OK;
+}
+
+/* Open every pair and find its columns. */
+static int fe__run_open(fe__run *u)
+{
+    for (size_t i = 0; i < u->a.npairs; i++) {
+        int rc = fe__pair_open(&u->a.pairs[i], &u->a, &u->roles, u->kelvin, u->err,
+                               sizeof u->err);
         if (rc != FE_CLI_OK)
-            goto fail;
-        fe_cli_pending_clear();
-        if (!a.json)
-            printf("report: %s/report.md\n", a.report);
+            return rc;
     }
-    rc = FE_CLI_OK;
-    goto cleanup;
-internal:
-    snprintf(err, sizeof err, "out of memory or internal error");
-    rc = FE_CLI_IO;
-fail:
-    fprintf(stderr, "foldest discover: %s\n", err);
-cleanup:
-    if (pts != NULL)
-        fclose(pts);
-    for (size_t i = 0; i < a.npairs; i++) {
-        fe_cli_table_close(&a.pairs[i].real);
-        fe_cli_table_close(&a.pairs[i].sim);
+    u->st.a = &u->a;
+    return FE_CLI_OK;
+}
+
+int fe_cli_discover(int argc, char **argv)
+{
+    fe__run *u = calloc(1, sizeof *u);
+    int rc;
+    if (u == NULL) {
+        fprintf(stderr, "foldest discover: out of memory\n");
+        return FE_CLI_IO;
     }
-    free(a.pairs);
-    free(storage);
-    free(work);
-    free(res);
-    free(blocks);
-    free(per);
-    free(per_g);
-    free(out.per_coef);
-    free(out.per_se);
-    free(out.per_rows);
-    free(out.per_held);
-    free(panel);
+    rc = fe_cli_options("discover", fe__discover_options, &argc, &argv);
+    if (rc != FE_CLI_OK) {
+        free(u);
+        return rc < 0 ? FE_CLI_OK : rc;
+    }
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], "--sphere") == 0) {
+            free(u);
+            return fe__discover_sphere_main(argc, argv);
+        }
+    rc = fe__discover_parse(argc, argv, &u->a, u->err, sizeof u->err);
+    if (rc == -1) {
+        fe__discover_usage(stdout);
+        rc = FE_CLI_OK;
+    } else if (rc == FE_CLI_OK) {
+        if ((rc = fe__run_open(u)) == FE_CLI_OK && (rc = fe__run_scan(u)) == FE_CLI_OK
+            && (rc = fe__run_base(u)) == FE_CLI_OK && (rc = fe__run_fold(u)) == FE_CLI_OK
+            && (rc = fe__run_select(u)) == FE_CLI_OK && (rc = fe__run_map(u)) == FE_CLI_OK) {
+            fe__run_per_recording(u);
+            fe__run_locate(u);
+            if (u->a.json)
+                fe__print_json(stdout, &u->out);
+            else
+                fe__print_story(stdout, &u->out);
+            if (u->pts != NULL)
+                rc = fe__run_report(u);
+        }
+        if (rc != FE_CLI_OK)
+            fprintf(stderr, "foldest discover: %s\n", u->err);
+    } else {
+        fprintf(stderr, "foldest discover: %s\n", u->err);
+        if (rc == FE_CLI_USAGE)
+            fprintf(stderr, "'foldest discover --help' for usage\n");
+    }
+    fe__run_free(u);
+    free(u);
     return rc;
 }
 /* Run discovery on recordings ends here */
