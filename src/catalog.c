@@ -205,3 +205,68 @@ int fe_catalog_explain(const char *name, double coef, double se, char *buf,
     return FE_OK;
 }
 /* Read a coefficient in words ends here */
+/* [[file:../literate/catalog.org::The three-axis terms][The three-axis terms]] */
+int fe_catalog_axes_init(fe_catalog_axes *c, const double centre[3], int has_time, double t1,
+                         int has_temperature, double temperature1)
+{
+    static const fe_discover_group all[FE_CATALOG_AXES_GROUPS] = {
+        {"bias", 0, 1}, {"hard_iron", 1, 3}, {"axis_gain", 4, 2},
+        {"cross_axis", 6, 3}, {"thermal_offset", 9, 3}, {"drift", 12, 1}};
+    static const char *const words[FE_CATALOG_AXES_GROUPS] = {
+        "a different radius", "an offset of the centre", "unequal per-axis scale",
+        "soft iron or non-orthogonal axes", "an offset that moves with temperature",
+        "a field or a gain drifting with time"};
+    if (c == NULL || centre == NULL)
+        return FE_EINVAL;
+    if (!isfinite(centre[0]) || !isfinite(centre[1]) || !isfinite(centre[2])
+        || (has_time && !isfinite(t1)) || (has_temperature && !isfinite(temperature1)))
+        return FE_ENONFINITE;
+    memset(c, 0, sizeof *c);
+    memcpy(c->centre, centre, sizeof c->centre);
+    c->t1 = has_time ? t1 : 0.0;
+    c->temperature1 = has_temperature ? temperature1 : 0.0;
+    for (size_t g = 0; g < FE_CATALOG_AXES_GROUPS; g++) {
+        if ((g == 4 && !has_temperature) || (g == 5 && !has_time))
+            continue;
+        c->groups[c->ngroups] = all[g];
+        c->description[c->ngroups++] = words[g];
+    }
+    return FE_OK;
+}
+
+int fe_catalog_axes_eval(const fe_catalog_axes *c, const double x[3], double t, double temp,
+                         double *phi, double *radius)
+{
+    double d[3], len, u[3], dT;
+    if (c == NULL || x == NULL || phi == NULL || radius == NULL)
+        return FE_EINVAL;
+    if (!isfinite(x[0]) || !isfinite(x[1]) || !isfinite(x[2]) || !isfinite(t)
+        || !isfinite(temp))
+        return FE_ENONFINITE;
+    for (int i = 0; i < 3; i++)
+        d[i] = x[i] - c->centre[i];
+    len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(len > 0.0))
+        return FE_ESINGULAR;
+    if (!isfinite(len))
+        return FE_ENONFINITE;
+    for (int i = 0; i < 3; i++)
+        u[i] = d[i] / len;
+    dT = temp - c->temperature1;
+    *radius = len;
+    phi[0] = 1.0;
+    phi[1] = u[0];
+    phi[2] = u[1];
+    phi[3] = u[2];
+    phi[4] = u[0] * u[0];
+    phi[5] = u[1] * u[1];
+    phi[6] = u[0] * u[1];
+    phi[7] = u[0] * u[2];
+    phi[8] = u[1] * u[2];
+    phi[9] = dT * u[0];
+    phi[10] = dT * u[1];
+    phi[11] = dT * u[2];
+    phi[12] = t - c->t1;
+    return FE_OK;
+}
+/* The three-axis terms ends here */

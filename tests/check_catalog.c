@@ -127,6 +127,92 @@ START_TEST(every_coefficient_in_words)
 }
 END_TEST
 
+
+START_TEST(three_axis_terms_are_their_formulas)
+{
+    /* A sample at distance 5 from the centre in direction (0.6, 0, 0.8),
+       temperature 3 above the first, time 7 after the first. */
+    const double b[3] = {10, -20, 30}, x[3] = {13, -20, 34};
+    const double want[FE_CATALOG_AXES_COLUMNS] = {1, 0.6, 0, 0.8, 0.36, 0, 0, 0.48, 0,
+                                                  1.8, 0, 2.4, 7};
+    double phi[FE_CATALOG_AXES_COLUMNS], r;
+    fe_catalog_axes c;
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, 100.0, 1, 20.0), FE_OK);
+    ck_assert_int_eq(fe_catalog_axes_eval(&c, x, 107.0, 23.0, phi, &r), FE_OK);
+    ck_assert_double_eq_tol(r, 5.0, 1e-14);
+    for (int j = 0; j < FE_CATALOG_AXES_COLUMNS; j++)
+        ck_assert_double_eq_tol(phi[j], want[j], 1e-14);
+    /* The groups cover the columns once each, in order. */
+    ck_assert_uint_eq(c.ngroups, 6);
+    {
+        size_t next = 0;
+        for (size_t g = 0; g < c.ngroups; g++) {
+            ck_assert_uint_eq(c.groups[g].first, next);
+            next += c.groups[g].count;
+        }
+        ck_assert_uint_eq(next, FE_CATALOG_AXES_COLUMNS);
+    }
+    /* Without a temperature the drift is the fifth group, and its words
+       are a drift's, not a temperature's. */
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, 100.0, 0, NAN), FE_OK);
+    ck_assert_uint_eq(c.ngroups, 5);
+    ck_assert_str_eq(c.groups[4].name, "drift");
+    ck_assert_uint_eq(c.groups[4].first, 12);
+    ck_assert_str_eq(c.description[4], "a field or a gain drifting with time");
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, NAN, 0, NAN), FE_OK);
+    ck_assert_uint_eq(c.ngroups, 4);
+    ck_assert_str_eq(c.groups[3].name, "cross_axis");
+    /* Refusals. */
+    ck_assert_int_eq(fe_catalog_axes_eval(&c, b, 0, 0, phi, &r), FE_ESINGULAR);
+    {
+        double far[3] = {1e200, 1e200, 0}, nan3[3] = {0, NAN, 0}, bad[3] = {0, 0, INFINITY};
+        ck_assert_int_eq(fe_catalog_axes_eval(&c, far, 0, 0, phi, &r), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_eval(&c, nan3, 0, 0, phi, &r), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_eval(&c, x, NAN, 0, phi, &r), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_init(&c, bad, 0, 0, 0, 0), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, NAN, 0, 0), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, 0, 1, INFINITY), FE_ENONFINITE);
+    }
+    ck_assert_int_eq(fe_catalog_axes_init(NULL, b, 0, 0, 0, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_eval(&c, x, 0, 0, NULL, &r), FE_EINVAL);
+}
+END_TEST
+
+START_TEST(three_axis_gain_is_read_from_its_coefficients)
+{
+    /* y = (I + E)(x - b) on a sphere of radius R, E symmetric with diagonal
+       (0.02, -0.01, 0) and 0.015 between x and y: |y| = R (1 + u'Eu) + O(E^2),
+       and u'Eu = 0.02 u_x^2 - 0.01 u_y^2 + 0.03 u_x u_y exactly in the
+       columns bias, axis_gain and the first of cross_axis: least squares of
+       the radial residual on them reads E back, to second order. */
+    const double b[3] = {1, 2, 3}, R = 50.0;
+    double g[64], coef[4], cov[16], work[256], rss;
+    fe_lsq l;
+    fe_catalog_axes cat;
+    ck_assert_uint_le(fe_lsq_storage(4), 64);
+    ck_assert_uint_le(fe_lsq_solve_work(4), 256);
+    ck_assert_int_eq(fe_catalog_axes_init(&cat, b, 0, 0, 0, 0), FE_OK);
+    fe_lsq_init(&l, 4, g);
+    for (int i = 0; i < 2000; i++) {
+        double z = 1.0 - 2.0 * (i + 0.5) / 2000, a = 2.399963 * i, s = sqrt(1 - z * z);
+        double u[3] = {s * cos(a), s * sin(a), z}, y[3], phi[FE_CATALOG_AXES_COLUMNS], r;
+        y[0] = b[0] + R * (1.02 * u[0] + 0.015 * u[1]);
+        y[1] = b[1] + R * (0.015 * u[0] + 0.99 * u[1]);
+        y[2] = b[2] + R * u[2];
+        ck_assert_int_eq(fe_catalog_axes_eval(&cat, y, 0, 0, phi, &r), FE_OK);
+        {
+            double row[4] = {phi[0], phi[4], phi[5], phi[6]};
+            ck_assert_int_eq(fe_lsq_add(&l, row, r - R, 1.0), FE_OK);
+        }
+    }
+    ck_assert_int_eq(fe_lsq_solve(&l, NULL, 4, coef, &rss, cov, work), FE_OK);
+    ck_assert_double_eq_tol(coef[0] / R, 0.0, 1e-3);
+    ck_assert_double_eq_tol(coef[1] / R, 0.02, 1e-3);
+    ck_assert_double_eq_tol(coef[2] / R, -0.01, 1e-3);
+    ck_assert_double_eq_tol(coef[3] / R, 0.03, 1e-3);
+}
+END_TEST
+
 Suite *fe_catalog_suite(void)
 {
     Suite *s = suite_create("catalog");
@@ -134,6 +220,8 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, every_builtin_term_is_its_formula);
     tcase_add_test(t, user_terms_and_a_full_catalog);
     tcase_add_test(t, every_coefficient_in_words);
+    tcase_add_test(t, three_axis_terms_are_their_formulas);
+    tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);
     suite_add_tcase(s, t);
     return s;
 }

@@ -90,6 +90,40 @@ void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups);
 int fe_catalog_explain(const char *name, double coef, double stderr_,
                        char *buf, size_t len);
 
+/* The three-axis catalog: the radial residual r = |x - b| - R of a vector
+   sensor against a sphere (centre b, radius R), in terms of the unit
+   direction u = (x - b) / |x - b|. */
+enum {
+    FE_CATALOG_AXES_COLUMNS = 13,   /* 1; u; u_x^2, u_y^2; u_x u_y, u_x u_z,
+                                       u_y u_z; (T - T1) u; t - t1 */
+    FE_CATALOG_AXES_GROUPS = 6      /* bias, hard_iron, axis_gain,
+                                       cross_axis, thermal_offset, drift */
+};
+
+typedef struct fe_catalog_axes {
+    double centre[3];               /* b */
+    double t1, temperature1;        /* the first time and temperature */
+    size_t ngroups;                 /* the groups these data can test */
+    fe_discover_group groups[FE_CATALOG_AXES_GROUPS];
+    const char *description[FE_CATALOG_AXES_GROUPS];   /* of groups[i] */
+} fe_catalog_axes;
+
+/* fe_catalog_axes_init: the catalog for samples around `centre`: bias,
+   hard_iron (the base: the sphere's own parameters), axis_gain,
+   cross_axis, then thermal_offset when the samples have a temperature
+   (the first is temperature1) and drift when they have a time (the first
+   is t1).  Errors: FE_EINVAL (NULL), FE_ENONFINITE (centre, or t1 or
+   temperature1 when used). */
+int fe_catalog_axes_init(fe_catalog_axes *c, const double centre[3], int has_time, double t1,
+                         int has_temperature, double temperature1);
+
+/* fe_catalog_axes_eval: the FE_CATALOG_AXES_COLUMNS columns of sample x
+   at time t and temperature temp into phi, and |x - b| into *radius.
+   Errors: FE_EINVAL (NULL), FE_ENONFINITE (an input not finite),
+   FE_ESINGULAR (x at the centre: no direction). */
+int fe_catalog_axes_eval(const fe_catalog_axes *c, const double x[3], double t, double temp,
+                         double *phi, double *radius);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1498,31 +1498,6 @@ typedef struct fe__sphere_args {
     int json;
 } fe__sphere_args;
 
-enum { FE__SPH_COLS = 13 };
-
-/* The columns of a sample: 1, u, u_x^2, u_y^2, cross products, (T-T1) u, t-t1. */
-static void fe__sphere_terms(const double x[3], double t, double temp, const double b[3],
-                             double t1, double temp1, double *phi, double *radius)
-{
-    double d[3] = {x[0] - b[0], x[1] - b[1], x[2] - b[2]};
-    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    double u[3] = {d[0] / len, d[1] / len, d[2] / len};
-    *radius = len;
-    phi[0] = 1.0;
-    phi[1] = u[0];
-    phi[2] = u[1];
-    phi[3] = u[2];
-    phi[4] = u[0] * u[0];
-    phi[5] = u[1] * u[1];
-    phi[6] = u[0] * u[1];
-    phi[7] = u[0] * u[2];
-    phi[8] = u[1] * u[2];
-    phi[9] = (temp - temp1) * u[0];
-    phi[10] = (temp - temp1) * u[1];
-    phi[11] = (temp - temp1) * u[2];
-    phi[12] = t - t1;
-}
-
 static int fe__sphere_read(fe_cli_table *t, const size_t *cols, size_t k, double *v,
                            char *err, size_t errlen)
 {
@@ -1538,15 +1513,10 @@ static int fe__discover_sphere(fe__sphere_args *a)
     fe_quadric q;
     fe_sphere_fit fit;
     fe_discover_acc acc;
-    fe_discover_group groups[6] = {
-        {"bias", 0, 1}, {"hard_iron", 1, 3}, {"axis_gain", 4, 2},
-        {"cross_axis", 6, 3}, {"thermal_offset", 9, 3}, {"drift", 12, 1}};
-    const char *desc[6] = {"a different radius", "an offset of the centre",
-                           "unequal per-axis scale", "soft iron or non-orthogonal axes",
-                           "an offset that moves with temperature",
-                           "a field or a gain drifting with time"};
-    size_t base[2] = {0, 1}, ngroups;
-    double *storage = NULL, *work = NULL, phi[FE__SPH_COLS];
+    fe_catalog_axes cat;
+    const fe_discover_group *groups = cat.groups;
+    size_t base[2] = {0, 1};
+    double *storage = NULL, *work = NULL, phi[FE_CATALOG_AXES_COLUMNS];
     fe_discover_result *res = NULL;
     fe_discover_options opt = fe_discover_default_options();
     int rc, has_time = 0, has_temp = a->temperature != NULL;
@@ -1638,12 +1608,14 @@ static int fe__discover_sphere(fe__sphere_args *a)
     }
     held = (size_t)floor(a->holdout * (double)rows);
     fit_rows = rows - held;
-    ngroups = has_temp ? 5 : 4;
-    if (has_time)
-        groups[ngroups++] = groups[5];
+    if (fe_catalog_axes_init(&cat, fit.offset, has_time, t1, has_temp, temp1) != FE_OK) {
+        fprintf(stderr, "foldest discover: %s: the sphere's centre is not finite\n", t.name);
+        rc = FE_CLI_REFUSED;
+        goto done;
+    }
     {
-        size_t nst = fe_discover_acc_doubles(FE__SPH_COLS, (size_t)a->blocks);
-        size_t nw = fe_discover_workspace_doubles(FE__SPH_COLS, (size_t)a->blocks);
+        size_t nst = fe_discover_acc_doubles(FE_CATALOG_AXES_COLUMNS, (size_t)a->blocks);
+        size_t nw = fe_discover_workspace_doubles(FE_CATALOG_AXES_COLUMNS, (size_t)a->blocks);
         storage = malloc(nst * sizeof *storage);
         work = malloc(nw * sizeof *work);
         res = malloc(sizeof *res);
@@ -1652,8 +1624,8 @@ static int fe__discover_sphere(fe__sphere_args *a)
             rc = FE_CLI_IO;
             goto fail;
         }
-        if (fe_discover_acc_init(&acc, FE__SPH_COLS, (size_t)a->blocks, fit_rows, 0, storage,
-                                 nst) != FE_OK) {
+        if (fe_discover_acc_init(&acc, FE_CATALOG_AXES_COLUMNS, (size_t)a->blocks, fit_rows, 0,
+                                 storage, nst) != FE_OK) {
             fprintf(stderr, "foldest discover: %s: %zu rows are too few for %ld blocks\n",
                     t.name, rows, a->blocks);
             rc = FE_CLI_REFUSED;
@@ -1664,9 +1636,9 @@ static int fe__discover_sphere(fe__sphere_args *a)
             goto fail;
         while ((rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK) {
             double len;
-            fe__sphere_terms(v, has_time ? v[3] : (double)t.rows, has_temp ? v[k - 1] : 0.0,
-                             fit.offset, t1, temp1, phi, &len);
-            if (fe_discover_add(&acc, phi, len - fit.radius) != FE_OK) {
+            if (fe_catalog_axes_eval(&cat, v, has_time ? v[3] : (double)t.rows,
+                                     has_temp ? v[k - 1] : 0.0, phi, &len) != FE_OK
+                || fe_discover_add(&acc, phi, len - fit.radius) != FE_OK) {
                 snprintf(err, sizeof err, "%s:%zu: a sample at the centre", t.name, t.line);
                 rc = FE_CLI_INPUT;
                 goto fail;
@@ -1678,7 +1650,7 @@ static int fe__discover_sphere(fe__sphere_args *a)
         opt.base = base;
         opt.nbase = 2;
         opt.noise = FE_DISCOVER_NOISE_BATCH;    /* see the text */
-        rc = fe_discover_select(&acc, groups, ngroups, &opt, res, work, nw);
+        rc = fe_discover_select(&acc, cat.groups, cat.ngroups, &opt, res, work, nw);
         if (rc != FE_OK) {
             fprintf(stderr, "foldest discover: %s: %s\n", t.name, fe_strerror(rc));
             rc = FE_CLI_REFUSED;
@@ -1693,8 +1665,9 @@ static int fe__discover_sphere(fe__sphere_args *a)
         while ((rc = fe__sphere_read(&t, cols, k, v, err, sizeof err)) == FE_OK) {
             double len, before, after;
             int o;
-            fe__sphere_terms(v, has_time ? v[3] : (double)t.rows, has_temp ? v[k - 1] : 0.0,
-                             fit.offset, t1, temp1, phi, &len);
+            if (fe_catalog_axes_eval(&cat, v, has_time ? v[3] : (double)t.rows,
+                                     has_temp ? v[k - 1] : 0.0, phi, &len) != FE_OK)
+                continue;                       /* refused in pass 2 */
             before = len - fit.radius;
             after = before;
             for (size_t j = 0; j < res->ncols; j++)
@@ -1743,7 +1716,7 @@ static int fe__discover_sphere(fe__sphere_args *a)
             for (size_t s = 0; s < res->steps; s++) {
                 const fe_discover_group *g = &groups[res->added[s]];
                 printf("%s{\"name\": \"%s\", \"description\": \"%s\", \"coefficients\": [",
-                       s ? ", " : "", g->name, desc[res->added[s] < 5 ? res->added[s] : 5]);
+                       s ? ", " : "", g->name, cat.description[res->added[s]]);
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
                         if (res->cols[j] == g->first + c) {
@@ -1790,7 +1763,7 @@ static int fe__discover_sphere(fe__sphere_args *a)
             for (size_t s = 0; s < res->steps; s++) {
                 const fe_discover_group *g = &groups[res->added[s]];
                 printf("  %zu. %s (%s): F = %.1f, p = %.2g; coefficients / radius:", s + 1,
-                       g->name, desc[res->added[s] < 5 ? res->added[s] : 5],
+                       g->name, cat.description[res->added[s]],
                        res->added_rank[s].statistic, res->added_rank[s].p_value);
                 for (size_t c = 0; c < g->count; c++)
                     for (size_t j = 0; j < res->ncols; j++)
