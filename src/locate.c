@@ -455,12 +455,13 @@ static void fe__cell_add(fe_residual_cell *c, double t, int pair, double before,
     c->sq1 += after * after;
 }
 
-/* The band (0 .. bands - 1) of u in [lo, hi]. */
+/* The band (0 .. bands - 1) of u in [lo, hi]; a value outside the range
+   joins the band at its end (clamped before the conversion to int, which
+   a value far outside would overflow). */
 static int fe__band(double u, double lo, double hi, int bands)
 {
-    double w = hi - lo;
-    int b = w > 0 ? (int)((u - lo) / w * bands) : 0;
-    return b < 0 ? 0 : b >= bands ? bands - 1 : b;
+    double w = hi - lo, q = w > 0 ? (u - lo) / w * bands : 0.0;
+    return !(q > 0.0) ? 0 : q >= bands ? bands - 1 : (int)q;
 }
 
 static int fe__in_region(const fe_residual_map *m, size_t g, const fe_sample *s)

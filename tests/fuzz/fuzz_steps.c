@@ -392,6 +392,50 @@ static void fuzz_innovations(in *s, unsigned shape)
                     && isfinite(out[i].t0) && isfinite(out[i].t1));
 }
 
+/* Residuals folded into a residual map by block and region, then
+   located and judged. */
+static void fuzz_residual_map(in *s, unsigned shape)
+{
+    fe_residual_map *a = malloc(sizeof *a), *as = malloc(sizeof *as);
+    fe_located out[8];
+    double lo[3], hi[3];
+    size_t nout = 0;
+    int rc;
+    fill(s, lo, 3);
+    fill(s, hi, 3);
+    if (a == NULL || as == NULL
+        || fe_residual_map_init(a, 2 + shape % 3, 64, 0, shape >> 2, lo, hi) != FE_OK)
+        goto done;
+    while (s->n > 0) {
+        fe_sample x;
+        double before = number(s), after = number(s);
+        unsigned how = byte(s);
+        memset(&x, 0, sizeof x);
+        x.t = number(s);
+        x.position = number(s);
+        x.velocity = (how & 1) ? 0.0 : number(s);
+        x.temperature = number(s);
+        memcpy(as, a, sizeof *a);
+        rc = fe_residual_map_add(a, &x, before, after);
+        if (rc != FE_OK)
+            REQUIRE(memcmp(as, a, sizeof *a) == 0);
+        REQUIRE(fe_strerror(rc) != NULL);
+        if ((how & 8) && rc == FE_OK)
+            fe_residual_map_break(a);
+    }
+    rc = fe_residual_map_locate(a, 1.0, 0.05, out, 8, &nout);
+    REQUIRE(rc == FE_OK);
+    for (size_t i = 0; i < nout && i < 8; i++) {
+        char json[1024];
+        REQUIRE(out[i].p_value >= 0.0 && out[i].p_value <= 1.0 && isfinite(out[i].n));
+        REQUIRE(fe_located_json(&out[i], json, sizeof json) == FE_OK);
+    }
+    REQUIRE(!isnan(fe_residual_map_largest_after(a, 0.5)));
+done:
+    free(a);
+    free(as);
+}
+
 /* A model given as callbacks: y = th0 + th1 u + th2 exp(x), which
    overflows for large positions; analytic or finite-difference Jacobian. */
 static int model_predict(const fe_sample *x, const double *th, double *y, void *user)
@@ -467,7 +511,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     in s = {data, size};
     unsigned which = byte(&s), shape = byte(&s);
-    switch (which % 10) {
+    switch (which % 11) {
     case 0: fuzz_meanvar(&s); break;
     case 1: fuzz_quadric(&s, shape); break;
     case 2: fuzz_lsq(&s, shape); break;
@@ -477,6 +521,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case 6: fuzz_discover_rows(&s, shape); break;
     case 7: fuzz_innovations(&s, shape); break;
     case 8: fuzz_model(&s, shape); break;
+    case 10: fuzz_residual_map(&s, shape); break;
     default: fuzz_discover_columns(&s, shape); break;
     }
     return 0;
