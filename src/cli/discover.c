@@ -1168,8 +1168,8 @@ static void fe__report_data(FILE *f, const fe__plot_info *pi)
 }
 /* The page's list of data files ends here */
 /* [[file:../../literate/cli_discover.org::The page and the plot script][The page and the plot script]] */
-/* The four series of the time plot (fitted, held out; before, after) and
-   the zero line. */
+/* The series of a plot: before and after (only one when no term was
+   found), fitted and held out (only fitted when `filter` is NULL). */
 static void fe__plot_series(FILE *f, const char *data, const char *filter, int terms,
                             int held)
 {
@@ -1183,15 +1183,15 @@ static void fe__plot_series(FILE *f, const char *data, const char *filter, int t
                 snprintf(y, sizeof y, "(%s == %d ? $%d : NaN)", filter, h, 2 + 2 * a);
             else
                 snprintf(y, sizeof y, "%d", 2 + 2 * a);
-            fprintf(f, "'%s' using 1:%s:%d with yerrorlines pt %d ps 0.9 lw 1.5 "
-                       "lc rgb '%s' title '%s%s', \\\n     ",
-                    first ? data : "", y, 3 + 2 * a,
+            fprintf(f, "%s'%s' using 1:%s:%d with yerrorlines pt %d ps 0.9 lw 1.5 "
+                       "lc rgb '%s' title '%s%s'",
+                    first ? "" : ", \\\n     ", first ? data : "", y, 3 + 2 * a,
                     h ? 6 - 2 * a : 7 - 2 * a, colour[a],
                     !terms ? "mean residual" : a ? "after" : "before",
                     !held ? "" : h ? " (held out)" : " (fitted)");
             first = 0;
         }
-    fprintf(f, "0 with lines lw 1 lc rgb '#404040' notitle\n");
+    fputc('\n', f);
 }
 
 static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plot_info *pi,
@@ -1251,7 +1251,7 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
                "set terminal pngcairo size 1000,600 noenhanced\n"
                "set encoding utf8\nset datafile separator ' '\nset grid\n"
                "set key below horizontal samplen 3 spacing 1.2\nset bmargin 5.5\n"
-               "set bars small\n"
+               "set bars small\nset xzeroaxis lt -1 lw 1 lc rgb '#404040'\n"
                "if (ARGC > 0) cd ARG1\n"
                "set output 'residual_time.png'\n"
                "set title '%s: mean residual per time block, %s1 standard error'\n"
