@@ -576,6 +576,60 @@ START_TEST(report_lays_recordings_end_to_end)
 }
 END_TEST
 
+/* Add `offset` to the time (first column) of every data row of dir/name. */
+static void shift_times(const char *name, double offset)
+{
+    static char text[8 << 20];
+    char path[256];
+    const char *p;
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    fe_test_read_file(path, text, sizeof text);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    p = strchr(text, '\n') + 1;
+    fwrite(text, 1, (size_t)(p - text), f);            /* the header */
+    while (*p != '\0') {
+        char *end;
+        double t = strtod(p, &end);
+        const char *nl = strchr(end, '\n');
+        ck_assert_ptr_nonnull(nl);
+        fprintf(f, "%.6f", t + offset);
+        fwrite(end, 1, (size_t)(nl + 1 - end), f);
+        p = nl + 1;
+    }
+    fclose(f);
+}
+
+/* A clock in seconds since 1970: the blocks' times keep their fractions
+   (10 significant digits would round them to whole seconds). */
+START_TEST(report_keeps_an_epoch_clock)
+{
+    static char out[65536];
+    char cmd[2048], path[256], line[512];
+    double t0 = 0, t1 = 0, t, first;
+    FILE *f;
+    make_dir();
+    named_pair(2000, "a", &t0, &t1);
+    shift_times("r.csv", 1.7e9 + 0.123);
+    shift_times("s.csv", 1.7e9 + 0.123);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel a --time 't [s]' "
+             "--role 'v (m/s)=velocity' --base bias --holdout 0.2 --blocks 4 --report %s/rep",
+             FE_TEST_CLI, dir, dir, dir);
+    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s", out);
+    snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    fclose(f);
+    ck_assert_int_eq(sscanf(line, "%lf %*f %*f %*f %*f %*f %*f %*f %*d %lf", &t, &first), 2);
+    ck_assert_msg(fabs(first - (1.7e9 + 0.123 + t0)) < 1e-5, "first time %.6f, want %.6f", first,
+                  1.7e9 + 0.123 + t0);
+    ck_assert_msg(t > first && t < 1.7e9 + t1 + 1, "middle time %.6f", t);
+    remove_dir();
+}
+END_TEST
+
 START_TEST(free_fall_recordings_show_quadratic_drag)
 {
     /* The vacuum simulation of each drop's free fall (examples/freefall_sim)
@@ -668,6 +722,7 @@ Suite *fe_discover_cli_suite(void)
     tcase_add_loop_test(t, report_axis_carries_the_channels_unit, 0,
                         (int)(sizeof unit_cases / sizeof unit_cases[0]));
     tcase_add_test(t, report_lays_recordings_end_to_end);
+    tcase_add_test(t, report_keeps_an_epoch_clock);
     tcase_add_test(t, free_fall_recordings_show_quadratic_drag);
     tcase_add_test(t, magnetometers_show_axis_gain_and_cross_axis);
     suite_add_tcase(s, t);

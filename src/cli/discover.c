@@ -1129,13 +1129,13 @@ static int fe__write_means(const char *path, const fe__stat *s, size_t n, size_t
         const fe__stat *b = &s[i];
         if (b->n < 2)
             continue;
-        fprintf(f, "%.10g %.6g %.6g %.6g %.6g %.0f %.6g %.6g",
+        fprintf(f, "%.15g %.6g %.6g %.6g %.6g %.0f %.6g %.6g",
                 blocks ? 0.5 * (b->t0 + b->t1) : b->sumt / b->n,
                 b->sum0 / b->n, fe__mean_se(b->n, b->sum0, b->sq0, w0),
                 b->sum1 / b->n, fe__mean_se(b->n, b->sum1, b->sq1, w1),
                 b->n, sqrt(b->sq0 / b->n), sqrt(b->sq1 / b->n));
         if (blocks)
-            fprintf(f, " %d %.10g %.10g %d", i >= nfit, b->t0, b->t1, b->pair + 1);
+            fprintf(f, " %d %.15g %.15g %d", i >= nfit, b->t0, b->t1, b->pair + 1);
         fputc('\n', f);
     }
     bad = ferror(f);
@@ -1260,12 +1260,12 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
             qchan, pm, qtime, pi->njoins > 0 ? " (recordings end to end)" : "", minus,
             unit[0] ? " [" : "", qunit, unit[0] ? "]" : "");
     if (pi->held)
-        fprintf(f, "set object 1 rect from first %.10g, graph 0 to first %.10g, graph 1 behind "
+        fprintf(f, "set object 1 rect from first %.15g, graph 0 to first %.15g, graph 1 behind "
                    "fillcolor rgb '#e6e6e6' fillstyle solid 1.0 noborder\n"
-                   "set label 1 'held out' at first %.10g, graph 0.96 left offset 0.5,0\n",
+                   "set label 1 'held out' at first %.15g, graph 0.96 left offset 0.5,0\n",
                 pi->held0, pi->held1, pi->held0);
     for (size_t j = 0; j < pi->njoins; j++)
-        fprintf(f, "set arrow %zu from first %.10g, graph 0 to first %.10g, graph 1 nohead "
+        fprintf(f, "set arrow %zu from first %.15g, graph 0 to first %.15g, graph 1 nohead "
                    "dashtype 3 lc rgb '#707070'\n", j + 1, pi->joins[j], pi->joins[j]);
     fe__plot_series(f, "blocks.dat", pi->held ? "$9" : NULL, terms, pi->held);
     if (pi->state_var != NULL) {
@@ -1622,7 +1622,7 @@ int fe_cli_discover(int argc, char **argv)
                     fe__stat_add(&bins[v][b], x, pair_index, before, after);
             }
             if (pts != NULL && i % stride == 0)
-                fprintf(pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
+                fprintf(pts, "%.15g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
                         s.position, s.velocity, s.temperature);
             i++;
         }
