@@ -440,8 +440,10 @@ int fe_residual_map_init(fe_residual_map *m, size_t blocks, uint64_t fit, uint64
 }
 /* Start a residual map ends here */
 /* [[file:../literate/locate.org::Fold a row into the residual map][Fold a row into the residual map]] */
-static void fe__cell_add(fe_residual_cell *c, double t, int pair, double before, double after)
+void fe_residual_cell_add(fe_residual_cell *c, double t, int pair, double before, double after)
 {
+    if (c == NULL)
+        return;
     if (c->n == 0) {
         c->t0 = t;
         c->pair = pair;
@@ -449,6 +451,7 @@ static void fe__cell_add(fe_residual_cell *c, double t, int pair, double before,
     c->t1 = t;
     c->pair1 = pair;
     c->n += 1;
+    c->sum_at += t;
     c->sum0 += before;
     c->sq0 += before * before;
     c->sum1 += after;
@@ -517,10 +520,11 @@ int fe_residual_map_add(fe_residual_map *m, const fe_sample *s, double before, d
        map unchanged. */
     for (size_t c = 0; c < ncell; c++)
         if (!isfinite(cell[c]->sum0 + before) || !isfinite(cell[c]->sq0 + before * before)
+            || !isfinite(cell[c]->sum_at + at[c])
             || !isfinite(cell[c]->sum1 + after) || !isfinite(cell[c]->sq1 + after * after))
             return FE_ENONFINITE;
     for (size_t c = 0; c < ncell; c++)
-        fe__cell_add(cell[c], at[c], m->recording, before, after);
+        fe_residual_cell_add(cell[c], at[c], m->recording, before, after);
     m->n++;
     return FE_OK;
 }
@@ -547,6 +551,7 @@ static void fe__cell_merge(fe_residual_cell *x, const fe_residual_cell *y, int s
     x->t1 = y->t1;
     x->pair1 = y->pair1 + shift;
     x->n += y->n;
+    x->sum_at += y->sum_at;
     x->sum0 += y->sum0;
     x->sq0 += y->sq0;
     x->sum1 += y->sum1;

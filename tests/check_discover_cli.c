@@ -330,6 +330,306 @@ START_TEST(bad_inputs)
 }
 END_TEST
 
+/* ---------------------------------------------------------------- the report
+   A synthetic pair with physicists' column names: time "t [s]", channel
+   "accel_z[m/s^2]", velocity "v (m/s)"; the report's data files, script
+   and plots. */
+
+/* Replace the header line of dir/name by `header` (a line without '\n'). */
+static void rename_columns(const char *name, const char *header)
+{
+    static char text[8 << 20];
+    char path[256];
+    const char *nl;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    fe_test_read_file(path, text, sizeof text);
+    nl = strchr(text, '\n');
+    ck_assert_ptr_nonnull(nl);
+    {
+        FILE *f = fopen(path, "w");
+        ck_assert_ptr_nonnull(f);
+        fprintf(f, "%s%s", header, nl);
+        fclose(f);
+    }
+}
+
+/* A pair r.csv, s.csv of `rows` rows with the columns renamed; the first
+   and last time of the recording. */
+static void named_pair(int rows, const char *channel, double *t0, double *t1)
+{
+    static char out[8192];
+    char cmd[1024], header[512], path[256], line[256];
+    FILE *f;
+    snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 5 --rows %d "
+             "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, rows, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    snprintf(header, sizeof header, "t [s],%s", channel);
+    rename_columns("r.csv", header);
+    snprintf(header, sizeof header, "t [s],%s,position,v (m/s),input", channel);
+    rename_columns("s.csv", header);
+    snprintf(path, sizeof path, "%s/r.csv", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    *t0 = strtod(line, NULL);
+    while (fgets(line, sizeof line, f) != NULL)
+        *t1 = strtod(line, NULL);
+    fclose(f);
+}
+
+/* discover on the named pair with a report in dir/rep. */
+static void report_of_named_pair(const char *channel)
+{
+    static char out[65536];
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel '%s' "
+             "--time 't [s]' --role position=position --role 'v (m/s)=velocity' --role input=input "
+             "--base bias,gain --holdout 0.25 --blocks 10 --report %s/rep", FE_TEST_CLI, dir, dir,
+             channel, dir);
+    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s\n%s", cmd, out);
+}
+
+static int have_gnuplot(void)
+{
+    char out[256];
+    if (run("gnuplot --version", out, sizeof out) == 0)
+        return 1;
+    fprintf(stderr, "SKIP report plots: gnuplot is not installed (the deps step installs gnuplot-nox)\n");
+    return 0;
+}
+
+START_TEST(report_data_and_plots_a_physicist_keeps)
+{
+    static char text[65536];
+    char path[256], line[512], cmd[1024];
+    double t0 = 0, t1 = 0, last_fitted = -INFINITY, first_held = INFINITY, prev = -INFINITY;
+    int nblocks = 0, nheld = 0, nbins = 0;
+    FILE *f;
+    make_dir();
+    named_pair(20000, "accel_z[m/s^2]", &t0, &t1);
+    report_of_named_pair("accel_z[m/s^2]");
+
+    /* blocks.dat: 12 columns, time first and inside the recording's span,
+       standard errors non-negative and at least the rows' spread over
+       sqrt(n) (correlated rows are worth less than one each), held-out
+       blocks flagged and after every fitted block. */
+    snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fgets(line, sizeof line, f) != NULL) {
+        double t, m0, se0, m1, se1, n, rms0, rms1, first, last;
+        int held, rec;
+        ck_assert_msg(sscanf(line, "%lf %lf %lf %lf %lf %lf %lf %lf %d %lf %lf %d", &t, &m0, &se0,
+                             &m1, &se1, &n, &rms0, &rms1, &held, &first, &last, &rec) == 12,
+                      "blocks.dat: %s", line);
+        ck_assert_msg(t >= t0 && t <= t1, "blocks.dat: time %g outside [%g, %g]", t, t0, t1);
+        ck_assert_msg(first <= t && t <= last && first >= t0 && last <= t1, "blocks.dat: %s", line);
+        ck_assert_msg(t > prev, "blocks.dat: times not increasing at %g", t);
+        prev = t;
+        ck_assert_msg(se0 > 0 && se1 > 0 && isfinite(se0) && isfinite(se1), "blocks.dat: %s", line);
+        ck_assert_msg(se0 >= 0.99 * sqrt((rms0 * rms0 - m0 * m0) / n)
+                      && se1 >= 0.99 * sqrt((rms1 * rms1 - m1 * m1) / n), "blocks.dat: %s", line);
+        /* Noise of sd 1, lag-one correlation 0.5: the bar is about
+           sqrt(3 / n), not sqrt(1 / n) nor wildly more. */
+        ck_assert_msg(se0 < 3.0 / sqrt(n), "blocks.dat: error bar %g for %g rows", se0, n);
+        ck_assert_msg(held == 0 || held == 1, "blocks.dat: %s", line);
+        ck_assert_int_eq(rec, 1);
+        if (held) {
+            nheld++;
+            first_held = first < first_held ? first : first_held;
+        } else {
+            ck_assert_msg(first_held == INFINITY, "a fitted block after a held-out one: %s", line);
+            last_fitted = last;
+        }
+        nblocks++;
+    }
+    fclose(f);
+    ck_assert_int_eq(nblocks - nheld, 10);
+    /* A quarter of 20000 rows held out, in blocks of the fitted blocks' 1500 rows. */
+    ck_assert_int_eq(nheld, 4);
+    ck_assert_msg(last_fitted < first_held, "held out from %g, fitted until %g", first_held,
+                  last_fitted);
+
+    /* bins.dat: 8 columns, the velocity increasing, error bars >= 0. */
+    snprintf(path, sizeof path, "%s/rep/bins.dat", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    prev = -INFINITY;
+    while (fgets(line, sizeof line, f) != NULL) {
+        double v, m0, se0, m1, se1, n, rms0, rms1, extra;
+        ck_assert_msg(sscanf(line, "%lf %lf %lf %lf %lf %lf %lf %lf %lf", &v, &m0, &se0, &m1, &se1,
+                             &n, &rms0, &rms1, &extra) == 8, "bins.dat: %s", line);
+        ck_assert_msg(v > prev && se0 >= 0 && se1 >= 0 && n >= 2, "bins.dat: %s", line);
+        prev = v;
+        nbins++;
+    }
+    fclose(f);
+    ck_assert_msg(nbins >= 20 && nbins <= 40, "%d bins", nbins);
+
+    /* The script: labels with the columns' names and the channel's unit,
+       the held-out band, relative paths only. */
+    snprintf(path, sizeof path, "%s/rep/plots.gp", dir);
+    fe_test_read_file(path, text, sizeof text);
+    ck_assert_msg(strstr(text, "set xlabel 't [s]'\n") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "set ylabel 'mean residual (recording \xe2\x88\x92 model) [m/s^2]'\n")
+                  != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "set xlabel 'v (m/s)'\n") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "'held out'") != NULL && strstr(text, "(held out)") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "with yerrorlines") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, dir) == NULL, "the script names its folder:\n%s", text);
+
+    /* The page lists the files and their columns. */
+    snprintf(path, sizeof path, "%s/rep/report.md", dir);
+    fe_test_read_file(path, text, sizeof text);
+    ck_assert_msg(strstr(text, "`blocks.dat`, one line per time block: 1 middle time (column `t [s]`)")
+                  != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "9 held out (1) or fitted (0)") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "`bins.dat`, one line per bin of `v (m/s)`") != NULL, "%s", text);
+
+    /* The script runs from inside the folder, with no argument. */
+    if (have_gnuplot()) {
+        char out[4096];
+        unsigned char magic[8];
+        snprintf(cmd, sizeof cmd, "cd %s/rep && rm residual_time.png residual_state.png && "
+                 "gnuplot plots.gp", dir);
+        ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s:\n%s", cmd, out);
+        ck_assert_msg(out[0] == '\0', "gnuplot warned:\n%s", out);
+        for (int k = 0; k < 2; k++) {
+            snprintf(path, sizeof path, "%s/rep/%s", dir, k ? "residual_state.png" : "residual_time.png");
+            f = fopen(path, "rb");
+            ck_assert_msg(f != NULL, "no %s", path);
+            ck_assert_int_eq(fread(magic, 1, 8, f), 8);
+            fseek(f, 0, SEEK_END);
+            ck_assert_msg(ftell(f) > 10000, "%s: %ld bytes", path, ftell(f));
+            fclose(f);
+            ck_assert_int_eq(memcmp(magic, "\x89PNG\r\n\x1a\n", 8), 0);
+        }
+    }
+    remove_dir();
+}
+END_TEST
+
+/* The channel's unit on the y axis, by the rule of cli_discover.org. */
+static const char *const unit_cases[][2] = {
+    {"accel_z[m/s^2]", " [m/s^2]"}, {"accel_z [ m/s^2 ]", " [m/s^2]"}, {"temp (C)", " [C]"},
+    {"x_m", " [m]"}, {"T_K", " [K]"}, {"accel_z", ""}, {"acceleration", ""}, {"x_", ""},
+};
+
+START_TEST(report_axis_carries_the_channels_unit)
+{
+    static char text[65536];
+    char path[256], want[256];
+    double t0, t1;
+    make_dir();
+    named_pair(2000, unit_cases[_i][0], &t0, &t1);
+    report_of_named_pair(unit_cases[_i][0]);
+    snprintf(path, sizeof path, "%s/rep/plots.gp", dir);
+    fe_test_read_file(path, text, sizeof text);
+    snprintf(want, sizeof want, "set ylabel 'mean residual (recording \xe2\x88\x92 model)%s'\n",
+             unit_cases[_i][1]);
+    ck_assert_msg(strstr(text, want) != NULL, "%s: want \"%s\" in:\n%s", unit_cases[_i][0], want,
+                  text);
+    remove_dir();
+}
+END_TEST
+
+/* Two recordings, each with its clock from 0: laid end to end on the time
+   axis, the second after the first, a join drawn between them. */
+START_TEST(report_lays_recordings_end_to_end)
+{
+    static char out[65536], text[65536];
+    char cmd[2048], path[256], line[512];
+    double t0, t1, prev = -INFINITY;
+    int recs[3] = {0, 0, 0};
+    FILE *f;
+    make_dir();
+    named_pair(6000, "a", &t0, &t1);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --real %s/r.csv "
+             "--sim %s/s.csv --channel a --time 't [s]' --role 'v (m/s)=velocity' --base bias "
+             "--holdout 0 --blocks 8 --report %s/rep", FE_TEST_CLI, dir, dir, dir, dir, dir);
+    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s", out);
+    snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fgets(line, sizeof line, f) != NULL) {
+        double t, x[7], first, last;
+        int held, rec;
+        ck_assert_int_eq(sscanf(line, "%lf %lf %lf %lf %lf %lf %lf %lf %d %lf %lf %d", &t, &x[0],
+                                &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &held, &first, &last,
+                                &rec), 12);
+        ck_assert_msg(t > prev && held == 0 && rec >= 1 && rec <= 2, "blocks.dat: %s", line);
+        ck_assert_msg(t >= t0 && t <= 2 * t1 + 1, "blocks.dat: %s", line);
+        prev = t;
+        recs[rec]++;
+    }
+    fclose(f);
+    ck_assert_int_eq(recs[1], 4);
+    ck_assert_int_eq(recs[2], 4);
+    ck_assert_msg(prev > t1, "the second recording is not after the first: %g", prev);
+    snprintf(path, sizeof path, "%s/rep/plots.gp", dir);
+    fe_test_read_file(path, text, sizeof text);
+    ck_assert_msg(strstr(text, "set xlabel 't [s] (recordings end to end)'") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "set arrow 1 from first ") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "held out") == NULL, "no rows held out, yet:\n%s", text);
+    remove_dir();
+}
+END_TEST
+
+/* Add `offset` to the time (first column) of every data row of dir/name. */
+static void shift_times(const char *name, double offset)
+{
+    static char text[8 << 20];
+    char path[256];
+    const char *p;
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    fe_test_read_file(path, text, sizeof text);
+    f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    p = strchr(text, '\n') + 1;
+    fwrite(text, 1, (size_t)(p - text), f);            /* the header */
+    while (*p != '\0') {
+        char *end;
+        double t = strtod(p, &end);
+        const char *nl = strchr(end, '\n');
+        ck_assert_ptr_nonnull(nl);
+        fprintf(f, "%.6f", t + offset);
+        fwrite(end, 1, (size_t)(nl + 1 - end), f);
+        p = nl + 1;
+    }
+    fclose(f);
+}
+
+/* A clock in seconds since 1970: the blocks' times keep their fractions
+   (10 significant digits would round them to whole seconds). */
+START_TEST(report_keeps_an_epoch_clock)
+{
+    static char out[65536];
+    char cmd[2048], path[256], line[512];
+    double t0 = 0, t1 = 0, t, first;
+    FILE *f;
+    make_dir();
+    named_pair(2000, "a", &t0, &t1);
+    shift_times("r.csv", 1.7e9 + 0.123);
+    shift_times("s.csv", 1.7e9 + 0.123);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel a --time 't [s]' "
+             "--role 'v (m/s)=velocity' --base bias --holdout 0.2 --blocks 4 --report %s/rep",
+             FE_TEST_CLI, dir, dir, dir);
+    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s", out);
+    snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
+    f = fopen(path, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    fclose(f);
+    ck_assert_int_eq(sscanf(line, "%lf %*f %*f %*f %*f %*f %*f %*f %*d %lf", &t, &first), 2);
+    ck_assert_msg(fabs(first - (1.7e9 + 0.123 + t0)) < 1e-5, "first time %.6f, want %.6f", first,
+                  1.7e9 + 0.123 + t0);
+    ck_assert_msg(t > first && t < 1.7e9 + t1 + 1, "middle time %.6f", t);
+    remove_dir();
+}
+END_TEST
+
 START_TEST(free_fall_recordings_show_quadratic_drag)
 {
     /* The vacuum simulation of each drop's free fall (examples/freefall_sim)
@@ -418,6 +718,11 @@ Suite *fe_discover_cli_suite(void)
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);
     tcase_add_test(t, bursty_clocks_keep_every_covered_row);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));
+    tcase_add_test(t, report_data_and_plots_a_physicist_keeps);
+    tcase_add_loop_test(t, report_axis_carries_the_channels_unit, 0,
+                        (int)(sizeof unit_cases / sizeof unit_cases[0]));
+    tcase_add_test(t, report_lays_recordings_end_to_end);
+    tcase_add_test(t, report_keeps_an_epoch_clock);
     tcase_add_test(t, free_fall_recordings_show_quadratic_drag);
     tcase_add_test(t, magnetometers_show_axis_gain_and_cross_axis);
     suite_add_tcase(s, t);

@@ -6,7 +6,10 @@
    One table: for each case and each command, the exit status documented in
    cli.org, a message naming the file and the problem (FILE:LINE:COLUMN
    where there is a line), nothing on standard output, and no output file
-   (--apply, --report, synth's pair) or temporary file left behind. */
+   (--apply, --report, synth's pair) or temporary file left behind.  Then
+   what needs no shell: names with shell metacharacters in every path
+   argument and in column names, file modes, standard output on a full
+   disk, interruption. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <fcntl.h>
@@ -333,6 +336,10 @@ END_TEST
    file modes, standard output, interruption.  These run foldest without a
    shell (fork and exec), so that a hostile name reaches it unchanged. */
 
+/* What the next child gets besides: its standard input from this file,
+   TMPDIR set to this folder (NULL: unchanged). */
+static const char *child_stdin, *child_tmpdir;
+
 /* Start foldest with `args` (NULL-terminated, without argv[0]) in the
    directory `cwd`, under `mask`, its stdout to `out` (NULL: /dev/null) and
    stderr to cwd/stderr.txt.  The child's pid. */
@@ -361,6 +368,10 @@ static pid_t start(const char *cwd, mode_t mask, const char *out, const char *co
         fd = open("stderr.txt", O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (fd < 0 || dup2(fd, 2) < 0)
             _exit(122);
+        if (child_stdin != NULL && ((fd = open(child_stdin, O_RDONLY)) < 0 || dup2(fd, 0) < 0))
+            _exit(124);
+        if (child_tmpdir != NULL && setenv("TMPDIR", child_tmpdir, 1) != 0)
+            _exit(125);
         execv(argv[0], argv);
         _exit(123);
     }
@@ -382,9 +393,10 @@ static int run_argv(const char *cwd, mode_t mask, const char *out, const char *c
 
 static int exists(const char *dirpath, const char *name)
 {
-    char path[2048];
+    char path[4096];
     struct stat st;
-    snprintf(path, sizeof path, "%s/%s", dirpath, name);
+    ck_assert_msg((size_t)snprintf(path, sizeof path, "%s/%s", dirpath, name) < sizeof path,
+                  "path too long: %s/%s", dirpath, name);
     return stat(path, &st) == 0;
 }
 
@@ -473,6 +485,245 @@ START_TEST(report_folder_names_run_nothing)
                   "--report '%s' ran a command", hostile_folders[_i]);
     ck_assert_msg(exists(rep, "report.md"), "no report.md in '%s'", rep);
     ck_assert_msg(exists(rep, "residual_time.png"), "no plot in '%s'\n%s", rep, err);
+    remove_tree(d);
+}
+END_TEST
+
+/* ---------------------------------------------------------------- every path argument
+   Names with the metacharacters of the shell (quotes, ';', '$(...)',
+   backquotes, '&', '|', spaces, a newline, globs, '!', '\') and of printf
+   ('%s%n'), each a folder and inside the file names in it, in every path
+   argument of every command: stats FILE; calibrate FILE --apply OUT;
+   discover --sphere FILE; discover --real --sim --report; synth --real
+   --sim; and the folder as TMPDIR for discover's copy of standard input.
+   Every command works, or fails cleanly with the path in its message as it
+   was given, and nothing is run: no file PWNED appears in the working
+   directory, the folder, the report folder, the test's directory or /tmp.
+   synth's suggested command, pasted into sh, analyses the pair. */
+static const char *const hostile_names[] = {
+    "x';touch PWNED;'", "a\"b;touch PWNED;\"c", "$(touch PWNED)", "`touch PWNED`",
+    "bob's run & touch PWNED &", "a | touch PWNED", "x\ntouch PWNED\n",
+    "* ?[a] ~ $HOME !! \\", "100% %s%n%x",
+};
+
+static int pwned_before[2];     /* PWNED was already in /tmp, in the test's directory */
+
+static void assert_nothing_ran(const char *d, const char *h, const char *step)
+{
+    char sub[1024], rep[2048], cwd[1024];
+    snprintf(sub, sizeof sub, "%s/%s", d, h);
+    snprintf(rep, sizeof rep, "%s/%s rep", sub, h);
+    ck_assert_ptr_nonnull(getcwd(cwd, sizeof cwd));
+    ck_assert_msg(!exists(d, "PWNED") && !exists(sub, "PWNED") && !exists(rep, "PWNED")
+                  && (pwned_before[0] || !exists("/tmp", "PWNED"))
+                  && (pwned_before[1] || !exists(cwd, "PWNED")),
+                  "%s, names '%s': a command was run", step, h);
+}
+
+/* foldest `args` in d: the status `want`, `expect` (if any) in its
+   stderr (copied to err), nothing run. */
+static void path_step(const char *d, const char *h, const char *const *args, int want,
+                      const char *expect, char *err, size_t errlen)
+{
+    int status = run_argv(d, 022, NULL, args);
+    read_stderr(d, err, errlen);
+    ck_assert_msg(status == want, "foldest %s %s (names '%s'): status %d, want %d\n%s", args[0],
+                  args[1], h, status, want, err);
+    ck_assert_msg(expect == NULL || strstr(err, expect) != NULL,
+                  "foldest %s (names '%s'): stderr lacks \"%s\":\n%s", args[0], h, expect, err);
+    assert_nothing_ran(d, h, args[0]);
+}
+
+/* gnuplot plots.gp in the folder `where`, without a shell; its status. */
+static int gnuplot_in(const char *where)
+{
+    pid_t pid;
+    fflush(NULL);
+    pid = fork();
+    ck_assert_int_ge(pid, 0);
+    if (pid == 0) {
+        int fd = open("/dev/null", O_WRONLY);
+        if (chdir(where) != 0 || fd < 0 || dup2(fd, 1) < 0)
+            _exit(120);
+        execlp("gnuplot", "gnuplot", "plots.gp", (char *)NULL);
+        _exit(127);
+    }
+    return finish(pid);
+}
+
+START_TEST(every_path_argument_takes_any_name)
+{
+    const char *h = hostile_names[_i];
+    char d[64], sub[1024], r[1024], s[1024], m[1024], cal[1024], rep[1024], missing[1024],
+         nocal[1024], norep[1024], nor[1024], where[2048], cmd[8192];
+    static char err[16384];
+    int status;
+    snprintf(d, sizeof d, "/tmp/foldest-paths-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    ck_assert_ptr_nonnull(getcwd(cmd, sizeof cmd));
+    pwned_before[0] = exists("/tmp", "PWNED");
+    pwned_before[1] = exists(cmd, "PWNED");
+    snprintf(sub, sizeof sub, "%s/%s", d, h);
+    ck_assert_int_eq(mkdir(sub, 0755), 0);
+    snprintf(r, sizeof r, "%s/%s r.csv", h, h);
+    snprintf(s, sizeof s, "%s/%s s.csv", h, h);
+    snprintf(m, sizeof m, "%s/%s m.csv", h, h);
+    snprintf(cal, sizeof cal, "%s/%s cal.csv", h, h);
+    snprintf(rep, sizeof rep, "%s/%s rep", h, h);
+    snprintf(missing, sizeof missing, "%s/%s missing.csv", h, h);
+    snprintf(nocal, sizeof nocal, "%s/no such folder/%s cal.csv", h, h);
+    snprintf(norep, sizeof norep, "%s/no such folder/%s rep", h, h);
+    snprintf(nor, sizeof nor, "%s/no such folder/%s r.csv", h, h);
+
+    /* synth writes the pair; its suggestion, pasted into sh, runs discover. */
+    {
+        const char *args[] = {"synth", "--effect", "quadratic_drag", "--rows", "3000",
+                              "--real", r, "--sim", s, NULL};
+        const char *from, *to;
+        path_step(d, h, args, 0, "analyse with:", err, sizeof err);
+        ck_assert_msg(exists(d, r) && exists(d, s), "synth: no pair in '%s'", sub);
+        from = strstr(err, "  foldest discover ");
+        to = from != NULL ? strstr(from, " --holdout 0.3\n") : NULL;
+        ck_assert_msg(to != NULL, "synth's suggestion:\n%s", err);
+        from += strlen("  foldest");
+        snprintf(cmd, sizeof cmd, "cd %s && %s%.*s --holdout 0.3 --json > /dev/null 2>&1", d,
+                 FE_TEST_CLI, (int)(to - from), from);
+        status = system(cmd);
+        assert_nothing_ran(d, h, "synth's suggestion in sh");
+        ck_assert_msg(status == 0, "synth's suggestion failed in sh:\n%s", cmd);
+    }
+    {
+        const char *args[] = {"stats", r, NULL};
+        path_step(d, h, args, 0, NULL, err, sizeof err);
+    }
+    {
+        FILE *f;
+        snprintf(where, sizeof where, "%s/%s", d, m);
+        f = fopen(where, "w");
+        ck_assert_ptr_nonnull(f);
+        fputs("t,mx,my,mz\n", f);
+        write_rows(f, GOOD_ROWS, 0, 0, 0.0);
+        fclose(f);
+    }
+    {
+        const char *args[] = {"calibrate", "--columns", "mx,my,mz", "--apply", cal, m, NULL};
+        path_step(d, h, args, 0, NULL, err, sizeof err);
+        ck_assert_msg(exists(d, cal), "calibrate --apply: no '%s'", cal);
+    }
+    {
+        const char *args[] = {"discover", "--sphere", m, "--columns", "mx,my,mz", "--json", NULL};
+        path_step(d, h, args, 0, NULL, err, sizeof err);
+    }
+    {
+        const char *args[] = {"discover", "--real", r, "--sim", s, "--channel", "acceleration",
+                              "--role", "velocity=velocity", "--base", "bias,gain",
+                              "--report", rep, "--json", NULL};
+        path_step(d, h, args, 0, NULL, err, sizeof err);
+        snprintf(where, sizeof where, "%s/%s", d, rep);
+        ck_assert_msg(exists(where, "report.md") && exists(where, "plots.gp"),
+                      "no report in '%s'", where);
+        /* The script, run where it was written, runs nothing either. */
+        if (exists(where, "residual_time.png")) {
+            ck_assert_int_eq(gnuplot_in(where), 0);
+            assert_nothing_ran(d, h, "gnuplot plots.gp in the report folder");
+        } else {
+            fprintf(stderr, "SKIP gnuplot in a hostile folder: gnuplot is not installed\n");
+        }
+    }
+    /* Standard input, copied into a TMPDIR of that name and gone after. */
+    {
+        const char *args[] = {"discover", "--real", "-", "--sim", s, "--channel", "acceleration",
+                              "--role", "velocity=velocity", "--json", NULL};
+        snprintf(where, sizeof where, "%s/%s", d, r);
+        child_stdin = where;
+        child_tmpdir = sub;
+        path_step(d, h, args, 0, NULL, err, sizeof err);
+        child_stdin = child_tmpdir = NULL;
+        ck_assert_msg(!any_named(sub, "foldest-spool"), "a spool file left in '%s'", sub);
+    }
+    /* Failures name the path as given. */
+    {
+        const char *args[] = {"stats", missing, NULL};
+        snprintf(where, sizeof where, "%s: cannot open", missing);
+        path_step(d, h, args, 4, where, err, sizeof err);
+    }
+    {
+        const char *args[] = {"calibrate", "--columns", "mx,my,mz", "--apply", nocal, m, NULL};
+        snprintf(where, sizeof where, "%s: cannot create", nocal);
+        path_step(d, h, args, 4, where, err, sizeof err);
+    }
+    {
+        const char *args[] = {"synth", "--effect", "bias", "--rows", "100", "--real", nor,
+                              "--sim", s, NULL};
+        snprintf(where, sizeof where, "%s: cannot create", nor);
+        path_step(d, h, args, 4, where, err, sizeof err);
+    }
+    {
+        const char *args[] = {"discover", "--real", r, "--sim", s, "--channel", "acceleration",
+                              "--report", norep, NULL};
+        snprintf(where, sizeof where, "%s: cannot create", norep);
+        path_step(d, h, args, 4, where, err, sizeof err);
+    }
+    remove_tree(d);
+}
+END_TEST
+
+/* Column names reach the plot script as gnuplot strings: backquotes, '@'
+   macros, quotes that would close the string and call system(), in the
+   time, channel and state columns; the report is drawn, the labels say
+   the names, and nothing runs, also when the script is run again. */
+START_TEST(column_names_in_the_plot_script_run_nothing)
+{
+    static const char *const time = "t`touch PWNED`";
+    static const char *const channel =
+        "`touch PWNED` @ARG0 $(touch PWNED)' . system('touch PWNED') . 'x_m";
+    static const char *const vel = "v' . system('touch PWNED') . '";
+    static char text[1 << 20];
+    char d[64], path[256], role[256];
+    const char *args[] = {"discover", "--real", "r.csv", "--sim", "s.csv", "--channel", channel,
+                          "--time", time, "--role", role, "--base", "bias", "--report", "rep",
+                          NULL};
+    snprintf(d, sizeof d, "/tmp/foldest-columns-XXXXXX");
+    ck_assert_ptr_nonnull(mkdtemp(d));
+    make_pair(d, "3000");
+    for (int k = 0; k < 2; k++) {               /* rename the columns */
+        FILE *f;
+        char *nl;
+        snprintf(path, sizeof path, "%s/%s", d, k ? "s.csv" : "r.csv");
+        fe_test_read_file(path, text, sizeof text);
+        nl = strchr(text, '\n');
+        ck_assert_ptr_nonnull(nl);
+        f = fopen(path, "w");
+        ck_assert_ptr_nonnull(f);
+        if (k)
+            fprintf(f, "%s,%s,position,%s,input%s", time, channel, vel, nl);
+        else
+            fprintf(f, "%s,%s%s", time, channel, nl);
+        fclose(f);
+    }
+    snprintf(role, sizeof role, "%s=velocity", vel);
+    {
+        char err[4096];
+        int status = run_argv(d, 022, NULL, args);
+        read_stderr(d, err, sizeof err);
+        ck_assert_msg(status == 0, "status %d\n%s", status, err);
+    }
+    snprintf(path, sizeof path, "%s/rep", d);
+    ck_assert_msg(!exists(d, "PWNED") && !exists(path, "PWNED"),
+                  "a column name ran a command when foldest drew the plots");
+    snprintf(path, sizeof path, "%s/rep/plots.gp", d);
+    fe_test_read_file(path, text, sizeof text);
+    ck_assert_msg(strstr(text, "set xlabel 't`touch PWNED`'\n") != NULL, "%s", text);
+    ck_assert_msg(strstr(text, "set xlabel 'v'' . system(''touch PWNED'') . '''\n") != NULL,
+                  "%s", text);
+    ck_assert_msg(strstr(text, "(recording \xe2\x88\x92 model) [m]'\n") != NULL, "%s", text);
+    snprintf(path, sizeof path, "%s/rep", d);
+    if (exists(path, "residual_time.png"))
+        ck_assert_int_eq(gnuplot_in(path), 0);
+    else
+        fprintf(stderr, "SKIP gnuplot on hostile column names: gnuplot is not installed\n");
+    ck_assert_msg(!exists(d, "PWNED") && !exists(path, "PWNED"),
+                  "a column name ran a command when the script ran again");
     remove_tree(d);
 }
 END_TEST
@@ -613,6 +864,9 @@ Suite *fe_hostile_suite(void)
                         (int)(sizeof synth_cases / sizeof synth_cases[0]));
     tcase_add_loop_test(t, report_folder_names_run_nothing, 0,
                         (int)(sizeof hostile_folders / sizeof hostile_folders[0]));
+    tcase_add_loop_test(t, every_path_argument_takes_any_name, 0,
+                        (int)(sizeof hostile_names / sizeof hostile_names[0]));
+    tcase_add_test(t, column_names_in_the_plot_script_run_nothing);
     tcase_add_loop_test(t, outputs_take_the_umask_mode, 0, 2);
     tcase_add_loop_test(t, full_standard_output_is_an_error, 0,
                         (int)(sizeof full_commands / sizeof full_commands[0]));

@@ -134,9 +134,16 @@ typedef struct fe_residual_cell {
     double n;                   /* rows */
     double sum0, sq0;           /* residual before: sum, sum of squares */
     double sum1, sq1;           /* after */
-    double t0, t1;              /* time of the first and last row */
+    double t0, t1;              /* time (bins: value) of the first and last row */
+    double sum_at;              /* sum of the rows' times (bins: values) */
     int pair, pair1;            /* recordings of those rows */
 } fe_residual_cell;
+
+/* fe_residual_cell_add: one row at time (or value) `at` of recording
+   `pair`, with its residual before and after, into c.  Exposed so that a
+   caller can keep cells of its own (a plot's blocks) in the same form. */
+void fe_residual_cell_add(fe_residual_cell *c, double at, int pair, double before,
+                          double after);
 
 typedef struct fe_residual_map {
     size_t blocks;              /* K: block K holds the held-out rows */

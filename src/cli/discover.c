@@ -924,7 +924,70 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fprintf(f, "  (%s)\n", o->why);
 }
 /* Print the story ends here */
-/* [[file:../../literate/cli_discover.org::Write the report][Write the report]] */
+/* [[file:../../literate/cli_discover.org::The unit in a column name, and a mean's standard error][The unit in a column name, and a mean's standard error]] */
+/* Unit symbols recognised after the last '_' of a column name. */
+static const char *const fe__unit_suffixes[] = {
+    "m", "mm", "cm", "km", "um", "nm", "s", "ms", "us", "ns", "min", "h",
+    "K", "C", "degC", "V", "mV", "uV", "A", "mA", "uA", "Ohm", "W", "mW", "J",
+    "Pa", "kPa", "hPa", "MPa", "bar", "mbar", "N", "Nm", "Hz", "kHz",
+    "rad", "deg", "g", "mg", "kg", "T", "mT", "uT", "nT", "G", "mG", NULL};
+
+/* The unit of the column `name` into unit[len]: the text in a final [...]
+   or (...), else a listed symbol after the last '_'; "" when none. */
+static void fe__unit_of(const char *name, char *unit, size_t len)
+{
+    size_t n = strlen(name);
+    const char *u;
+    unit[0] = '\0';
+    while (n > 0 && name[n - 1] == ' ')
+        n--;
+    if (n > 0 && (name[n - 1] == ']' || name[n - 1] == ')')) {
+        char open = name[n - 1] == ']' ? '[' : '(';
+        size_t a = n - 1, b = n - 1;            /* the unit is name[a, b) */
+        while (a > 0 && name[a - 1] != open)
+            a--;
+        if (a == 0)
+            return;                             /* no opening bracket */
+        while (a < b && name[a] == ' ')
+            a++;
+        while (b > a && name[b - 1] == ' ')
+            b--;
+        if (b - a < len) {
+            memcpy(unit, name + a, b - a);
+            unit[b - a] = '\0';
+        }
+        return;
+    }
+    u = strrchr(name, '_');
+    if (u == NULL || u == name)
+        return;
+    for (const char *const *k = fe__unit_suffixes; *k != NULL; k++)
+        if (strcmp(u + 1, *k) == 0 && strlen(*k) < len) {
+            strcpy(unit, *k);
+            return;
+        }
+}
+
+/* The standard error of the mean of n rows of sum `sum` and sum of squares
+   `sq`, each row worth `w` independent rows (at least one row in all). */
+static double fe__mean_se(double n, double sum, double sq, double w)
+{
+    double var = (sq - sum * sum / n) / (n - 1.0), neff = n * w;
+    return sqrt((var > 0.0 ? var : 0.0) / (neff > 1.0 ? neff : 1.0));
+}
+/* The unit in a column name, and a mean's standard error ends here */
+/* [[file:../../literate/cli_discover.org::Report files and the means of blocks and bins][Report files and the means of blocks and bins]] */
+typedef struct fe__plot_info {
+    const char *time_name;      /* the time column's name */
+    const char *channel;        /* the channel's column name */
+    const char *state_var;      /* position, velocity or temperature; NULL: none */
+    const char *state_name;     /* its column's name */
+    double held0, held1;        /* the held-out rows' span on the time axis */
+    int held;                   /* there are held-out rows */
+    const double *joins;        /* where each later recording starts */
+    size_t njoins;
+} fe__plot_info;
+
 static int fe__have_gnuplot(void)
 {
     char *const argv[] = {"gnuplot", "--version", NULL};
@@ -972,31 +1035,102 @@ static void fe__report_pending(const char *dir, int made)
         fe_cli_pending_add(dir, 1);
 }
 
-/* Write per-block and per-bin means: what the eye needs to see a concealed
-   effect that the cloud of points hides. */
-static int fe__write_means(const char *path, const fe_residual_cell *s, size_t n, int use_index)
+/* Write the means of blocks (`blocks` set: the middle time, then the
+   held-out flag for i >= nfit, first and last time, recording) or of bins
+   (the mean state value), with their standard errors; rows worth w0
+   before, w1 after.  0, or -1 when the file could not be written. */
+static int fe__write_means(const char *path, const fe_residual_cell *s, size_t n, size_t nfit,
+                           int blocks, double w0, double w1)
 {
     FILE *f = fopen(path, "w");
+    int bad;
     if (f == NULL)
         return -1;
-    for (size_t i = 0; i < n; i++)
-        if (s[i].n > 0)
-            fprintf(f, "%.10g %.6g %.6g %.0f %.6g %.6g\n",
-                    use_index ? (double)i + 0.5 : 0.5 * (s[i].t0 + s[i].t1),
-                    s[i].sum0 / s[i].n, s[i].sum1 / s[i].n, s[i].n,
-                    sqrt(s[i].sq0 / s[i].n), sqrt(s[i].sq1 / s[i].n));
-    return fclose(f);
+    for (size_t i = 0; i < n; i++) {
+        const fe_residual_cell *b = &s[i];
+        if (b->n < 2)
+            continue;
+        fprintf(f, "%.15g %.6g %.6g %.6g %.6g %.0f %.6g %.6g",
+                blocks ? 0.5 * (b->t0 + b->t1) : b->sum_at / b->n,
+                b->sum0 / b->n, fe__mean_se(b->n, b->sum0, b->sq0, w0),
+                b->sum1 / b->n, fe__mean_se(b->n, b->sum1, b->sq1, w1),
+                b->n, sqrt(b->sq0 / b->n), sqrt(b->sq1 / b->n));
+        if (blocks)
+            fprintf(f, " %d %.15g %.15g %d", i >= nfit, b->t0, b->t1, b->pair + 1);
+        fputc('\n', f);
+    }
+    bad = ferror(f);
+    return fclose(f) != 0 || bad ? -1 : 0;
+}
+/* Report files and the means of blocks and bins ends here */
+/* [[file:../../literate/cli_discover.org::The page's list of data files][The page's list of data files]] */
+static void fe__report_data(FILE *f, const fe__plot_info *pi)
+{
+    fprintf(f, "## Data\n\n"
+               "Plain text, columns separated by one space; blocks and bins of fewer than "
+               "two rows are left out.  Standard errors: the rows' spread over the square "
+               "root of their count times what one row is worth in independent rows under "
+               "the noise model (the baseline's before, the final model's after).\n\n"
+               "- `blocks.dat`, one line per time block: 1 middle time (column `%s`%s), "
+               "2 mean residual before the discovered terms, 3 its standard error, "
+               "4 mean residual after, 5 its standard error, 6 rows, 7 RMS before, "
+               "8 RMS after, 9 held out (1) or fitted (0), 10 first time, 11 last time, "
+               "12 recording (1, 2, ...).\n",
+            pi->time_name, pi->njoins > 0 ? "; recordings end to end" : "");
+    if (pi->state_var != NULL)
+        fprintf(f, "- `bins.dat`, one line per bin of `%s` (40 equal bins over its range, all "
+                   "rows): 1 mean value of `%s` in the bin, 2 to 8 as in `blocks.dat`.\n",
+                pi->state_name, pi->state_name);
+    fprintf(f, "- `residuals.dat`, every few rows: 1 time (the recording's own clock), "
+               "2 residual before, 3 after, 4 position, 5 velocity, 6 temperature "
+               "(0 where the role is not given).\n"
+               "- `plots.gp`, the gnuplot script: `gnuplot plots.gp` in this folder "
+               "draws the plots again.\n");
+}
+/* The page's list of data files ends here */
+/* [[file:../../literate/cli_discover.org::The page and the plot script][The page and the plot script]] */
+/* The series of a plot: before and after (only one when no term was
+   found), fitted and held out (only fitted when `filter` is NULL). */
+static void fe__plot_series(FILE *f, const char *data, const char *filter, int terms,
+                            int held)
+{
+    static const char *const colour[2] = {"#c0504d", "#1f4e79"};
+    int first = 1;
+    fprintf(f, "plot ");
+    for (int h = 0; h <= held; h++)
+        for (int a = 0; a <= terms; a++) {
+            char y[64];
+            if (filter != NULL)
+                snprintf(y, sizeof y, "(%s == %d ? $%d : NaN)", filter, h, 2 + 2 * a);
+            else
+                snprintf(y, sizeof y, "%d", 2 + 2 * a);
+            fprintf(f, "%s'%s' using 1:%s:%d with yerrorlines pt %d ps 0.9 lw 1.5 "
+                       "lc rgb '%s' title '%s%s'",
+                    first ? "" : ", \\\n     ", first ? data : "", y, 3 + 2 * a,
+                    h ? 6 - 2 * a : 7 - 2 * a, colour[a],
+                    !terms ? "mean residual" : a ? "after" : "before",
+                    !held ? "" : h ? " (held out)" : " (fitted)");
+            first = 0;
+        }
+    fputc('\n', f);
 }
 
-static int fe__write_report(const char *dir, const fe__outcome *o, const char *points,
-                            const char *state_var, int state_col, char *err, size_t errlen)
+static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plot_info *pi,
+                            char *err, size_t errlen)
 {
-    char path[4096], script[4096], qvar[512] = "";
+    /* U+2212 MINUS SIGN and U+00B1 PLUS-MINUS SIGN, in UTF-8. */
+    static const char minus[] = "\xe2\x88\x92", pm[] = "\xc2\xb1";
+    char path[4096], script[4096], unit[256], qtime[512], qchan[512], qstate[512] = "",
+         qunit[512];
     fe_cli_output out;
     FILE *f;
-    int plots = fe__have_gnuplot(), rc;
-    if (state_var != NULL && fe__gnuplot_quote(qvar, sizeof qvar, state_var)) {
-        snprintf(err, errlen, "%.200s: column name too long for the plot script", state_var);
+    int plots = fe__have_gnuplot(), terms = o->r->steps > 0, rc;
+    fe__unit_of(pi->channel, unit, sizeof unit);
+    if (fe__gnuplot_quote(qtime, sizeof qtime, pi->time_name)
+        || fe__gnuplot_quote(qchan, sizeof qchan, pi->channel)
+        || fe__gnuplot_quote(qunit, sizeof qunit, unit)
+        || (pi->state_var != NULL && fe__gnuplot_quote(qstate, sizeof qstate, pi->state_name))) {
+        snprintf(err, errlen, "a column name is too long for the plot script");
         return FE_CLI_USAGE;
     }
     snprintf(path, sizeof path, "%s/report.md", dir);
@@ -1006,52 +1140,73 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const char *p
     fprintf(f, "# foldest discover report\n\n**Verdict: %s**\n\n```\n", o->verdict);
     fe__print_story(f, o);
     fprintf(f, "```\n\n");
-    if (plots) {
-        fprintf(f, "## Residual against time\n\n![residual against time](residual_time.png)\n\n");
-        if (state_var != NULL)
-            fprintf(f, "## Residual against %s\n\n![residual against %s](residual_state.png)\n\n",
-                    state_var, state_var);
-    } else {
-        fprintf(f, "(gnuplot is not installed: no plots; the points are in %s)\n", points);
+    if (!plots)
+        fprintf(f, "(gnuplot is not installed: no plots.  `gnuplot plots.gp` in this folder "
+                   "draws them where it is.)\n\n");
+    fprintf(f, "## Residual against time\n\n");
+    if (plots)
+        fprintf(f, "![mean residual against time](residual_time.png)\n\n");
+    fprintf(f, "Mean residual of `%s` (recording %s model) per time block%s, at the block's "
+               "middle time, with %s1 standard error.%s\n\n",
+            pi->channel, minus, terms ? ", before and after the discovered terms" : "", pm,
+            pi->held ? "  Blocks of held-out rows (never seen by selection or fitting) "
+                       "are drawn with open points on the grey band." : "");
+    if (pi->state_var != NULL) {
+        fprintf(f, "## Residual against %s\n\n", pi->state_name);
+        if (plots)
+            fprintf(f, "![mean residual against %s](residual_state.png)\n\n", pi->state_name);
+        fprintf(f, "Mean residual in 40 equal bins of `%s` (the %s), all rows, with %s1 "
+                   "standard error.\n\n", pi->state_name, pi->state_var, pm);
     }
-    fprintf(f, "Data: `blocks.dat` and `bins.dat` (block or state value, mean residual "
-               "before, after, rows, RMS before, after) and `residuals.dat` (time, residual "
-               "before, after, position, velocity, temperature; every few rows).\n");
+    fe__report_data(f, pi);
     if ((rc = fe_cli_output_commit(&out, err, errlen)) != FE_CLI_OK)
         return rc;
-    if (!plots)
-        return FE_CLI_OK;
+
     snprintf(script, sizeof script, "%s/plots.gp", dir);
     f = fopen(script, "w");
     if (f == NULL) {
         snprintf(err, errlen, "%.1000s: cannot write: %s", script, strerror(errno));
         return FE_CLI_IO;
     }
-    fprintf(f, "set terminal pngcairo size 1000,500 noenhanced\n"
-               "set datafile separator ' '\nset grid\nset key outside\n"
+    fprintf(f, "# foldest discover: the report's plots.  In this folder: gnuplot plots.gp\n"
+               "set terminal pngcairo size 1000,600 noenhanced\n"
+               "set encoding utf8\nset datafile separator ' '\nset grid\n"
+               "set key below horizontal samplen 3 spacing 1.2\nset bmargin 5.5\n"
+               "set bars small\nset xzeroaxis lt -1 lw 1 lc rgb '#404040'\n"
                "if (ARGC > 0) cd ARG1\n"
                "set output 'residual_time.png'\n"
-               "set xlabel 'time block (fitted blocks, then the held-out rows)'\n"
-               "set ylabel 'RMS of recording - model'\n"
-               "set title 'Residual RMS per time block, before and after the discovered terms'\n"
-               "plot 'blocks.dat' using 1:5 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
-               "'' using 1:6 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n");
-    (void)points;
-    (void)state_col;
-    if (state_var != NULL)
-        fprintf(f, "set output 'residual_state.png'\nset xlabel '%s'\n"
-                   "set title 'Residual mean against %s (40 bins)'\n"
-                   "plot 'bins.dat' using 1:2 with linespoints lw 2 lc rgb '#c0504d' title 'before', "
-                   "'' using 1:3 with linespoints lw 2 lc rgb '#1f4e79' title 'after'\n",
-                qvar, qvar);
-    fclose(f);
-    if (fe__run_gnuplot(script, dir) != 0) {
+               "set title '%s: mean residual per time block, %s1 standard error'\n"
+               "set xlabel '%s%s'\n"
+               "set ylabel 'mean residual (recording %s model)%s%s%s'\n",
+            qchan, pm, qtime, pi->njoins > 0 ? " (recordings end to end)" : "", minus,
+            unit[0] ? " [" : "", qunit, unit[0] ? "]" : "");
+    if (pi->held)
+        fprintf(f, "set object 1 rect from first %.15g, graph 0 to first %.15g, graph 1 behind "
+                   "fillcolor rgb '#e6e6e6' fillstyle solid 1.0 noborder\n"
+                   "set label 1 'held out' at first %.15g, graph 0.96 left offset 0.5,0\n",
+                pi->held0, pi->held1, pi->held0);
+    for (size_t j = 0; j < pi->njoins; j++)
+        fprintf(f, "set arrow %zu from first %.15g, graph 0 to first %.15g, graph 1 nohead "
+                   "dashtype 3 lc rgb '#707070'\n", j + 1, pi->joins[j], pi->joins[j]);
+    fe__plot_series(f, "blocks.dat", pi->held ? "$9" : NULL, terms, pi->held);
+    if (pi->state_var != NULL) {
+        fprintf(f, "unset object 1\nunset label 1\nunset arrow\n"
+                   "set output 'residual_state.png'\n"
+                   "set title '%s: mean residual in 40 bins of %s (all rows), %s1 standard error'\n"
+                   "set xlabel '%s'\n", qchan, qstate, pm, qstate);
+        fe__plot_series(f, "bins.dat", NULL, terms, 0);
+    }
+    if (fclose(f) != 0) {
+        snprintf(err, errlen, "%.1000s: cannot write: %s", script, strerror(errno));
+        return FE_CLI_IO;
+    }
+    if (plots && fe__run_gnuplot(script, dir) != 0) {
         snprintf(err, errlen, "%.1000s: gnuplot failed", script);
         return FE_CLI_IO;
     }
     return FE_CLI_OK;
 }
-/* Write the report ends here */
+/* The page and the plot script ends here */
 /* [[file:../../literate/cli_discover.org::Run discovery on recordings][Run discovery on recordings]] */
 static int fe__discover_sphere_main(int argc, char **argv);
 
@@ -1085,6 +1240,12 @@ typedef struct fe__run {
     double *per_g;
     FILE *pts;
     char points[4200];
+    /* The report's time plot: the fitted blocks, then the held-out rows in
+       blocks of the same length, on a time axis that lays the recordings
+       end to end. */
+    fe_residual_cell *pblocks;
+    size_t nplot, njoins;
+    double joins[FE__MAX_PAIRS], held_x0, last_x, shift, step_x;
     fe__outcome out;
     char err[2048];
 } fe__run;
@@ -1103,6 +1264,7 @@ static void fe__run_free(fe__run *u)
     free(u->panel);
     free(u->res);
     free(u->map);
+    free(u->pblocks);
     free(u->per);
     free(u->per_g);
     free(u->out.per_coef);
@@ -1269,6 +1431,12 @@ static int fe__run_open_report(fe__run *u)
         return FE_CLI_IO;
     }
     fe__report_pending(u->a.report, made);
+    u->nplot = (size_t)u->a.blocks
+               + (u->out.heldout > 0 ? (size_t)ceil((double)u->out.heldout
+                                                    * (double)u->a.blocks
+                                                    / (double)u->out.fit) : 0);
+    if ((u->pblocks = calloc(u->nplot, sizeof *u->pblocks)) == NULL)
+        return FE__OOM(u);
     snprintf(u->points, sizeof u->points, "%s/residuals.dat", u->a.report);
     if ((u->pts = fopen(u->points, "w")) == NULL) {
         snprintf(u->err, sizeof u->err, "%.1000s: cannot write: %s", u->points,
@@ -1333,6 +1501,26 @@ static int fe__run_map(fe__run *u)
             snprintf(u->err, sizeof u->err, "a residual is not finite at t = %g", s.t);
             return FE_CLI_INPUT;
         }
+        if (u->pblocks != NULL) {
+            double x;
+            size_t K = (size_t)u->a.blocks;
+            size_t pk = i < u->out.fit ? (size_t)((double)i * (double)K / (double)u->out.fit)
+                        : K + (size_t)((double)(i - u->out.fit) * (double)K / (double)u->out.fit);
+            if (new_pair && i > 0) {
+                if (s.t + u->shift <= u->last_x)
+                    u->shift = u->last_x + u->step_x - s.t;
+                if (u->njoins < FE__MAX_PAIRS)
+                    u->joins[u->njoins++] = s.t + u->shift;
+            }
+            x = s.t + u->shift;
+            if (i > 0 && !new_pair)
+                u->step_x = x - u->last_x;
+            u->last_x = x;
+            if (i == u->out.fit)
+                u->held_x0 = x;
+            fe_residual_cell_add(&u->pblocks[pk < u->nplot ? pk : u->nplot - 1], x, pair, before,
+                                 after);
+        }
         if (r->ncols > 0) {
             double row[FE_DISCOVER_MAX_COLUMNS];
             for (size_t j = 0; j < r->ncols; j++)
@@ -1389,38 +1577,52 @@ static void fe__run_locate(fe__run *u)
     u->out.nbase = u->nbase;
 }
 
-/* The report: the plot data and report.md (with plots when gnuplot is
-   there).  The state variable plotted is the first located region's, else
-   velocity, temperature or position, whichever the rows carry. */
+/* The report: the plot data, report.md and plots.gp, and the plots when
+   gnuplot is there. */
 static int fe__run_report(fe__run *u)
 {
-    const char *var = NULL;
-    int col = 0, rc = FE_CLI_OK;
+    fe__plot_info pi;
+    const fe__pair *p0 = &u->a.pairs[0];
+    const fe_discover_result *r = u->res;
+    int v = -1;                 /* map->bin[v]: position, velocity, temperature */
     char bp[4200];
+    double w0 = fe_discover_row_worth(&r->path[0].noise, r->baseline.n);
+    double w1 = fe_discover_row_worth(&r->noise, r->final.n);
+    int rc;
     fclose(u->pts);
     u->pts = NULL;
-    for (size_t i = 0; i < u->out.nlocated && var == NULL; i++)
-        if (u->out.located[i].region != FE_REGION_TIME)
-            var = fe_region_variable(u->out.located[i].region);
-    if (var != NULL && strcmp(var, "speed") == 0)
-        var = "velocity";
-    if (var == NULL)
-        var = u->roles & FE_ROLE_VELOCITY ? "velocity"
-              : u->roles & FE_ROLE_TEMPERATURE ? "temperature"
-              : u->roles & FE_ROLE_POSITION ? "position" : NULL;
-    if (var != NULL)
-        col = strcmp(var, "position") == 0 ? 4 : strcmp(var, "velocity") == 0 ? 5 : 6;
+    memset(&pi, 0, sizeof pi);
+    for (size_t i = 0; i < u->out.nlocated && v < 0; i++)
+        if (u->out.located[i].region != FE_REGION_TIME) {
+            const char *var = fe_region_variable(u->out.located[i].region);
+            v = strcmp(var, "position") == 0 ? 0 : strcmp(var, "temperature") == 0 ? 2 : 1;
+        }
+    if (v < 0)
+        v = u->roles & FE_ROLE_VELOCITY ? 1 : u->roles & FE_ROLE_TEMPERATURE ? 2
+            : u->roles & FE_ROLE_POSITION ? 0 : -1;
+    pi.time_name = p0->real.names[p0->real_cols[0]];
+    pi.channel = p0->real.names[p0->real_cols[1]];
+    if (v >= 0 && p0->role_col[v] >= 0) {
+        pi.state_var = fe__role_names[v];
+        pi.state_name = p0->sim.names[p0->sim_cols[p0->role_col[v]]];
+    }
+    pi.held = u->out.heldout > 0;
+    pi.held0 = u->held_x0;
+    pi.held1 = u->last_x;
+    pi.joins = u->joins;
+    pi.njoins = u->njoins;
     snprintf(bp, sizeof bp, "%s/blocks.dat", u->a.report);
-    if (fe__write_means(bp, u->map->block, (size_t)u->a.blocks + 1, 1) != 0)
-        rc = FE_CLI_IO;
+    rc = fe__write_means(bp, u->pblocks, u->nplot, (size_t)u->a.blocks, 1, w0, w1) != 0
+             ? FE_CLI_IO : FE_CLI_OK;
     snprintf(bp, sizeof bp, "%s/bins.dat", u->a.report);
-    if (var != NULL && fe__write_means(bp, u->map->bin[col - 4], FE_RESIDUAL_BINS, 0) != 0)
+    if (rc == FE_CLI_OK && pi.state_var != NULL
+        && fe__write_means(bp, u->map->bin[v], FE_RESIDUAL_BINS, FE_RESIDUAL_BINS, 0, w0, w1) != 0)
         rc = FE_CLI_IO;
-    if (rc == FE_CLI_IO) {
+    if (rc != FE_CLI_OK) {
         snprintf(u->err, sizeof u->err, "%.1000s: cannot write the plot data", u->a.report);
         return rc;
     }
-    rc = fe__write_report(u->a.report, &u->out, u->points, var, col, u->err, sizeof u->err);
+    rc = fe__write_report(u->a.report, &u->out, &pi, u->err, sizeof u->err);
     if (rc != FE_CLI_OK)
         return rc;
     fe_cli_pending_clear();

@@ -16,6 +16,24 @@ static const char fe__synth_help[] =
     "'none' (mechanical rig) or 'none_thermal' (thermal rig).  The truth and the\n"
     "command that analyses the pair are printed on standard error.\n";
 
+/* `s` as one word of a POSIX shell (see above). */
+static void fe__shell_word(FILE *f, const char *s)
+{
+    static const char safe[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                               "0123456789_-./,+:=@%";
+    if (*s != '\0' && strspn(s, safe) == strlen(s)) {
+        fputs(s, f);
+        return;
+    }
+    fputc('\'', f);
+    for (; *s != '\0'; s++)
+        if (*s == '\'')
+            fputs("'\\''", f);
+        else
+            fputc(*s, f);
+    fputc('\'', f);
+}
+
 int fe_cli_synth(int argc, char **argv)
 {
     const char *effect = NULL, *real = NULL, *sim = NULL;
@@ -125,9 +143,12 @@ int fe_cli_synth(int argc, char **argv)
     fprintf(stderr, "synth: %zu rows; hidden effect %s, coefficient %.6g; noise sd %g, "
                     "lag-one correlation %g\n",
             spec.rows, effect, g.coefficient, spec.noise_sd, spec.noise_rho);
-    fprintf(stderr, "analyse with:\n  foldest discover --real %s --sim %s --channel %s "
-                    "%s --base %s --holdout 0.3\n",
-            real, sim, g.thermal ? "load" : "acceleration",
+    fprintf(stderr, "analyse with:\n  foldest discover --real ");
+    fe__shell_word(stderr, real);
+    fprintf(stderr, " --sim ");
+    fe__shell_word(stderr, sim);
+    fprintf(stderr, " --channel %s %s --base %s --holdout 0.3\n",
+            g.thermal ? "load" : "acceleration",
             g.thermal ? "--role temperature=temperature --role ambient=ambient"
                       : "--role position=position --role velocity=velocity --role input=input",
             strcmp(effect, "bias") == 0 ? "gain" : strcmp(effect, "gain") == 0 ? "bias"

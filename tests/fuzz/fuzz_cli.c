@@ -6,7 +6,10 @@
    could reach outside the scratch directory (containing '/'), that read
    standard input ("-"), or that would make the run long (synth, numbers
    of more than four digits) are replaced by "@".  The command must return
-   a documented exit status (0 to 4) and leave no temporary file behind. */
+   a documented exit status (0 to 4), leave no temporary file behind, and
+   create no file that its arguments did not name: an output name such as
+   x';touch PWNED;' (the seeds *_shell_names) is a name, and a PWNED beside
+   it would mean that something ran it. */
 #include "fuzz_common.h"
 
 #include <dirent.h>
@@ -33,9 +36,47 @@ static int named(const char *name, int argc, char **argv)
     return 0;
 }
 
+/* Does an argument name `name`, as itself or as the value in --opt=name? */
+static int named_as_value(const char *name, int argc, char **argv)
+{
+    for (int i = 0; i < argc; i++) {
+        const char *eq = strchr(argv[i], '=');
+        if (strcmp(argv[i], name) == 0 || (eq != NULL && strcmp(eq + 1, name) == 0))
+            return 1;
+    }
+    return 0;
+}
+
+/* The files of a report written into the working directory (--report .). */
+static int report_file(const char *name)
+{
+    static const char *const names[] = {"report.md", "plots.gp", "blocks.dat", "bins.dat",
+                                        "residuals.dat", "residual_time.png",
+                                        "residual_state.png"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(name, names[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* Remove the folder `name` and the files in it (a --report folder), without
+   a shell: the name is whatever the fuzzer made. */
+static void remove_folder(const char *name)
+{
+    DIR *d = opendir(name);
+    struct dirent *e;
+    REQUIRE(d != NULL);
+    while ((e = readdir(d)) != NULL)
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0)
+            REQUIRE(unlinkat(dirfd(d), e->d_name, 0) == 0);
+    closedir(d);
+    REQUIRE(rmdir(name) == 0);
+}
+
 /* Remove everything in the scratch directory (one level of subdirectories:
    --report DIR); fail if a half-written output (NAME.tmp.XXXXXX) is left,
-   unless the arguments named that very file. */
+   unless the arguments named that very file, or if anything is there that
+   no argument named. */
 static void sweep(int argc, char **argv)
 {
     DIR *d = opendir(".");
@@ -48,11 +89,13 @@ static void sweep(int argc, char **argv)
             fprintf(stderr, "fuzz_cli: temporary file left behind: %s\n", e->d_name);
             abort();
         }
-        if (unlink(e->d_name) != 0) {
-            char cmd[600];
-            snprintf(cmd, sizeof cmd, "rm -rf './%s'", e->d_name);
-            REQUIRE(system(cmd) == 0);
+        if (strcmp(e->d_name, "in.csv") != 0 && !report_file(e->d_name)
+            && strstr(e->d_name, ".tmp.") == NULL && !named_as_value(e->d_name, argc, argv)) {
+            fprintf(stderr, "fuzz_cli: '%s' was created, but no argument names it\n", e->d_name);
+            abort();
         }
+        if (unlink(e->d_name) != 0)
+            remove_folder(e->d_name);
     }
     closedir(d);
 }
