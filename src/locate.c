@@ -102,6 +102,29 @@ void fe_innovations_break(fe_innovations *a)
 }
 /* Fold a report into its block ends here */
 /* [[file:../literate/locate.org::Merge consecutive parts][Merge consecutive parts]] */
+/* The span of a cell (time and recording of its first and last row)
+   when the cell of a later part, with times y0 .. y1 in its recordings
+   q0 .. q1 numbered from 0 in that part, joins it; x_empty when the cell
+   had no rows.  The later part's recordings are numbered on by `shift`. */
+static void fe__span_join(double *t0, int *pair, double *t1, int *pair1, int x_empty,
+                          double y0, int q0, double y1, int q1, int shift)
+{
+    if (x_empty) {
+        *t0 = y0;
+        *pair = q0 + shift;
+    }
+    *t1 = y1;
+    *pair1 = q1 + shift;
+}
+
+/* How far the recordings of a later part are numbered on when it joins a
+   part of n rows whose current recording is `recording`: the same
+   recording when the later part's first row follows on (first_linked). */
+static int fe__recording_shift(uint64_t n, int recording, int first_linked)
+{
+    return n == 0 ? recording : recording + (first_linked ? 0 : 1);
+}
+
 int fe_innovations_merge(fe_innovations *a, const fe_innovations *b)
 {
     int shift;
@@ -111,7 +134,7 @@ int fe_innovations_merge(fe_innovations *a, const fe_innovations *b)
         return FE_EMISMATCH;
     if (b->n == 0)
         return FE_OK;
-    shift = a->n == 0 ? a->recording : a->recording + (b->first_linked ? 0 : 1);
+    shift = fe__recording_shift(a->n, a->recording, b->first_linked);
     if (a->n > 0 && a->have_prev && b->first_linked && b->first_dim > 0) {
         size_t d = a->prev_dim < b->first_dim ? a->prev_dim : b->first_dim;
         fe_innovation_block *bk = &a->block[(size_t)(b->row0 * a->blocks / a->total)];
@@ -124,12 +147,8 @@ int fe_innovations_merge(fe_innovations *a, const fe_innovations *b)
         const fe_innovation_block *y = &b->block[k];
         if (y->n == 0)
             continue;
-        if (x->n == 0) {
-            x->t0 = y->t0;
-            x->pair = y->pair + shift;
-        }
-        x->t1 = y->t1;
-        x->pair1 = y->pair1 + shift;
+        fe__span_join(&x->t0, &x->pair, &x->t1, &x->pair1, x->n == 0, y->t0, y->pair, y->t1,
+                      y->pair1, shift);
         x->n += y->n;
         x->dof += y->dof;
         x->nis += y->nis;
@@ -544,12 +563,8 @@ static void fe__cell_merge(fe_residual_cell *x, const fe_residual_cell *y, int s
 {
     if (y->n == 0)
         return;
-    if (x->n == 0) {
-        x->t0 = y->t0;
-        x->pair = y->pair + shift;
-    }
-    x->t1 = y->t1;
-    x->pair1 = y->pair1 + shift;
+    fe__span_join(&x->t0, &x->pair, &x->t1, &x->pair1, x->n == 0, y->t0, y->pair, y->t1,
+                  y->pair1, shift);
     x->n += y->n;
     x->sum_at += y->sum_at;
     x->sum0 += y->sum0;
@@ -569,7 +584,7 @@ int fe_residual_map_merge(fe_residual_map *a, const fe_residual_map *b)
         return FE_EMISMATCH;
     if (b->n == 0)
         return FE_OK;
-    shift = a->n == 0 ? a->recording : a->recording + (b->first_linked ? 0 : 1);
+    shift = fe__recording_shift(a->n, a->recording, b->first_linked);
     for (size_t k = 0; k <= a->blocks; k++)
         fe__cell_merge(&a->block[k], &b->block[k], shift);
     for (size_t g = 0; g < a->nregions; g++)
