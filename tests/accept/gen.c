@@ -440,13 +440,20 @@ static void levinson(const double *r, int p, double *a)
     }
 }
 
+/* The innovations of x under the AR(p) filter a, for rows p .. n - 1 only,
+   into out[0 .. n - p): the conditional GLS.  The first p rows, filtered
+   with fewer than p lags, are not innovations (row 0 keeps the series'
+   whole variance, gamma_0, not sigma_eta^2); counted as if they were, they
+   overstate z for columns with a level at the start (gain, bias, slow
+   terms) under strongly coloured noise: for a gain under the resonant
+   AR(2), z = -10.9 instead of -1.0.  Dropping them loses p of n rows. */
 static void whiten(const double *a, int p, const double *x, double *out, long n)
 {
-    for (long i = 0; i < n; i++) {
+    for (long i = p; i < n; i++) {
         double v = x[i];
-        for (int k = 1; k <= p && k <= i; k++)
+        for (int k = 1; k <= p; k++)
             v -= a[k] * x[i - k];
-        out[i] = v;
+        out[i - p] = v;
     }
 }
 
@@ -1084,7 +1091,7 @@ static int usage(void)
 int main(int argc, char **argv)
 {
     const char *cname = NULL, *out = NULL;
-    long seed = -1, n, nf;
+    long seed = -1, n, nf, nw;
     const acase *cs = NULL;
     draw d;
     int base[3], nb = 0, tr[MAXT], nt = 0, identifiable = 1, attempts = 0, at_limit = 0, bumps = 0;
@@ -1182,6 +1189,7 @@ int main(int argc, char **argv)
 
         /* The true noise's whitening filter: AR(p) by Levinson-Durbin. */
         p = nf / 5 < 30 ? (int)(nf / 5) : 30;
+        nw = nf - p;
         noise_acf(d.noise_type, n, p, acf);
         levinson(acf, p, ar);
         for (int k = 0; k < NTERMS; k++)
@@ -1194,7 +1202,7 @@ int main(int argc, char **argv)
         vis = vec(n);
         tmp = vec(nf);
         whiten(ar, p, d.noise, tmp, nf);
-        sig_e = sd_of(tmp, nf);
+        sig_e = sd_of(tmp, nw);
 
         /* A first amplitude: the design |z| drawn in [8, 14]. */
         for (int j = 0; j < nt; j++) {
@@ -1205,13 +1213,13 @@ int main(int argc, char **argv)
             for (int l = 0; l < nt; l++)
                 if (l != j)
                     cols[k++] = wphi[tr[l]];
-            memcpy(tmp, wphi[tr[j]], (size_t)nf * sizeof *tmp);
-            if (k > 0 && lsq(cols, k, tmp, nf, coef, se) >= 0)
-                for (long i = 0; i < nf; i++)
+            memcpy(tmp, wphi[tr[j]], (size_t)nw * sizeof *tmp);
+            if (k > 0 && lsq(cols, k, tmp, nw, coef, se) >= 0)
+                for (long i = 0; i < nw; i++)
                     for (int l = 0; l < k; l++)
                         tmp[i] -= coef[l] * cols[l][i];
             rn = 0;
-            for (long i = 0; i < nf; i++)
+            for (long i = 0; i < nw; i++)
                 rn += tmp[i] * tmp[i];
             rn = sqrt(rn);
             a[j] = sgn_rand() * unif2(8, 14) * sig_e / (rn > 0 ? rn : 1e-300);
@@ -1240,7 +1248,7 @@ int main(int argc, char **argv)
             for (long i = 0; i < nf; i++)
                 tmp[i] = d.y[i] - d.s_i[i] + eff[i];
             whiten(ar, p, tmp, wy, nf);
-            g = design_check(&d, wphi, wy, nf, base, nb, tr, nt);
+            g = design_check(&d, wphi, wy, nw, base, nb, tr, nt);
             ok = g.delta >= DELTA_MIN;
             for (int j = 0; j < nt; j++)
                 ok &= fabs(g.z[j]) >= Z_MIN;
