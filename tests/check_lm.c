@@ -509,6 +509,43 @@ START_TEST(sessions_count_their_parameters)
 }
 END_TEST
 
+START_TEST(sessions_start_at_the_centroids)
+{
+    /* Two sessions of four points (different counts would weight the mean
+       distance by sample; equal here so the hand figures stay short):
+       session 0 at the corners of a square of half-side 1 about (1, 2, 3)
+       in the z = 3 plane, session 1 at the corners of a square of half-diagonal 2 about
+       (-4, 0, 5).  Centroids (1, 2, 3) and (-4, 0, 5); distances sqrt(2)
+       four times and 2 four times; S = I * 8 / (4 sqrt(2) + 8). */
+    static const double a[12] = {2, 3, 3, 0, 3, 3, 0, 1, 3, 2, 1, 3};
+    static const double b[12] = {-2, 0, 5, -6, 0, 5, -4, 2, 5, -4, -2, 5};
+    fe_sessions c = {2, {a, b}, {4, 4}, 0};
+    double x[12], s = 8.0 / (4.0 * sqrt(2.0) + 8.0);
+    for (int k = 0; k < 12; k++)
+        x[k] = 99.0;
+    fe_sessions_start(&c, x);
+    ck_assert_double_eq_tol(x[0], s, 1e-15);
+    ck_assert_double_eq_tol(x[3], s, 1e-15);
+    ck_assert_double_eq_tol(x[5], s, 1e-15);
+    ck_assert_double_eq(x[1], 0.0);
+    ck_assert_double_eq(x[2], 0.0);
+    ck_assert_double_eq(x[4], 0.0);
+    ck_assert_double_eq_tol(x[6], 1.0, 1e-15);
+    ck_assert_double_eq_tol(x[7], 2.0, 1e-15);
+    ck_assert_double_eq_tol(x[8], 3.0, 1e-15);
+    ck_assert_double_eq_tol(x[9], -4.0, 1e-15);
+    ck_assert_double_eq_tol(x[10], 0.0, 1e-15);
+    ck_assert_double_eq_tol(x[11], 5.0, 1e-15);
+    /* One offset for both: the mean of the centroids, (-1.5, 1, 4). */
+    c.one_offset = 1;
+    fe_sessions_start(&c, x);
+    ck_assert_double_eq_tol(x[0], s, 1e-15);
+    ck_assert_double_eq_tol(x[6], -1.5, 1e-15);
+    ck_assert_double_eq_tol(x[7], 1.0, 1e-15);
+    ck_assert_double_eq_tol(x[8], 4.0, 1e-15);
+}
+END_TEST
+
 START_TEST(magnetometer_sessions_synthetic)
 {
     enum { NS = 4, PER = 500 };
@@ -689,6 +726,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, report_table_and_stop);
     tcase_add_test(t, model_failures_are_handled);
     tcase_add_test(t, sessions_count_their_parameters);
+    tcase_add_test(t, sessions_start_at_the_centroids);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     suite_add_tcase(s, t);
