@@ -509,6 +509,121 @@ START_TEST(sessions_count_their_parameters)
 }
 END_TEST
 
+/* One residual x^2 - 4 of one parameter; rows of the iteration table. */
+static int square_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double j = 2.0 * x[0];
+    (void)ctx;
+    return fe_lm_emit(s, x[0] * x[0] - 4.0, 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+struct rows { int n; fe_lm_iteration row[8]; };
+
+static int keep_rows(const fe_lm_iteration *it, void *ctx)
+{
+    struct rows *r = ctx;
+    if (r->n < 8)
+        r->row[r->n++] = *it;
+    return 0;
+}
+
+START_TEST(first_step_is_extended_along_its_line)
+{
+    /* The first iteration from x = 1, done here by hand as lm.org states
+       it: cost (1/2) f^2, A = J^2, b = -J f, h = b / (A (1 + lambda0)),
+       predicted reduction (1/2) h (b + lambda0 A h), gain ratio rho =
+       (cost - cost(x + h)) / predicted.  rho is about 0.44, more than
+       0.25 from 1, so the step goes to the minimum t* of the parabola
+       through the cost at 0 (slope -b h) and at 1, and t* h is the step
+       reported when the cost is lower there. */
+    fe_lm_problem p = {1, 0, 0, square_model, NULL};
+    double *w = lm_work(&p, FE_LM_DENSE), x = 1.0;
+    struct rows t = {0};
+    fe_lm_result r;
+    const double lambda = fe_lm_default_params().lambda0;
+    double f0 = x * x - 4.0, J = 2.0 * x, cost = 0.5 * f0 * f0, A = J * J, b = -J * f0;
+    double h = b / (A * (1.0 + lambda)), pred = 0.5 * h * (b + lambda * A * h);
+    double f1 = (x + h) * (x + h) - 4.0, cost1 = 0.5 * f1 * f1, rho = (cost - cost1) / pred;
+    double slope = h * b, c = cost1 - cost + slope, ts = fmin(slope / (2.0 * c), 64.0);
+    double fe = (x + ts * h) * (x + ts * h) - 4.0, coste = 0.5 * fe * fe;
+    ck_assert_double_lt(fabs(rho - 1.0), 0.75);          /* the premises */
+    ck_assert_double_gt(fabs(rho - 1.0), 0.25);
+    ck_assert_double_lt(coste, cost1);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, w, keep_rows, &t, &r), FE_OK);
+    ck_assert_int_ge(t.n, 2);
+    FE_ASSERT_REL(t.row[0].ratio, rho, 1e-12);
+    FE_ASSERT_REL(t.row[0].step, fabs(ts * h), 1e-12);
+    FE_ASSERT_REL(t.row[0].change, cost - coste, 1e-12);   /* the step taken */
+    FE_ASSERT_REL(t.row[0].cost, coste, 1e-12);
+    ck_assert_double_eq(t.row[0].lambda, lambda);
+    ck_assert_int_eq(t.row[0].accepted, 1);
+    ck_assert_int_ge(r.extended, 1);
+    FE_ASSERT_REL(r.initial_cost, cost, 1e-15);
+    ck_assert_double_eq_tol(x, 2.0, 1e-9);
+    free(w);
+}
+END_TEST
+
+/* Two parameters whose columns are s (1, 1) and s (1 + d, 1 - d). */
+struct collinear { double d; };
+
+static int collinear_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct collinear *c = ctx;
+    const double S = 1e4;
+    for (int i = 0; i < 2; i++) {
+        double j[2] = {S, S * (1.0 + (i ? -c->d : c->d))};
+        int rc = fe_lm_emit(s, j[0] * x[0] + j[1] * x[1] - S * (1.0 + i), 1.0, j,
+                            FE_SCHUR_NONE, NULL);
+        if (rc != FE_OK)
+            return rc;
+    }
+    return FE_OK;
+}
+
+static int stop_at_once(const fe_lm_iteration *it, void *ctx)
+{
+    *(fe_lm_iteration *)ctx = *it;
+    return 1;
+}
+
+START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
+{
+    /* Without damping (lambda0 = 1e-300) the Cholesky pivot of the second
+       column is its distance from the first: pivot^2 / A22 = 2 d^2 / (2 +
+       2 d^2), 1e-14 for d = 1e-7, under the rank tolerance 1e-12 of the
+       diagonal (A22 = 2e8): the system is singular, no step (step 0, not
+       accepted).  For d = 1e-5 (1e-10) the step is the exact solution of
+       the 2 x 2 system. */
+    struct collinear c = {1e-7};
+    fe_lm_problem p = {2, 0, 0, collinear_model, &c};
+    double *w = lm_work(&p, FE_LM_DENSE), x[2] = {0, 0};
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_iteration row;
+    fe_lm_result r;
+    par.lambda0 = 1e-300;           /* 1 + lambda0 is 1: no damping */
+    par.lambda_min = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_double_eq(row.step, 0.0);
+    ck_assert_int_eq(row.accepted, 0);
+    ck_assert_double_eq(x[0], 0.0);
+    ck_assert_double_eq(x[1], 0.0);
+    c.d = 1e-5;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_int_eq(row.accepted, 1);
+    /* x0 + x1 (1 + d) = 1, x0 + x1 (1 - d) = 2: x1 = -1/(2d), x0 = 1 - x1 (1 + d). */
+    {
+        double x1 = -1.0 / (2.0 * c.d), x0 = 1.0 - x1 * (1.0 + c.d);
+        FE_ASSERT_REL(x[1], x1, 1e-6);
+        FE_ASSERT_REL(x[0], x0, 1e-6);
+        FE_ASSERT_REL(row.step, hypot(x0, x1), 1e-6);
+    }
+    free(w);
+}
+END_TEST
+
 START_TEST(sessions_start_at_the_centroids)
 {
     /* Two sessions of four points (different counts would weight the mean
@@ -727,6 +842,8 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, model_failures_are_handled);
     tcase_add_test(t, sessions_count_their_parameters);
     tcase_add_test(t, sessions_start_at_the_centroids);
+    tcase_add_test(t, first_step_is_extended_along_its_line);
+    tcase_add_test(t, undamped_rank_test_is_relative_to_the_diagonal);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     suite_add_tcase(s, t);

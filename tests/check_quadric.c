@@ -429,6 +429,28 @@ START_TEST(compare_a_box_of_one_point_absolutely)
 }
 END_TEST
 
+START_TEST(compare_is_the_largest_scaled_difference)
+{
+    /* Two samples 0.5 apart on x: N = 2, s = 0.5, so a moment of degree d
+       has the scale 2 * 0.5^d (0.5 for d = 2, 0.25 for d = 3).  Moving
+       the x^2 sum by 0.3 and the x^3 sum by 0.1: 0.3 / 0.5 = 0.6 and
+       0.1 / 0.25 = 0.4; the largest, 0.6, whatever the order. */
+    const double p[6] = {0, 0, 0, 0.5, 0, 0};
+    fe_quadric a = FE_QUADRIC_EMPTY, b = FE_QUADRIC_EMPTY;
+    double apart = -1.0;
+    fe_quadric_add_many(&a, p, 2, NULL);
+    fe_quadric_add_many(&b, p, 2, NULL);
+    a.m[fe_quadric_index(2, 0, 0)] += 0.3;
+    a.m[fe_quadric_index(3, 0, 0)] += 0.1;
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    FE_ASSERT_REL(apart, 0.6, 1e-14);
+    a.m[fe_quadric_index(2, 0, 0)] -= 0.3;
+    a.m[fe_quadric_index(3, 0, 0)] += 0.2;     /* now 0.3 / 0.25 */
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    FE_ASSERT_REL(apart, 1.2, 1e-14);
+}
+END_TEST
+
 START_TEST(state_size)
 {
     /* The figure the prose promises and make size prints for the M4. */
@@ -453,6 +475,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, block_extremes_in_the_tail_of_a_block);
     tcase_add_test(t, block_coverage_of_a_hemisphere_inside_the_box);
     tcase_add_test(t, compare_a_box_of_one_point_absolutely);
+    tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);
     suite_add_tcase(s, t);
     return s;
