@@ -564,7 +564,103 @@ START_TEST(first_step_is_extended_along_its_line)
 }
 END_TEST
 
-/* Two parameters whose columns are s (1, 1) and s (1 + d, 1 - d). */
+/* sigma (x^2 - 4): the cost of the scaled square; its gradient. */
+static int scaled_square_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double sg = *(const double *)ctx, j = sg * 2.0 * x[0];
+    return fe_lm_emit(s, sg * (x[0] * x[0] - 4.0), 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+static double sq_cost(double sg, double x)
+{
+    double f = sg * (x * x - 4.0);
+    return 0.5 * f * f;
+}
+
+START_TEST(second_step_searches_along_the_last_two)
+{
+    /* The first two iterations of lm.org's algorithm, done here by hand
+       for the one residual sigma (x^2 - 4) from x = 1: the damped step, its
+       gain ratio, the parabola along a step whose ratio is more than 0.25
+       from 1, the damping's update lambda max(1/3, 1 - (2 rho - 1)^3), and
+       after the second accepted step the search along d = x2 - x0 (the
+       last two steps): the cost at x2 + d, the minimum t* of the parabola
+       through cost(x2) (slope b'd) and cost(x2 + d), or 64 when it opens
+       downwards, kept if lower than at x2 + d, and the move if lower than
+       at x2.  From x = 3 the second step lands short of the root and the
+       search moves it nearer; sigma = 0.01 puts the parabola's curvature
+       term under 1. */
+    double sg = 0.01;
+    fe_lm_problem p = {1, 0, 0, scaled_square_model, &sg};
+    double *w = lm_work(&p, FE_LM_DENSE), x = 3.0, y = 3.0, ya = 0.0;
+    double lambda = fe_lm_default_params().lambda0, nu = 2.0, rowcost[2];
+    struct rows t = {0};
+    fe_lm_result r;
+    int have = 0, accelerated = 0, extended = 0;
+    for (int it = 0; it < 2; it++) {
+        double f = sg * (y * y - 4.0), J = sg * 2.0 * y, A = J * J, b = -J * f;
+        double cost = sq_cost(sg, y), h = b / (A * (1.0 + lambda));
+        double pred = 0.5 * h * (b + lambda * A * h), slope = h * b;
+        double yt = y + h, ct = sq_cost(sg, yt), rho = (cost - ct) / pred;
+        if (rho > 0.0 && fabs(rho - 1.0) > 0.25) {
+            double c = ct - cost + slope;
+            if (c > 0.0 && slope > 0.0) {
+                double ts = fmin(slope / (2.0 * c), 64.0);
+                if (ts > 0.0 && ts != 1.0 && sq_cost(sg, y + ts * h) < ct) {
+                    yt = y + ts * h;
+                    ct = sq_cost(sg, yt);
+                    extended++;
+                }
+            }
+        }
+        ck_assert_double_gt(rho, 0.0);              /* both are taken */
+        {
+            double d = yt - ya, tt = 2.0 * rho - 1.0;
+            ya = y;
+            y = yt;
+            cost = ct;
+            if (have) {
+                double f2 = sg * (y * y - 4.0), b2 = -(sg * 2.0 * y) * f2, sl = b2 * d;
+                if (sl > 0.0) {
+                    double c1 = sq_cost(sg, y + d), c = c1 - cost + sl, ta, cta;
+                    ta = c > 0.0 ? fmin(sl / (2.0 * c), 64.0) : 64.0;
+                    cta = c1;
+                    if (ta != 1.0) {
+                        cta = sq_cost(sg, y + ta * d);
+                        if (!(cta < c1)) {
+                            ta = 1.0;
+                            cta = c1;
+                        }
+                    }
+                    ck_assert_double_lt(c, 1.0);    /* the premise */
+                    if (cta < cost) {
+                        y += ta * d;
+                        cost = sq_cost(sg, y);
+                        accelerated++;
+                    }
+                }
+            }
+            have = 1;
+            lambda = fmax(1e-10, lambda * fmax(1.0 / 3.0, 1.0 - tt * tt * tt));
+            nu = 2.0;
+        }
+        rowcost[it] = cost;
+    }
+    (void)nu;
+    ck_assert_int_eq(accelerated, 1);               /* the search moved */
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, w, keep_rows, &t, &r), FE_OK);
+    ck_assert_int_ge(t.n, 3);
+    FE_ASSERT_REL(t.row[0].cost, rowcost[0], 1e-12);
+    FE_ASSERT_REL(t.row[1].cost, rowcost[1], 1e-12);
+    ck_assert_int_ge(r.accelerated, 1);
+    ck_assert_int_eq(extended, 0);
+    ck_assert_double_eq_tol(x, 2.0, 1e-9);
+    free(w);
+}
+END_TEST
+
+/* Two parameters whose columns are S (1, 1) and S K (1 + d, 1 - d),
+   K = 1000: the second diagonal entry is K times the off-diagonal one. */
 struct collinear { double d; };
 
 static int collinear_model(const double *x, fe_lm_sink *s, void *ctx)
@@ -572,7 +668,7 @@ static int collinear_model(const double *x, fe_lm_sink *s, void *ctx)
     const struct collinear *c = ctx;
     const double S = 1e4;
     for (int i = 0; i < 2; i++) {
-        double j[2] = {S, S * (1.0 + (i ? -c->d : c->d))};
+        double j[2] = {S, S * 1e3 * (1.0 + (i ? -c->d : c->d))};
         int rc = fe_lm_emit(s, j[0] * x[0] + j[1] * x[1] - S * (1.0 + i), 1.0, j,
                             FE_SCHUR_NONE, NULL);
         if (rc != FE_OK)
@@ -590,11 +686,12 @@ static int stop_at_once(const fe_lm_iteration *it, void *ctx)
 START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
 {
     /* Without damping (lambda0 = 1e-300) the Cholesky pivot of the second
-       column is its distance from the first: pivot^2 / A22 = 2 d^2 / (2 +
-       2 d^2), 1e-14 for d = 1e-7, under the rank tolerance 1e-12 of the
-       diagonal (A22 = 2e8): the system is singular, no step (step 0, not
-       accepted).  For d = 1e-5 (1e-10) the step is the exact solution of
-       the 2 x 2 system. */
+       column is its distance from the first: pivot^2 / A22 = d^2 / (1 +
+       d^2), 1e-14 for d = 1e-7, under the rank tolerance 1e-12 of the
+       diagonal A22 = 2e14 (though above 1e-12 of the off-diagonal entry
+       A12 = 2e11, or of A11 = 2e8): the system is singular, no step (step
+       0, not accepted).  For d = 1e-4 (1e-8) the step is the exact
+       solution of the 2 x 2 system. */
     struct collinear c = {1e-7};
     fe_lm_problem p = {2, 0, 0, collinear_model, &c};
     double *w = lm_work(&p, FE_LM_DENSE), x[2] = {0, 0};
@@ -609,13 +706,14 @@ START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
     ck_assert_int_eq(row.accepted, 0);
     ck_assert_double_eq(x[0], 0.0);
     ck_assert_double_eq(x[1], 0.0);
-    c.d = 1e-5;
+    c.d = 1e-4;
     ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
                      FE_ESTOPPED);
     ck_assert_int_eq(row.accepted, 1);
-    /* x0 + x1 (1 + d) = 1, x0 + x1 (1 - d) = 2: x1 = -1/(2d), x0 = 1 - x1 (1 + d). */
+    /* x0 + K x1 (1 + d) = 1, x0 + K x1 (1 - d) = 2: x1 = -1/(2dK),
+       x0 = 1 - K x1 (1 + d). */
     {
-        double x1 = -1.0 / (2.0 * c.d), x0 = 1.0 - x1 * (1.0 + c.d);
+        double x1 = -1.0 / (2.0 * c.d * 1e3), x0 = 1.0 - 1e3 * x1 * (1.0 + c.d);
         FE_ASSERT_REL(x[1], x1, 1e-6);
         FE_ASSERT_REL(x[0], x0, 1e-6);
         FE_ASSERT_REL(row.step, hypot(x0, x1), 1e-6);
@@ -843,6 +941,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, sessions_count_their_parameters);
     tcase_add_test(t, sessions_start_at_the_centroids);
     tcase_add_test(t, first_step_is_extended_along_its_line);
+    tcase_add_test(t, second_step_searches_along_the_last_two);
     tcase_add_test(t, undamped_rank_test_is_relative_to_the_diagonal);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
