@@ -1330,10 +1330,14 @@ START_TEST(pipeline_bad_arguments_read_nothing)
     wrong |= fe_parallel_fold_source(&f, &a, &src, FE_PARALLEL_MAX_THREADS + 1, 2, ring, 2,
                                      &done) != FE_ESIZE;
     wrong |= fe_parallel_fold_source(&nomerge, &a, &src, 1, 2, ring, 2, &done) != FE_ENOTSUP;
-    ring[1].acc = ring[0].acc;
-    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
-    ring[1].acc = &a;
-    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+    {
+        void *keep = ring[1].acc;
+        ring[1].acc = ring[0].acc;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].acc = &a;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].acc = keep;
+    }
     src.obs_size = sizeof x[0] / 2;             /* a source of other observations */
     wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
     src.obs_size = sizeof x[0];
