@@ -104,6 +104,7 @@ Suite *fe_synth_suite(void)
 {
     Suite *s = suite_create("synth");
     TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 60);           /* 10^6 rows: about 1 s, more on a busy machine */
     tcase_add_test(t, spec_refusals_at_their_edges);
     tcase_add_test(t, thermal_rig_follows_its_equations);
     suite_add_tcase(s, t);
