@@ -130,6 +130,53 @@ START_TEST(two_shards_equal_one)
 }
 END_TEST
 
+START_TEST(merged_hemispheres_cover_the_sphere)
+{
+    /* The samples above the centre folded in one accumulation, those below
+       in another: merged, they report what the whole reports: the count,
+       the box (against the brute-force extremes), the moments, and every
+       one of the 100 regions (every region holds a sample direction from
+       the true centre, counted here), so coverage 1. */
+    enum { N = 6000 };
+    static double x[3 * N];
+    fe_quadric up = FE_QUADRIC_EMPTY, down = FE_QUADRIC_EMPTY, whole = FE_QUADRIC_EMPTY;
+    int seen[FE_QUADRIC_REGIONS] = {0}, count = 0;
+    double lo[3], hi[3];
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 12);
+    for (int j = 0; j < 3; j++)
+        lo[j] = hi[j] = x[j];
+    for (size_t i = 0; i < N; i++) {
+        double v[3] = {x[3 * i] - C0[0], x[3 * i + 1] - C0[1], x[3 * i + 2] - C0[2]};
+        int r = fe_quadric_region(v);
+        count += r >= 0 && !seen[r];
+        if (r >= 0)
+            seen[r] = 1;
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], x[3 * i + j]);
+            hi[j] = fmax(hi[j], x[3 * i + j]);
+        }
+        ck_assert_int_eq(fe_quadric_add(v[2] > 0.0 ? &up : &down, x + 3 * i), FE_OK);
+    }
+    ck_assert_int_eq(count, 100);
+    ck_assert_int_eq(fe_quadric_add_many(&whole, x, N, NULL), FE_OK);
+    ck_assert_double_lt(fe_quadric_coverage(&down), 1.0);    /* each half alone */
+    ck_assert_double_lt(fe_quadric_coverage(&up), 1.0);
+    ck_assert_int_eq(fe_quadric_merge(&up, &down), FE_OK);
+    ck_assert_uint_eq(fe_quadric_count(&up), N);
+    ck_assert_mem_eq(up.lo, lo, sizeof lo);
+    ck_assert_mem_eq(up.hi, hi, sizeof hi);
+    ck_assert_int_eq(fe_quadric_regions(&up), 100);
+    FE_ASSERT_REL(fe_quadric_coverage(&up), 1.0, 0.0);
+    ck_assert_int_eq(fe_quadric_regions(&whole), 100);
+    {
+        double apart = -1.0;
+        ck_assert_int_eq(fe_quadric_recentre(&up, whole.ref), FE_OK);
+        ck_assert_int_eq(fe_quadric_compare(&up, &whole, &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+    }
+}
+END_TEST
+
 START_TEST(merge_every_split_and_associativity)
 {
     enum { N = 40 };
@@ -468,6 +515,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, step_equals_block);
     tcase_add_test(t, two_shards_equal_one);
     tcase_add_test(t, merge_every_split_and_associativity);
+    tcase_add_test(t, merged_hemispheres_cover_the_sphere);
     tcase_add_test(t, recentre_equals_accumulating_there);
     tcase_add_test(t, bad_samples_leave_it_unchanged);
     tcase_add_test(t, regions_have_equal_area);
