@@ -73,6 +73,15 @@ START_TEST(argument_errors)
     ck_assert_int_eq(fe_scan(&f, &a, z, 1, NULL, NULL), FE_EINVAL);
     ck_assert_int_eq(fe_scan_visit(&f, &a, z, 1, NULL, NULL, NULL), FE_EINVAL);
     ck_assert_int_eq(a.count, 0);
+    /* A refused fold reports that it folded nothing, whatever *done held. */
+    {
+        size_t done = 99;
+        ck_assert_int_eq(fe_fold(NULL, &a, z, 1, &done), FE_EINVAL);
+        ck_assert_uint_eq(done, 0);
+        done = 99;
+        ck_assert_int_eq(fe_fold(&f, &a, NULL, 1, &done), FE_EINVAL);
+        ck_assert_uint_eq(done, 0);
+    }
 }
 END_TEST
 
@@ -215,6 +224,15 @@ START_TEST(product_rejects_bad_layout)
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 8), FE_EINVAL);
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 12), FE_OK);
     ck_assert_int_eq(fe_product_accumulator(NULL, &spec, 12), FE_EINVAL);
+    /* Each argument refused alone: a NULL spec, an observation of no
+       bytes, parts missing for a non-zero count. */
+    ck_assert_int_eq(fe_product_accumulator(&prod, NULL, 12), FE_EINVAL);
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 0), FE_EINVAL);
+    {
+        const fe_product none = {NULL, 1}, empty = {NULL, 0};
+        ck_assert_int_eq(fe_product_accumulator(&prod, &none, 12), FE_EINVAL);
+        ck_assert_int_eq(fe_product_accumulator(&prod, &empty, 12), FE_OK);
+    }
     /* Every part is checked, not only the first: the second one ending
        exactly at the end of the observation fits, one byte further not. */
     {

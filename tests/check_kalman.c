@@ -618,6 +618,113 @@ START_TEST(sizes_and_arguments)
 }
 END_TEST
 
+/* Issue 20: refusals at their edges, and the information form's prior and
+   sums against direct calculations. */
+START_TEST(edges_of_the_sizes_models_and_sums)
+{
+    /* Every bad dimension gives 0 doubles, each alone; the largest good
+       one does not. */
+    ck_assert_uint_eq(fe_kalman_info_doubles(0, 1), 0);
+    ck_assert_uint_eq(fe_kalman_info_doubles(1, 0), 0);
+    ck_assert_uint_eq(fe_kalman_info_doubles(FE_KALMAN_MAX_DIM + 1, 1), 0);
+    ck_assert_uint_eq(fe_kalman_info_doubles(1, FE_KALMAN_MAX_DIM + 1), 0);
+    ck_assert_uint_gt(fe_kalman_info_doubles(1, FE_KALMAN_MAX_DIM), 0);
+    {   /* A packet larger than bmax, for the small kernels too. */
+        kf f;
+        const double A[4] = {1, 0, 0, 1}, z[2] = {1, 2}, Z[4] = {1, 0, 0, 1};
+        fe_kalman_obs o = {2, A, z, Z};
+        kf_make(&f, 2, 1);
+        ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 1.0), FE_OK);
+        ck_assert_int_eq(fe_kalman_update_fast(&f.k, &o, NULL), FE_ESIZE);
+        ck_assert_int_eq(fe_kalman_update(&f.k, &o, NULL), FE_ESIZE);
+        ck_assert_double_eq(f.k.x[0], 0.0);
+        ck_assert_double_eq(f.k.P[0], 1.0);
+        o.b = 1;                    /* at bmax: taken */
+        ck_assert_int_eq(fe_kalman_update_fast(&f.k, &o, NULL), FE_OK);
+        /* Scalar update from P = I, z = 1 on x0: x0 = 1/2, P00 = 1/2. */
+        ck_assert_double_eq_tol(f.k.x[0], 0.5, 1e-15);
+        ck_assert_double_eq_tol(f.k.P[0], 0.5, 1e-15);
+        kf_free(&f);
+    }
+    {   /* A model with no control matrix ignores m and u (not read): the
+           prediction is Phi x, Phi P Phi^T; a control matrix with a NaN
+           input is refused and changes nothing. */
+        kf f;
+        const double Phi[4] = {1, 0.5, 0, 1}, x0[2] = {2, 4}, P0[4] = {1, 0, 0, 2};
+        const double Gamma[2] = {0.5, 1}, ubad[1] = {NAN};
+        fe_kalman_model nog = {Phi, NULL, NULL, 2, NULL};
+        fe_kalman_model bad = {Phi, Gamma, ubad, 1, NULL};
+        kf_make(&f, 2, 1);
+        ck_assert_int_eq(fe_kalman_set_prior(&f.k, x0, P0), FE_OK);
+        ck_assert_int_eq(fe_kalman_predict(&f.k, &bad), FE_ENONFINITE);
+        ck_assert_double_eq(f.k.x[0], 2.0);
+        ck_assert_double_eq(f.k.P[3], 2.0);
+        ck_assert_int_eq(fe_kalman_predict(&f.k, &nog), FE_OK);
+        /* x = (2 + 0.5*4, 4); P = [[1 + 0.25*2, 0.5*2], [1, 2]]. */
+        ck_assert_double_eq_tol(f.k.x[0], 4.0, 1e-15);
+        ck_assert_double_eq_tol(f.k.x[1], 4.0, 1e-15);
+        ck_assert_double_eq_tol(f.k.P[0], 1.5, 1e-15);
+        ck_assert_double_eq_tol(f.k.P[1], 1.0, 1e-15);
+        ck_assert_double_eq_tol(f.k.P[2], 1.0, 1e-15);
+        ck_assert_double_eq_tol(f.k.P[3], 2.0, 1e-15);
+        kf_free(&f);
+    }
+    {   /* The information prior in memory full of other numbers: Lambda is
+           P0^{-1} (P0 Lambda = I, multiplied here) and eta solves
+           P0 eta = x0. */
+        enum { N = 3 };
+        size_t len = fe_kalman_info_doubles(N, 2);
+        double *m = malloc(len * sizeof *m), P0[N * N] = {4, 1, 0, 1, 3, 1, 0, 1, 2};
+        const double x0[N] = {1, -2, 3};
+        fe_kalman_info si;
+        ck_assert_ptr_nonnull(m);
+        for (size_t i = 0; i < len; i++)
+            m[i] = -7.0;
+        ck_assert_int_eq(fe_kalman_info_init(&si, N, 2, m, len), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_set_prior(&si, x0, P0), FE_OK);
+        for (size_t i = 0; i < N; i++) {
+            double e = 0.0;
+            for (size_t j = 0; j < N; j++) {
+                double s = 0.0;
+                for (size_t k = 0; k < N; k++)
+                    s += P0[i * N + k] * si.Lambda[k * N + j];
+                ck_assert_double_eq_tol(s, i == j ? 1.0 : 0.0, 1e-14);
+                e += P0[i * N + j] * si.eta[j];
+            }
+            ck_assert_double_eq_tol(e, x0[i], 1e-14);
+        }
+        free(m);
+    }
+    {   /* Merging sums at the edge of the doubles: 0.8e308 twice is
+           1.6e308 (doubling is exact); 1e308 twice overflows and is
+           refused, leaving s as it was. */
+        kinfo a, b;
+        kinfo_make(&a, 2, 1);
+        kinfo_make(&b, 2, 1);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, NULL, 1.0 / 0.8e308), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&b.s, NULL, 1.0 / 0.8e308), FE_OK);
+        {
+            double l0 = a.s.Lambda[0];
+            ck_assert_int_eq(fe_kalman_info_merge(&a.s, &b.s), FE_OK);
+            ck_assert_double_eq(a.s.Lambda[0], 2.0 * l0);
+            ck_assert(isfinite(a.s.Lambda[3]));
+        }
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, NULL, 1e-308), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&b.s, NULL, 1e-308), FE_OK);
+        {
+            double l0 = a.s.Lambda[0];
+            ck_assert(isfinite(l0));
+            ck_assert_int_eq(fe_kalman_info_merge(&a.s, &b.s), FE_ENONFINITE);
+            ck_assert_double_eq(a.s.Lambda[0], l0);
+            ck_assert_double_eq(a.s.Lambda[3], l0);
+            ck_assert_double_eq(a.s.Lambda[1], 0.0);
+        }
+        free(a.mem);
+        free(b.mem);
+    }
+}
+END_TEST
+
 /* --------------------------------------------------- symmetry, PD */
 
 START_TEST(covariance_stays_exactly_symmetric)
@@ -1360,6 +1467,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, row_major_dposv_needs_ldb_nrhs);
     tcase_add_test(t, bad_packets_are_refused_and_nothing_changes);
     tcase_add_test(t, sizes_and_arguments);
+    tcase_add_test(t, edges_of_the_sizes_models_and_sums);
     tcase_add_test(t, covariance_stays_exactly_symmetric);
     tcase_add_test(t, fast_path_equals_reference);
     tcase_add_test(t, joseph_form_against_long_double);

@@ -509,6 +509,256 @@ START_TEST(sessions_count_their_parameters)
 }
 END_TEST
 
+/* One residual x^2 - 4 of one parameter; rows of the iteration table. */
+static int square_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double j = 2.0 * x[0];
+    (void)ctx;
+    return fe_lm_emit(s, x[0] * x[0] - 4.0, 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+struct rows { int n; fe_lm_iteration row[8]; };
+
+static int keep_rows(const fe_lm_iteration *it, void *ctx)
+{
+    struct rows *r = ctx;
+    if (r->n < 8)
+        r->row[r->n++] = *it;
+    return 0;
+}
+
+START_TEST(first_step_is_extended_along_its_line)
+{
+    /* The first iteration from x = 1, done here by hand as lm.org states
+       it: cost (1/2) f^2, A = J^2, b = -J f, h = b / (A (1 + lambda0)),
+       predicted reduction (1/2) h (b + lambda0 A h), gain ratio rho =
+       (cost - cost(x + h)) / predicted.  rho is about 0.44, more than
+       0.25 from 1, so the step goes to the minimum t* of the parabola
+       through the cost at 0 (slope -b h) and at 1, and t* h is the step
+       reported when the cost is lower there. */
+    fe_lm_problem p = {1, 0, 0, square_model, NULL};
+    double *w = lm_work(&p, FE_LM_DENSE), x = 1.0;
+    struct rows t = {0};
+    fe_lm_result r;
+    const double lambda = fe_lm_default_params().lambda0;
+    double f0 = x * x - 4.0, J = 2.0 * x, cost = 0.5 * f0 * f0, A = J * J, b = -J * f0;
+    double h = b / (A * (1.0 + lambda)), pred = 0.5 * h * (b + lambda * A * h);
+    double f1 = (x + h) * (x + h) - 4.0, cost1 = 0.5 * f1 * f1, rho = (cost - cost1) / pred;
+    double slope = h * b, c = cost1 - cost + slope, ts = fmin(slope / (2.0 * c), 64.0);
+    double fe = (x + ts * h) * (x + ts * h) - 4.0, coste = 0.5 * fe * fe;
+    ck_assert_double_lt(fabs(rho - 1.0), 0.75);          /* the premises */
+    ck_assert_double_gt(fabs(rho - 1.0), 0.25);
+    ck_assert_double_lt(coste, cost1);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, w, keep_rows, &t, &r), FE_OK);
+    ck_assert_int_ge(t.n, 2);
+    FE_ASSERT_REL(t.row[0].ratio, rho, 1e-12);
+    FE_ASSERT_REL(t.row[0].step, fabs(ts * h), 1e-12);
+    FE_ASSERT_REL(t.row[0].change, cost - coste, 1e-12);   /* the step taken */
+    FE_ASSERT_REL(t.row[0].cost, coste, 1e-12);
+    ck_assert_double_eq(t.row[0].lambda, lambda);
+    ck_assert_int_eq(t.row[0].accepted, 1);
+    ck_assert_int_ge(r.extended, 1);
+    FE_ASSERT_REL(r.initial_cost, cost, 1e-15);
+    ck_assert_double_eq_tol(x, 2.0, 1e-9);
+    free(w);
+}
+END_TEST
+
+/* sigma (x^2 - 4): the cost of the scaled square; its gradient. */
+static int scaled_square_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double sg = *(const double *)ctx, j = sg * 2.0 * x[0];
+    return fe_lm_emit(s, sg * (x[0] * x[0] - 4.0), 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+static double sq_cost(double sg, double x)
+{
+    double f = sg * (x * x - 4.0);
+    return 0.5 * f * f;
+}
+
+START_TEST(second_step_searches_along_the_last_two)
+{
+    /* The first two iterations of lm.org's algorithm, done here by hand
+       for the one residual sigma (x^2 - 4) from x = 1: the damped step, its
+       gain ratio, the parabola along a step whose ratio is more than 0.25
+       from 1, the damping's update lambda max(1/3, 1 - (2 rho - 1)^3), and
+       after the second accepted step the search along d = x2 - x0 (the
+       last two steps): the cost at x2 + d, the minimum t* of the parabola
+       through cost(x2) (slope b'd) and cost(x2 + d), or 64 when it opens
+       downwards, kept if lower than at x2 + d, and the move if lower than
+       at x2.  From x = 3 the second step lands short of the root and the
+       search moves it nearer; sigma = 0.01 puts the parabola's curvature
+       term under 1. */
+    double sg = 0.01;
+    fe_lm_problem p = {1, 0, 0, scaled_square_model, &sg};
+    double *w = lm_work(&p, FE_LM_DENSE), x = 3.0, y = 3.0, ya = 0.0;
+    double lambda = fe_lm_default_params().lambda0, nu = 2.0, rowcost[2];
+    struct rows t = {0};
+    fe_lm_result r;
+    int have = 0, accelerated = 0, extended = 0;
+    for (int it = 0; it < 2; it++) {
+        double f = sg * (y * y - 4.0), J = sg * 2.0 * y, A = J * J, b = -J * f;
+        double cost = sq_cost(sg, y), h = b / (A * (1.0 + lambda));
+        double pred = 0.5 * h * (b + lambda * A * h), slope = h * b;
+        double yt = y + h, ct = sq_cost(sg, yt), rho = (cost - ct) / pred;
+        if (rho > 0.0 && fabs(rho - 1.0) > 0.25) {
+            double c = ct - cost + slope;
+            if (c > 0.0 && slope > 0.0) {
+                double ts = fmin(slope / (2.0 * c), 64.0);
+                if (ts > 0.0 && ts != 1.0 && sq_cost(sg, y + ts * h) < ct) {
+                    yt = y + ts * h;
+                    ct = sq_cost(sg, yt);
+                    extended++;
+                }
+            }
+        }
+        ck_assert_double_gt(rho, 0.0);              /* both are taken */
+        {
+            double d = yt - ya, tt = 2.0 * rho - 1.0;
+            ya = y;
+            y = yt;
+            cost = ct;
+            if (have) {
+                double f2 = sg * (y * y - 4.0), b2 = -(sg * 2.0 * y) * f2, sl = b2 * d;
+                if (sl > 0.0) {
+                    double c1 = sq_cost(sg, y + d), c = c1 - cost + sl, ta, cta;
+                    ta = c > 0.0 ? fmin(sl / (2.0 * c), 64.0) : 64.0;
+                    cta = c1;
+                    if (ta != 1.0) {
+                        cta = sq_cost(sg, y + ta * d);
+                        if (!(cta < c1)) {
+                            ta = 1.0;
+                            cta = c1;
+                        }
+                    }
+                    ck_assert_double_lt(c, 1.0);    /* the premise */
+                    if (cta < cost) {
+                        y += ta * d;
+                        cost = sq_cost(sg, y);
+                        accelerated++;
+                    }
+                }
+            }
+            have = 1;
+            lambda = fmax(1e-10, lambda * fmax(1.0 / 3.0, 1.0 - tt * tt * tt));
+            nu = 2.0;
+        }
+        rowcost[it] = cost;
+    }
+    (void)nu;
+    ck_assert_int_eq(accelerated, 1);               /* the search moved */
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, w, keep_rows, &t, &r), FE_OK);
+    ck_assert_int_ge(t.n, 3);
+    FE_ASSERT_REL(t.row[0].cost, rowcost[0], 1e-12);
+    FE_ASSERT_REL(t.row[1].cost, rowcost[1], 1e-12);
+    ck_assert_int_ge(r.accelerated, 1);
+    ck_assert_int_eq(extended, 0);
+    ck_assert_double_eq_tol(x, 2.0, 1e-9);
+    free(w);
+}
+END_TEST
+
+/* Two parameters whose columns are S (1, 1) and S K (1 + d, 1 - d),
+   K = 1000: the second diagonal entry is K times the off-diagonal one. */
+struct collinear { double d; };
+
+static int collinear_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct collinear *c = ctx;
+    const double S = 1e4;
+    for (int i = 0; i < 2; i++) {
+        double j[2] = {S, S * 1e3 * (1.0 + (i ? -c->d : c->d))};
+        int rc = fe_lm_emit(s, j[0] * x[0] + j[1] * x[1] - S * (1.0 + i), 1.0, j,
+                            FE_SCHUR_NONE, NULL);
+        if (rc != FE_OK)
+            return rc;
+    }
+    return FE_OK;
+}
+
+static int stop_at_once(const fe_lm_iteration *it, void *ctx)
+{
+    *(fe_lm_iteration *)ctx = *it;
+    return 1;
+}
+
+START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
+{
+    /* Without damping (lambda0 = 1e-300) the Cholesky pivot of the second
+       column is its distance from the first: pivot^2 / A22 = d^2 / (1 +
+       d^2), 1e-14 for d = 1e-7, under the rank tolerance 1e-12 of the
+       diagonal A22 = 2e14 (though above 1e-12 of the off-diagonal entry
+       A12 = 2e11, or of A11 = 2e8): the system is singular, no step (step
+       0, not accepted).  For d = 1e-4 (1e-8) the step is the exact
+       solution of the 2 x 2 system. */
+    struct collinear c = {1e-7};
+    fe_lm_problem p = {2, 0, 0, collinear_model, &c};
+    double *w = lm_work(&p, FE_LM_DENSE), x[2] = {0, 0};
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_iteration row;
+    fe_lm_result r;
+    par.lambda0 = 1e-300;           /* 1 + lambda0 is 1: no damping */
+    par.lambda_min = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_double_eq(row.step, 0.0);
+    ck_assert_int_eq(row.accepted, 0);
+    ck_assert_double_eq(x[0], 0.0);
+    ck_assert_double_eq(x[1], 0.0);
+    c.d = 1e-4;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_int_eq(row.accepted, 1);
+    /* x0 + K x1 (1 + d) = 1, x0 + K x1 (1 - d) = 2: x1 = -1/(2dK),
+       x0 = 1 - K x1 (1 + d). */
+    {
+        double x1 = -1.0 / (2.0 * c.d * 1e3), x0 = 1.0 - 1e3 * x1 * (1.0 + c.d);
+        FE_ASSERT_REL(x[1], x1, 1e-6);
+        FE_ASSERT_REL(x[0], x0, 1e-6);
+        FE_ASSERT_REL(row.step, hypot(x0, x1), 1e-6);
+    }
+    free(w);
+}
+END_TEST
+
+START_TEST(sessions_start_at_the_centroids)
+{
+    /* Two sessions of four points (different counts would weight the mean
+       distance by sample; equal here so the hand figures stay short):
+       session 0 at the corners of a square of half-side 1 about (1, 2, 3)
+       in the z = 3 plane, session 1 at the corners of a square of half-diagonal 2 about
+       (-4, 0, 5).  Centroids (1, 2, 3) and (-4, 0, 5); distances sqrt(2)
+       four times and 2 four times; S = I * 8 / (4 sqrt(2) + 8). */
+    static const double a[12] = {2, 3, 3, 0, 3, 3, 0, 1, 3, 2, 1, 3};
+    static const double b[12] = {-2, 0, 5, -6, 0, 5, -4, 2, 5, -4, -2, 5};
+    fe_sessions c = {2, {a, b}, {4, 4}, 0};
+    double x[12], s = 8.0 / (4.0 * sqrt(2.0) + 8.0);
+    for (int k = 0; k < 12; k++)
+        x[k] = 99.0;
+    fe_sessions_start(&c, x);
+    ck_assert_double_eq_tol(x[0], s, 1e-15);
+    ck_assert_double_eq_tol(x[3], s, 1e-15);
+    ck_assert_double_eq_tol(x[5], s, 1e-15);
+    ck_assert_double_eq(x[1], 0.0);
+    ck_assert_double_eq(x[2], 0.0);
+    ck_assert_double_eq(x[4], 0.0);
+    ck_assert_double_eq_tol(x[6], 1.0, 1e-15);
+    ck_assert_double_eq_tol(x[7], 2.0, 1e-15);
+    ck_assert_double_eq_tol(x[8], 3.0, 1e-15);
+    ck_assert_double_eq_tol(x[9], -4.0, 1e-15);
+    ck_assert_double_eq_tol(x[10], 0.0, 1e-15);
+    ck_assert_double_eq_tol(x[11], 5.0, 1e-15);
+    /* One offset for both: the mean of the centroids, (-1.5, 1, 4). */
+    c.one_offset = 1;
+    fe_sessions_start(&c, x);
+    ck_assert_double_eq_tol(x[0], s, 1e-15);
+    ck_assert_double_eq_tol(x[6], -1.5, 1e-15);
+    ck_assert_double_eq_tol(x[7], 1.0, 1e-15);
+    ck_assert_double_eq_tol(x[8], 4.0, 1e-15);
+}
+END_TEST
+
 START_TEST(magnetometer_sessions_synthetic)
 {
     enum { NS = 4, PER = 500 };
@@ -689,6 +939,10 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, report_table_and_stop);
     tcase_add_test(t, model_failures_are_handled);
     tcase_add_test(t, sessions_count_their_parameters);
+    tcase_add_test(t, sessions_start_at_the_centroids);
+    tcase_add_test(t, first_step_is_extended_along_its_line);
+    tcase_add_test(t, second_step_searches_along_the_last_two);
+    tcase_add_test(t, undamped_rank_test_is_relative_to_the_diagonal);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     suite_add_tcase(s, t);

@@ -161,6 +161,45 @@ START_TEST(block_statistics_match_a_direct_computation)
     ck_assert_ptr_nonnull(strstr(json, "\"test\": \"nis\""));
     ck_assert_ptr_nonnull(strstr(json, "\"acf_statistic\": null"));
     ck_assert_int_eq(fe_located_json(&l, json, 20), FE_ESIZE);
+    /* Every figure of the record under its key, in %.10g. */
+    l.p_value = 0.001;
+    l.mean_nis = 1.25;
+    l.lag1 = -0.5;
+    ck_assert_int_eq(fe_located_json(&l, json, sizeof json), FE_OK);
+    ck_assert_ptr_nonnull(strstr(json, "\"p_value\": 0.001"));
+    ck_assert_ptr_nonnull(strstr(json, "\"nis_statistic\": 5"));
+    ck_assert_ptr_nonnull(strstr(json, "\"mean_nis_per_dof\": 1.25"));
+    ck_assert_ptr_nonnull(strstr(json, "\"lag1\": -0.5"));
+    ck_assert_ptr_nonnull(strstr(json, "\"end\": 2.5"));
+}
+END_TEST
+
+START_TEST(blocks_without_pairs_have_no_autocorrelation_test)
+{
+    /* A break before every report: no lag-one pair anywhere, so the
+       autocorrelation test has nothing to say (p = 1) and the NIS of one
+       per report (p = 0.44 for 10 on 10 degrees of freedom) locates
+       nothing; the same reports with their pairs neither. */
+    fe_innovations inn;
+    size_t n = 9;
+    double w = 1.0;
+    for (int pairs = 0; pairs < 2; pairs++) {
+        ck_assert_int_eq(fe_innovations_init(&inn, 4, 40, 0), FE_OK);
+        for (int i = 0; i < 40; i++) {
+            fe_kalman_report r = {1, 1.0, 0, NULL, &w, NULL};
+            if (!pairs)
+                fe_innovations_break(&inn);
+            w = i % 2 ? 1.0 : -1.0;     /* alternating: lag one -1 when paired */
+            ck_assert_int_eq(fe_innovations_add(&inn, i, &r), FE_OK);
+        }
+        for (int b = 0; b < 4; b++)
+            ck_assert_double_eq(inn.block[b].acf_terms, pairs ? (b == 0 ? 9 : 10) : 0);
+        ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, NULL, 0, &n), FE_OK);
+        if (!pairs)
+            ck_assert_uint_eq(n, 0);
+        else    /* rho = -1 over 9 or 10 pairs: z = -3 or -3.16, p < 0.05/8 */
+            ck_assert_uint_ge(n, 1);
+    }
 }
 END_TEST
 
@@ -837,6 +876,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, arguments_merges_that_do_not_fit_and_json);
     tcase_add_test(t, merge_into_an_empty_part_is_the_other_part);
     tcase_add_test(t, json_of_every_length_is_whole_or_refused);
+    tcase_add_test(t, blocks_without_pairs_have_no_autocorrelation_test);
     tcase_add_test(t, a_missed_drag_is_located_where_it_acts);
     tcase_add_test(t, a_right_model_locates_nothing);
     tcase_add_test(t, residual_map_cells_equal_sums_over_the_rows);

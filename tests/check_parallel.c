@@ -1024,6 +1024,21 @@ START_TEST(sources_fold_their_concatenation)
     }
     sp[3] = &src[3];
     ck_assert_uint_eq(a.n, 0);
+    /* The accumulator's and the count's refusals, each with its own code,
+       come before the sources are looked at (none here, or valid ones). */
+    {
+        fe_accumulator nomerge = f;
+        nomerge.merge = NULL;
+        done = 7;
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, NULL, FE_PARALLEL_MAX_THREADS + 1,
+                                                  pp, &done), FE_ESIZE);
+        ck_assert_uint_eq(done, 0);
+        ck_assert_int_eq(fe_parallel_fold_sources(&nomerge, &a, NULL, 2, pp, &done), FE_ENOTSUP);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 0, pp, &done), FE_EINVAL);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, NULL, sp, 5, pp, &done), FE_EINVAL);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, NULL, &done), FE_EINVAL);
+        ck_assert_uint_eq(a.n, 0);
+    }
 }
 END_TEST
 
@@ -1315,10 +1330,17 @@ START_TEST(pipeline_bad_arguments_read_nothing)
     wrong |= fe_parallel_fold_source(&f, &a, &src, FE_PARALLEL_MAX_THREADS + 1, 2, ring, 2,
                                      &done) != FE_ESIZE;
     wrong |= fe_parallel_fold_source(&nomerge, &a, &src, 1, 2, ring, 2, &done) != FE_ENOTSUP;
-    ring[1].acc = ring[0].acc;
+    {
+        void *keep = ring[1].acc;
+        ring[1].acc = ring[0].acc;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].acc = &a;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].acc = keep;
+    }
+    src.obs_size = sizeof x[0] / 2;             /* a source of other observations */
     wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
-    ring[1].acc = &a;
-    wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+    src.obs_size = sizeof x[0];
     ck_assert_msg(!wrong, "a bad argument was not refused with the right code");
     ck_assert_uint_eq(done, 0);
     ck_assert_uint_eq(a.n, 0);

@@ -130,6 +130,53 @@ START_TEST(two_shards_equal_one)
 }
 END_TEST
 
+START_TEST(merged_hemispheres_cover_the_sphere)
+{
+    /* The samples above the centre folded in one accumulation, those below
+       in another: merged, they report what the whole reports: the count,
+       the box (against the brute-force extremes), the moments, and every
+       one of the 100 regions (every region holds a sample direction from
+       the true centre, counted here), so coverage 1. */
+    enum { N = 6000 };
+    static double x[3 * N];
+    fe_quadric up = FE_QUADRIC_EMPTY, down = FE_QUADRIC_EMPTY, whole = FE_QUADRIC_EMPTY;
+    int seen[FE_QUADRIC_REGIONS] = {0}, count = 0;
+    double lo[3], hi[3];
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 12);
+    for (int j = 0; j < 3; j++)
+        lo[j] = hi[j] = x[j];
+    for (size_t i = 0; i < N; i++) {
+        double v[3] = {x[3 * i] - C0[0], x[3 * i + 1] - C0[1], x[3 * i + 2] - C0[2]};
+        int r = fe_quadric_region(v);
+        count += r >= 0 && !seen[r];
+        if (r >= 0)
+            seen[r] = 1;
+        for (int j = 0; j < 3; j++) {
+            lo[j] = fmin(lo[j], x[3 * i + j]);
+            hi[j] = fmax(hi[j], x[3 * i + j]);
+        }
+        ck_assert_int_eq(fe_quadric_add(v[2] > 0.0 ? &up : &down, x + 3 * i), FE_OK);
+    }
+    ck_assert_int_eq(count, 100);
+    ck_assert_int_eq(fe_quadric_add_many(&whole, x, N, NULL), FE_OK);
+    ck_assert_double_lt(fe_quadric_coverage(&down), 1.0);    /* each half alone */
+    ck_assert_double_lt(fe_quadric_coverage(&up), 1.0);
+    ck_assert_int_eq(fe_quadric_merge(&up, &down), FE_OK);
+    ck_assert_uint_eq(fe_quadric_count(&up), N);
+    ck_assert_mem_eq(up.lo, lo, sizeof lo);
+    ck_assert_mem_eq(up.hi, hi, sizeof hi);
+    ck_assert_int_eq(fe_quadric_regions(&up), 100);
+    FE_ASSERT_REL(fe_quadric_coverage(&up), 1.0, 0.0);
+    ck_assert_int_eq(fe_quadric_regions(&whole), 100);
+    {
+        double apart = -1.0;
+        ck_assert_int_eq(fe_quadric_recentre(&up, whole.ref), FE_OK);
+        ck_assert_int_eq(fe_quadric_compare(&up, &whole, &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+    }
+}
+END_TEST
+
 START_TEST(merge_every_split_and_associativity)
 {
     enum { N = 40 };
@@ -321,6 +368,136 @@ START_TEST(coverage_ignores_an_initial_rest_and_sees_a_hemisphere)
 }
 END_TEST
 
+START_TEST(block_extremes_in_the_tail_of_a_block)
+{
+    /* A box from two samples, then 13 samples inside it but for one,
+       which leaves the box on one side of one axis: the eight-lane kernel
+       takes samples 0-7 in lanes and 8-12 one at a time (the four-lane one
+       0-11 and 12).  Each of the six sides, the sample leaving the box at
+       each place in the block: the box must be the brute-force minimum and
+       maximum of all 15 samples, and the moments those of one sample at a
+       time. */
+    enum { M = 13 };
+    static const double corner[6] = {0, 0, 0, 10, 10, 10};
+    int bad = 0;
+    for (int side = 0; side < 6; side++)
+        for (int at = 0; at < M; at++) {
+            double x[3 * M], lo[3], hi[3];
+            fe_quadric q = FE_QUADRIC_EMPTY, one = FE_QUADRIC_EMPTY;
+            for (int i = 0; i < M; i++)
+                for (int j = 0; j < 3; j++)
+                    x[3 * i + j] = 1.0 + 0.5 * ((i * (j + 2)) % 17);    /* in (0, 10) */
+            x[3 * at + side % 3] = side < 3 ? -4.0 - at : 14.0 + at;
+            ck_assert_int_eq(fe_quadric_add_many(&q, corner, 2, NULL), FE_OK);
+            ck_assert_int_eq(fe_quadric_add_many(&q, x, M, NULL), FE_OK);
+            for (int j = 0; j < 3; j++) {
+                lo[j] = 0.0;
+                hi[j] = 10.0;
+                for (int i = 0; i < M; i++) {
+                    lo[j] = fmin(lo[j], x[3 * i + j]);
+                    hi[j] = fmax(hi[j], x[3 * i + j]);
+                }
+                bad += q.lo[j] != lo[j] || q.hi[j] != hi[j];
+            }
+            fe_quadric_add(&one, corner);
+            fe_quadric_add(&one, corner + 3);
+            for (int i = 0; i < M; i++)
+                fe_quadric_add(&one, x + 3 * i);
+            bad += moment_diff(&q, &one, 30.0) > 1e-14;
+            bad += memcmp(q.seen, one.seen, sizeof q.seen) != 0;
+        }
+    ck_assert_int_eq(bad, 0);
+}
+END_TEST
+
+START_TEST(block_coverage_of_a_hemisphere_inside_the_box)
+{
+    /* The eight corners of a cube fix the box and its centre C0; then 300
+       samples inside it on the half z > 0 of a sphere about C0, folded as
+       one block.  They are all inside the box, so each is marked in the
+       region of its direction from C0 at the box's full size: the regions
+       counted must be those found here with fe_quadric_region (the
+       corners, marked while the box grew, stay below half its size but
+       for the last, which is in the upper half), and the marks those of
+       one sample at a time. */
+    enum { N = 300 };
+    static double x[3 * N], cube[3 * 8];
+    fe_quadric q = FE_QUADRIC_EMPTY, one = FE_QUADRIC_EMPTY;
+    fe_rng g = fe_rng_seed(31);
+    int seen[FE_QUADRIC_REGIONS] = {0}, count = 0;
+    for (int k = 0; k < 8; k++) {
+        double v[3] = {k & 1 ? 100.0 : -100.0, k & 2 ? 100.0 : -100.0, k & 4 ? 100.0 : -100.0};
+        for (int j = 0; j < 3; j++)
+            cube[3 * k + j] = C0[j] + v[j];
+    }
+    for (size_t i = 0; i < N; i++) {
+        double v[3];
+        fe_rng_unit_vector(&g, v);
+        v[2] = fabs(v[2]);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + 90.0 * v[j];
+        {
+            int r = fe_quadric_region(v);
+            count += r >= 0 && !seen[r];
+            if (r >= 0)
+                seen[r] = 1;
+        }
+    }
+    fe_quadric_add_many(&q, cube, 8, NULL);
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    for (int k = 0; k < 8; k++)
+        fe_quadric_add(&one, cube + 3 * k);
+    for (size_t i = 0; i < N; i++)
+        fe_quadric_add(&one, x + 3 * i);
+    ck_assert_int_eq(fe_quadric_regions(&q), count);
+    ck_assert_int_le(count, 50);                 /* the upper half of 100 */
+    ck_assert_mem_eq(q.seen, one.seen, sizeof q.seen);
+}
+END_TEST
+
+START_TEST(compare_a_box_of_one_point_absolutely)
+{
+    /* One sample: the box has no extent, every moment's scale N s^d is
+       zero, and a difference is reported as it is (0.5 here, under 1). */
+    const double p[3] = {1, 2, 3};
+    fe_quadric a = FE_QUADRIC_EMPTY, b = FE_QUADRIC_EMPTY;
+    double apart = -1.0;
+    fe_quadric_add(&a, p);
+    fe_quadric_add(&b, p);
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    ck_assert_double_eq(apart, 0.0);
+    a.m[1] = 0.5;
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    ck_assert_double_eq(apart, 0.5);
+    a.m[1] = 0.0;
+    a.m[34] = -0.25;
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    ck_assert_double_eq(apart, 0.25);
+}
+END_TEST
+
+START_TEST(compare_is_the_largest_scaled_difference)
+{
+    /* Two samples 0.5 apart on x: N = 2, s = 0.5, so a moment of degree d
+       has the scale 2 * 0.5^d (0.5 for d = 2, 0.25 for d = 3).  Moving
+       the x^2 sum by 0.3 and the x^3 sum by 0.1: 0.3 / 0.5 = 0.6 and
+       0.1 / 0.25 = 0.4; the largest, 0.6, whatever the order. */
+    const double p[6] = {0, 0, 0, 0.5, 0, 0};
+    fe_quadric a = FE_QUADRIC_EMPTY, b = FE_QUADRIC_EMPTY;
+    double apart = -1.0;
+    fe_quadric_add_many(&a, p, 2, NULL);
+    fe_quadric_add_many(&b, p, 2, NULL);
+    a.m[fe_quadric_index(2, 0, 0)] += 0.3;
+    a.m[fe_quadric_index(3, 0, 0)] += 0.1;
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    FE_ASSERT_REL(apart, 0.6, 1e-14);
+    a.m[fe_quadric_index(2, 0, 0)] -= 0.3;
+    a.m[fe_quadric_index(3, 0, 0)] += 0.2;     /* now 0.3 / 0.25 */
+    ck_assert_int_eq(fe_quadric_compare(&a, &b, &apart), FE_OK);
+    FE_ASSERT_REL(apart, 1.2, 1e-14);
+}
+END_TEST
+
 START_TEST(state_size)
 {
     /* The figure the prose promises and make size prints for the M4. */
@@ -338,10 +515,15 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, step_equals_block);
     tcase_add_test(t, two_shards_equal_one);
     tcase_add_test(t, merge_every_split_and_associativity);
+    tcase_add_test(t, merged_hemispheres_cover_the_sphere);
     tcase_add_test(t, recentre_equals_accumulating_there);
     tcase_add_test(t, bad_samples_leave_it_unchanged);
     tcase_add_test(t, regions_have_equal_area);
     tcase_add_test(t, coverage_ignores_an_initial_rest_and_sees_a_hemisphere);
+    tcase_add_test(t, block_extremes_in_the_tail_of_a_block);
+    tcase_add_test(t, block_coverage_of_a_hemisphere_inside_the_box);
+    tcase_add_test(t, compare_a_box_of_one_point_absolutely);
+    tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);
     suite_add_tcase(s, t);
     return s;

@@ -418,6 +418,10 @@ START_TEST(refuse_too_few_and_bad_arguments)
     ck_assert_int_eq(fe_sphere_fit_moments(NULL, FE_FIT_AXIAL, NULL, &f), FE_EINVAL);
     ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)7, NULL, &f), FE_EINVAL);
     ck_assert_int_eq(fe_sphere_fit_naive(x, 6, FE_FIT_SPHERE, NULL, w, 10, &f), FE_ESIZE);
+    /* No samples where some are promised, down to one. */
+    ck_assert_int_eq(fe_sphere_fit_naive(NULL, 1, FE_FIT_SPHERE, NULL, w, 10, &f), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_fit_naive(NULL, 6, FE_FIT_SPHERE, NULL, w, 10, &f), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_fit_naive(x, 6, FE_FIT_SPHERE, NULL, NULL, 10, &f), FE_EINVAL);
     ck_assert_str_eq(fe_sphere_model_name(FE_FIT_AXIAL), "axial");
     ck_assert_str_eq(fe_sphere_model_name(FE_FIT_ELLIPSOID), "ellipsoid"); /* the last */
     ck_assert_ptr_null(fe_sphere_model_name(FE_FIT_ELLIPSOID + 1));         /* one past */
@@ -478,6 +482,19 @@ START_TEST(refuse_one_hemisphere)
         fe_sphere_options o = fe_sphere_default_options();
         o.min_extent = 0.0;
         ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+        /* The coverage refusal at its edge: the fit reports the
+           accumulation's coverage; a minimum equal to it is met, the next
+           double above is not. */
+        {
+            double c = fe_quadric_coverage(&q);
+            ck_assert_double_eq(f.coverage, c);
+            ck_assert_double_lt(c, 1.0);
+            o.min_coverage = c;
+            ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+            o.min_coverage = nextafter(c, 2.0);
+            ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_EUNDETERMINED);
+            ck_assert_int_eq(f.refusal, FE_SPHERE_COVERAGE);
+        }
     }
 }
 END_TEST

@@ -2,6 +2,7 @@
 /* Streams: array, generator and file descriptor sources; folding them;
    rewinding; truncated records and pipes. */
 #define _POSIX_C_SOURCE 200809L
+#include <fcntl.h>
 #include <stdint.h>
 #include <unistd.h>
 
@@ -196,6 +197,26 @@ START_TEST(bad_arguments_and_mismatched_sizes)
 }
 END_TEST
 
+START_TEST(fd_source_read_error_is_an_io_error)
+{
+    /* read() on a directory fails (EISDIR): FE_EIO, nothing folded. */
+    double buf[8];
+    fe_fd_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    size_t done = 9;
+    int fd = open(".", O_RDONLY);
+    ck_assert_int_ge(fd, 0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, fd, sizeof(double), buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_fold_source(&f, &a, &src, &done), FE_EIO);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_uint_eq(a.n, 0);
+    ck_assert_uint_eq(st.len, 0);
+    close(fd);
+}
+END_TEST
+
 Suite *fe_stream_suite(void)
 {
     Suite *s = suite_create("stream");
@@ -207,6 +228,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, fd_source_on_a_pipe_cannot_rewind);
     tcase_add_test(t, batched_fold_stops_exactly_at_the_refused_observation);
     tcase_add_test(t, bad_arguments_and_mismatched_sizes);
+    tcase_add_test(t, fd_source_read_error_is_an_io_error);
     suite_add_tcase(s, t);
     return s;
 }

@@ -38,11 +38,75 @@ START_TEST(spec_refusals_at_their_edges)
 }
 END_TEST
 
+START_TEST(thermal_rig_follows_its_equations)
+{
+    /* The thermal rig as literate/synth.org states it, recomputed here row
+       by row: ambient 20 + 25 sin(2 pi t / (T / 2.3) + 0.3) over the
+       recording's length T; the heater 60 for the first 300 s of every
+       600 s; the temperature starts at the ambient and relaxes towards
+       ambient + heater with tau = 20 s (explicit Euler, the documented
+       step); the load (sim - 2) is an Ornstein-Uhlenbeck process of time
+       constant 5 s and unit spread, so load[i+1] = phi load[i] + e with
+       phi = 1 - dt/5 and var(e) = 2 dt / 5.  phi and var(e) are estimated
+       by least squares over 10^6 rows and held to four standard errors
+       (SE(phi) = sqrt(var(e) / sum load^2), SE(var) = var sqrt(2 / N)):
+       a time constant of 6 s moves phi by dt/30, about ten standard
+       errors, and var(e) by a sixth. */
+    enum { N = 1000000 };
+    fe_synth g;
+    fe_synth_spec spec = fe_synth_default_spec("none_thermal", 11);
+    fe_sample s;
+    double dt, total, temp = 0.0, sxy = 0.0, sxx = 0.0, worst = 0.0;
+    double *load = malloc(N * sizeof *load);
+    ck_assert_ptr_nonnull(load);
+    spec.rows = N;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    ck_assert_int_eq(g.thermal, 1);
+    dt = g.dt;
+    ck_assert_double_gt(dt, 0.0);
+    total = (double)N * dt;
+    for (size_t i = 0; i < N; i++) {
+        double t = (double)i * dt;
+        double amb = 20.0 + 25.0 * sin(2.0 * 3.14159265358979323846 * t / (total / 2.3) + 0.3);
+        double heat = fmod(t, 600.0) < 300.0 ? 60.0 : 0.0;
+        ck_assert_int_eq(fe_synth_next(&g, &s), FE_OK);
+        if (i == 0)
+            temp = amb;
+        worst = fmax(worst, fabs(s.t - t));
+        worst = fmax(worst, fabs(s.ambient - amb) / 45.0);
+        worst = fmax(worst, fabs(s.temperature - temp) / 100.0);
+        temp += (amb + heat - temp) * dt / 20.0;
+        load[i] = s.sim - 2.0;
+    }
+    ck_assert_int_eq(fe_synth_next(&g, &s), FE_END);
+    ck_assert_msg(worst < 1e-9, "time, ambient or temperature off the equations by %.3g", worst);
+    for (size_t i = 0; i + 1 < N; i++) {
+        sxy += load[i] * load[i + 1];
+        sxx += load[i] * load[i];
+    }
+    {
+        double phi = sxy / sxx, ve = 0.0, want_phi = 1.0 - dt / 5.0, want_ve = 2.0 * dt / 5.0;
+        for (size_t i = 0; i + 1 < N; i++) {
+            double e = load[i + 1] - phi * load[i];
+            ve += e * e;
+        }
+        ve /= (double)(N - 2);
+        ck_assert_msg(fabs(phi - want_phi) < 4.0 * sqrt(want_ve / sxx),
+                      "phi %.6f, want %.6f (SE %.2g)", phi, want_phi, sqrt(want_ve / sxx));
+        ck_assert_msg(fabs(ve - want_ve) < 4.0 * want_ve * sqrt(2.0 / N),
+                      "var(e) %.6g, want %.6g", ve, want_ve);
+    }
+    free(load);
+}
+END_TEST
+
 Suite *fe_synth_suite(void)
 {
     Suite *s = suite_create("synth");
     TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 60);           /* 10^6 rows: about 1 s, more on a busy machine */
     tcase_add_test(t, spec_refusals_at_their_edges);
+    tcase_add_test(t, thermal_rig_follows_its_equations);
     suite_add_tcase(s, t);
     return s;
 }
