@@ -646,6 +646,36 @@ START_TEST(residual_map_locates_a_window_and_a_region)
     ck_assert_str_eq(loc[0].test, "residual_mean");
     ck_assert_double_gt(loc[0].t, 6.0);
     ck_assert_double_lt(fabs(loc[0].mean_after), 0.2);
+    {
+        /* The window's pooled figures against the rows themselves: the
+           same noise stream, with the step, over rows 1000 .. 1399. */
+        fe_rng rng = fe_rng_seed(11);
+        double before = 0.0, after = 0.0, sq = 0.0;
+        for (int i = 0; i < 1400; i++) {
+            double e = fe_rng_normal(&rng);
+            if (i >= 1000) {
+                before += e + 0.6;
+                after += e;
+                sq += (e + 0.6) * (e + 0.6);
+            }
+        }
+        FE_ASSERT_REL(loc[0].mean_before, before / 400.0, 1e-12);
+        FE_ASSERT_REL(loc[0].mean_after, after / 400.0, 1e-12);
+        {
+            /* its mean square over the median block's */
+            double ms[20], med;
+            for (int k = 0; k < 20; k++)
+                ms[k] = m.block[k].sq0 / m.block[k].n;
+            for (int i = 1; i < 20; i++)        /* insertion sort */
+                for (int j = i; j > 0 && ms[j - 1] > ms[j]; j--) {
+                    double x = ms[j];
+                    ms[j] = ms[j - 1];
+                    ms[j - 1] = x;
+                }
+            med = 0.5 * (ms[9] + ms[10]);
+            FE_ASSERT_REL(loc[0].ms_ratio_before, sq / 400.0 / med, 1e-12);
+        }
+    }
     /* Worth a twentieth of a row each (a strongly coloured noise), the same step
        is no longer out of line in time: t falls by sqrt(20), below 2.5. */
     ck_assert_int_eq(fe_residual_map_locate(&m, 0.05, 0.05, loc, 8, &n), FE_OK);
@@ -660,6 +690,19 @@ START_TEST(residual_map_locates_a_window_and_a_region)
         char words[64];
         for (size_t i = 0; i < n && i < 8; i++)
             if (loc[i].region == FE_REGION_VELOCITY_NEGATIVE) {
+                /* its statistics from the map's sums: the region's mean
+                   against the fitted rows' mean, its mean square against
+                   theirs, each row worth one */
+                double n = 0, sum = 0, sq = 0;
+                const fe_residual_cell *c = &m.cell[0];
+                for (int k = 0; k < 20; k++) {
+                    n += m.block[k].n;
+                    sum += m.block[k].sum0;
+                    sq += m.block[k].sq0;
+                }
+                FE_ASSERT_REL(loc[i].t, (c->sum0 / c->n - sum / n) / sqrt(sq / n / c->n), 1e-12);
+                FE_ASSERT_REL(loc[i].z, (c->sq0 / c->n / (sq / n) - 1.0) / sqrt(2.0 / c->n),
+                              1e-12);
                 found = 1;
                 ck_assert_double_gt(loc[i].t, 0);
                 ck_assert_int_eq(fe_region_describe(&loc[i], words, sizeof words), FE_OK);
@@ -762,6 +805,8 @@ START_TEST(residual_map_refusals_at_their_edges)
     ck_assert_int_eq(fe_residual_map_add(NULL, &s, 1.0, 0.5), FE_EINVAL);
     ck_assert_mem_eq(&m, &keep, sizeof m);
     ck_assert_double_eq(fe_residual_map_largest_after(NULL, 1.0), 0.0);
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, 0, lo, hi), FE_OK);
+    ck_assert_double_eq(fe_residual_map_largest_after(&m, 1.0), 0.0);   /* empty */
 }
 END_TEST
 
