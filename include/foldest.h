@@ -27,6 +27,7 @@ extern "C" {
 #include "foldest/sessions.h"
 #include "foldest/kalman.h"
 #include "foldest/locate.h"
+#include "foldest/expr.h"
 #include "foldest/parallel.h"
 #include "foldest/quadric.h"
 #include "foldest/sphere.h"

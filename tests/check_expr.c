@@ -1,0 +1,195 @@
+/* SPDX-License-Identifier: MIT */
+/* Terms written as expressions: values against the same formulas written
+   in C, precedence, errors at their columns, refusals, and the panel
+   evaluation against the one-row one. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+static const char *const names[] = {"position", "velocity", "t", "T (C)", "sim"};
+enum { NV = 5 };
+
+static double value_of(const char *text, const double *v)
+{
+    fe_expr e;
+    size_t col = 99;
+    char msg[256];
+    double out = NAN;
+    int rc = fe_expr_compile(&e, text, names, NV, &col, msg, sizeof msg);
+    ck_assert_msg(rc == FE_OK, "%s: col %zu: %s", text, col, msg);
+    ck_assert_uint_eq(col, 0);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_OK);
+    return out;
+}
+
+START_TEST(expressions_are_their_formulas)
+{
+    fe_rng rng = fe_rng_seed(5);
+    for (int k = 0; k < 50; k++) {
+        double v[NV], x, u, t, T, s;
+        for (int j = 0; j < NV; j++)
+            v[j] = 2.0 * fe_rng_uniform(&rng) - 1.0;
+        v[3] = 20.0 + 5.0 * v[3];
+        x = v[0], u = v[1], t = v[2], T = v[3], s = v[4];
+        FE_ASSERT_REL(value_of("sin(2*pi*position/0.002)", v),
+                      sin(2 * 3.14159265358979323846 * x / 0.002), 1e-15);
+        FE_ASSERT_REL(value_of("velocity*abs(velocity)*cos(t)", v), u * fabs(u) * cos(t),
+                      1e-15);
+        FE_ASSERT_REL(value_of("sign(velocity)*exp(-(velocity/0.1)^2)", v),
+                      ((u > 0) - (u < 0)) * exp(-(u / 0.1) * (u / 0.1)), 1e-14);
+        FE_ASSERT_REL(value_of("(\"T (C)\" - 20)*sim + tanh(3*velocity)", v),
+                      (T - 20) * s + tanh(3 * u), 1e-14);
+        FE_ASSERT_REL(value_of("`T (C)`^4 / 1e8 - log(sqrt(abs(sim) + 1))", v),
+                      pow(T, 4) / 1e8 - log(sqrt(fabs(s) + 1)), 1e-14);
+        FE_ASSERT_REL(value_of("atan2(position, velocity) + min(t, sim) - max(t, sim)", v),
+                      atan2(x, u) + fmin(t, s) - fmax(t, s), 1e-14);
+        FE_ASSERT_REL(value_of("tan(0.5*position)", v), tan(0.5 * x), 1e-15);
+    }
+}
+END_TEST
+
+START_TEST(precedence_as_in_mathematics)
+{
+    const double v[NV] = {3, 0, 0, 0, 0};
+    ck_assert_double_eq(value_of("-2^2", v), -4.0);        /* -(2^2) */
+    ck_assert_double_eq(value_of("2^3^2", v), 512.0);      /* 2^(3^2) */
+    ck_assert_double_eq(value_of("2^-1", v), 0.5);
+    ck_assert_double_eq(value_of("1-2-3", v), -4.0);       /* left to right */
+    ck_assert_double_eq(value_of("8/2/2", v), 2.0);
+    ck_assert_double_eq(value_of("1+2*3^2", v), 19.0);
+    ck_assert_double_eq(value_of("(1+2)*3", v), 9.0);
+    ck_assert_double_eq(value_of("--position", v), 3.0);
+    ck_assert_double_eq(value_of(" +position * 2 ", v), 6.0);
+    ck_assert_double_eq(value_of("1.5e2 + .5 + 2E-1", v), 150.7);
+}
+END_TEST
+
+/* Compiling `text` fails with rc at column col, with `part` in the message. */
+static void fails_at(const char *text, int rc, size_t col, const char *part)
+{
+    fe_expr e;
+    size_t c = 0;
+    char msg[512];
+    ck_assert_int_eq(fe_expr_compile(&e, text, names, NV, &c, msg, sizeof msg), rc);
+    ck_assert_msg(c == col, "%s: column %zu, expected %zu (%s)", text, c, col, msg);
+    ck_assert_msg(strstr(msg, part) != NULL, "%s: message '%s' lacks '%s'", text, msg, part);
+}
+
+START_TEST(errors_name_their_column)
+{
+    fails_at("sin(position", FE_EPARSE, 13, "missing ')'");
+    fails_at("(position+1", FE_EPARSE, 12, "missing ')'");
+    fails_at("position)", FE_EPARSE, 9, "unmatched ')'");
+    fails_at("2*posiiton", FE_EPARSE, 3, "unknown name 'posiiton'");
+    fails_at("2*posiiton", FE_EPARSE, 3, "names: pi, position, velocity, t, T (C), sim");
+    fails_at("sine(t)", FE_EPARSE, 1, "unknown function");
+    fails_at("atan2(t)", FE_EPARSE, 1, "two arguments");
+    fails_at("sin(t, t)", FE_EPARSE, 1, "one argument");
+    fails_at("1 +", FE_EPARSE, 4, "ends too soon");
+    fails_at("1 $ 2", FE_EPARSE, 3, "unexpected character");
+    fails_at("0x10", FE_EPARSE, 2, "unexpected character");     /* no hexadecimal */
+    fails_at("1.2.3", FE_EPARSE, 1, "not a number");
+    fails_at("\"T (C)", FE_EPARSE, 1, "unterminated");
+    fails_at("", FE_EPARSE, 1, "ends too soon");
+    fails_at("\"pi\"", FE_EPARSE, 1, "unknown name 'pi'");    /* quoted: a column, not pi */
+    {
+        /* Deeper than the machine: a sum of 17 nested values needs 17
+           slots; nested parentheses beyond the parser's depth. */
+        char deep[512] = "", sum[512] = "";
+        for (int i = 0; i < 30; i++)
+            strcat(deep, "(");
+        strcat(deep, "1");
+        for (int i = 0; i < 30; i++)
+            strcat(deep, ")");
+        fails_at(deep, FE_ESIZE, 25, "nested too deeply");
+        for (int i = 0; i < 16; i++)
+            strcat(sum, "1+(");
+        strcat(sum, "1");
+        for (int i = 0; i < 16; i++)
+            strcat(sum, ")");
+        fails_at(sum, FE_ESIZE, 49, "too deep for the machine");   /* the 17th value */
+    }
+    {
+        /* Longer than FE_EXPR_MAX_CODE instructions. */
+        char longer[1024] = "1";
+        for (int i = 0; i < 70; i++)
+            strcat(longer, "+1");
+        fails_at(longer, FE_ESIZE, 128, "too long");
+    }
+    {
+        fe_expr e;
+        ck_assert_int_eq(fe_expr_compile(NULL, "1", names, NV, NULL, NULL, 0), FE_EINVAL);
+        ck_assert_int_eq(fe_expr_compile(&e, NULL, names, NV, NULL, NULL, 0), FE_EINVAL);
+        ck_assert_int_eq(fe_expr_compile(&e, "1", NULL, 1, NULL, NULL, 0), FE_EINVAL);
+        ck_assert_int_eq(fe_expr_compile(&e, "pi", NULL, 0, NULL, NULL, 0), FE_OK);
+    }
+}
+END_TEST
+
+START_TEST(values_that_are_not_finite_are_refused)
+{
+    fe_expr e;
+    double v[NV] = {-1, 0, 0, 0, 0}, out;
+    ck_assert_int_eq(fe_expr_compile(&e, "log(position)", names, NV, NULL, NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_ENONFINITE);
+    ck_assert_int_eq(fe_expr_compile(&e, "1/velocity", names, NV, NULL, NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_ENONFINITE);
+    ck_assert_int_eq(fe_expr_compile(&e, "exp(1000)", names, NV, NULL, NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_ENONFINITE);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, NULL), FE_EINVAL);
+    {
+        double rows[4 * NV] = {0}, res[4], work[FE_EXPR_MAX_STACK * 4];
+        size_t bad = 99;
+        ck_assert_uint_ge(sizeof work / sizeof work[0], fe_expr_work_doubles(4));
+        ck_assert_int_eq(fe_expr_compile(&e, "sqrt(position)", names, NV, NULL, NULL, 0),
+                         FE_OK);
+        rows[0 * NV] = 4, rows[1 * NV] = 9, rows[2 * NV] = -1, rows[3 * NV] = -4;
+        ck_assert_int_eq(fe_expr_eval_rows(&e, rows, NV, 4, res, work, &bad), FE_ENONFINITE);
+        ck_assert_uint_eq(bad, 2);                      /* the first bad row */
+        ck_assert_double_eq(res[1], 3.0);
+        ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 0, 4, res, work, &bad), FE_EINVAL);
+    }
+}
+END_TEST
+
+START_TEST(a_panel_equals_its_rows)
+{
+    static const char *const texts[] = {
+        "sin(2*pi*position/0.002)", "velocity*abs(velocity) - 3*sim^2/(1+t^2)",
+        "max(min(position, velocity), -0.5) * atan2(t, 1 + sim^2)",
+        "-(position - velocity)^3 + sign(t)*sqrt(abs(\"T (C)\"))",
+        "exp(-t^2) * cos(velocity) * tanh(position) / 2 - 1e-3"};
+    enum { N = 300 };
+    static double rows[N * NV], out[N], work[FE_EXPR_MAX_STACK * N];
+    fe_rng rng = fe_rng_seed(9);
+    for (size_t i = 0; i < N * NV; i++)
+        rows[i] = 4.0 * fe_rng_uniform(&rng) - 2.0;
+    for (size_t k = 0; k < sizeof texts / sizeof texts[0]; k++) {
+        fe_expr e;
+        size_t bad = 0;
+        ck_assert_int_eq(fe_expr_compile(&e, texts[k], names, NV, NULL, NULL, 0), FE_OK);
+        ck_assert_int_eq(fe_expr_eval_rows(&e, rows, NV, N, out, work, &bad), FE_OK);
+        for (size_t t = 0; t < N; t++) {
+            double one;
+            ck_assert_int_eq(fe_expr_eval(&e, rows + t * NV, &one), FE_OK);
+            ck_assert_double_eq(out[t], one);               /* the same operations */
+        }
+    }
+}
+END_TEST
+
+Suite *fe_expr_suite(void)
+{
+    Suite *s = suite_create("expr");
+    TCase *t = tcase_create("expr");
+    tcase_add_test(t, expressions_are_their_formulas);
+    tcase_add_test(t, precedence_as_in_mathematics);
+    tcase_add_test(t, errors_name_their_column);
+    tcase_add_test(t, values_that_are_not_finite_are_refused);
+    tcase_add_test(t, a_panel_equals_its_rows);
+    suite_add_tcase(s, t);
+    return s;
+}
