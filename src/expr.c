@@ -358,20 +358,39 @@ int fe_expr_compile(fe_expr *e, const char *text, const char *const *names, size
 }
 /* Compile ends here */
 /* [[file:../literate/expr.org::Evaluate][Evaluate]] */
+/* Whether instruction i of e can run on a stack of height h (and leave
+   the stack within its bounds). */
+static int fe__step_ok(const fe_expr *e, size_t i, size_t h)
+{
+    unsigned char op = e->op[i];
+    int k = fe__arity(op);
+    if (op > FE__MAX)
+        return 0;
+    if (k == 0)
+        return h < FE_EXPR_MAX_STACK
+               && (op == FE__CONST || (e->arg[i] >= 0.0 && e->arg[i] < (double)e->nvars));
+    return h >= (size_t)k;
+}
+
 int fe_expr_eval(const fe_expr *e, const double *v, double *out)
 {
-    double s[FE_EXPR_MAX_STACK];
+    double s[FE_EXPR_MAX_STACK] = {0};
     size_t h = 0;
-    if (e == NULL || out == NULL || (e->nvars > 0 && v == NULL) || e->ncode == 0)
+    if (e == NULL || out == NULL || (e->nvars > 0 && v == NULL) || e->ncode == 0
+        || e->ncode > FE_EXPR_MAX_CODE)
         return FE_EINVAL;
     for (size_t i = 0; i < e->ncode; i++) {
         unsigned char op = e->op[i];
+        if (!fe__step_ok(e, i, h))
+            return FE_EINVAL;
         switch (fe__arity(op)) {
         case 0: s[h++] = op == FE__CONST ? e->arg[i] : v[(size_t)e->arg[i]]; break;
         case 1: s[h - 1] = fe__apply1(op, s[h - 1]); break;
         default: s[h - 2] = fe__apply2(op, s[h - 2], s[h - 1]); h--; break;
         }
     }
+    if (h != 1)
+        return FE_EINVAL;
     *out = s[0];
     return isfinite(*out) ? FE_OK : FE_ENONFINITE;
 }
@@ -386,8 +405,15 @@ int fe_expr_eval_rows(const fe_expr *e, const double *v, size_t ldv, size_t n, d
 {
     size_t h = 0;
     if (e == NULL || out == NULL || work == NULL || e->ncode == 0
-        || (e->nvars > 0 && (v == NULL || ldv < e->nvars)))
+        || e->ncode > FE_EXPR_MAX_CODE || (e->nvars > 0 && (v == NULL || ldv < e->nvars)))
         return FE_EINVAL;
+    for (size_t i = 0, g = 0; i < e->ncode; i++) {      /* the program first */
+        if (!fe__step_ok(e, i, g))
+            return FE_EINVAL;
+        g = g + 1 - (size_t)fe__arity(e->op[i]);
+        if (i + 1 == e->ncode && g != 1)
+            return FE_EINVAL;
+    }
     for (size_t i = 0; i < e->ncode; i++) {
         unsigned char op = e->op[i];
         double *x = work + (h - (h > 0)) * n, *y = work + h * n;

@@ -579,9 +579,11 @@ int fe_residual_map_merge(fe_residual_map *a, const fe_residual_map *b)
     if (a == NULL || b == NULL)
         return FE_EINVAL;
     if (a->blocks != b->blocks || a->fit != b->fit || a->roles != b->roles
-        || b->row0 != a->row0 + a->n || memcmp(a->lo, b->lo, sizeof a->lo) != 0
-        || memcmp(a->hi, b->hi, sizeof a->hi) != 0)
+        || b->row0 != a->row0 + a->n)
         return FE_EMISMATCH;
+    for (int v = 0; v < 3; v++)
+        if (a->lo[v] != b->lo[v] || a->hi[v] != b->hi[v])   /* cut from other ranges */
+            return FE_EMISMATCH;
     if (b->n == 0)
         return FE_OK;
     shift = fe__recording_shift(a->n, a->recording, b->first_linked);

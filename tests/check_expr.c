@@ -155,6 +155,37 @@ START_TEST(values_that_are_not_finite_are_refused)
 }
 END_TEST
 
+START_TEST(a_program_not_made_by_the_compiler_is_refused)
+{
+    fe_expr e, good;
+    double v[NV] = {1, 2, 3, 4, 5}, out, rows[2 * NV] = {0}, res[2],
+           work[FE_EXPR_MAX_STACK * 2];
+    ck_assert_int_eq(fe_expr_compile(&good, "position + velocity", names, NV, NULL, NULL, 0),
+                     FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&good, v, &out), FE_OK);
+    ck_assert_double_eq(out, 3.0);
+    e = good;                           /* an operation with nothing to pop */
+    e.ncode = 1;
+    e.op[0] = good.op[2];
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, NV, 2, res, work, NULL), FE_EINVAL);
+    e = good;                           /* a variable past nvars */
+    e.arg[1] = (double)good.nvars;
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, NV, 2, res, work, NULL), FE_EINVAL);
+    e = good;                           /* two values left on the stack */
+    e.ncode = 2;
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, NV, 2, res, work, NULL), FE_EINVAL);
+    e = good;                           /* an operation that does not exist */
+    e.op[2] = 200;
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_EINVAL);
+    e = good;
+    e.ncode = FE_EXPR_MAX_CODE + 1;
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_EINVAL);
+}
+END_TEST
+
 START_TEST(a_panel_equals_its_rows)
 {
     static const char *const texts[] = {
@@ -189,6 +220,7 @@ Suite *fe_expr_suite(void)
     tcase_add_test(t, precedence_as_in_mathematics);
     tcase_add_test(t, errors_name_their_column);
     tcase_add_test(t, values_that_are_not_finite_are_refused);
+    tcase_add_test(t, a_program_not_made_by_the_compiler_is_refused);
     tcase_add_test(t, a_panel_equals_its_rows);
     suite_add_tcase(s, t);
     return s;
