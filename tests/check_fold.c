@@ -203,6 +203,13 @@ START_TEST(product_merges_component_wise)
     FE_ASSERT_REL(m1.mean, mw.mean, 1e-15);
     FE_ASSERT_REL(m1.m2, mw.m2, 1e-14);
     ck_assert_int_eq(t1.count, tw.count);
+    ck_assert_double_eq(t1.sum, tw.sum);
+    /* A copy of the product copies every part, the last one too. */
+    ck_assert_int_eq(fe_init(&prod, &p2), FE_OK);
+    ck_assert_int_eq(fe_copy(&prod, &p2, &pw), FE_OK);
+    ck_assert_mem_eq(&m2, &mw, sizeof m2);
+    ck_assert_int_eq(t2.count, tw.count);
+    ck_assert_double_eq(t2.sum, tw.sum);
     /* A component that cannot merge makes the product not merge. */
     {
         fe_accumulator nomerge = toy(), p;
@@ -212,6 +219,39 @@ START_TEST(product_merges_component_wise)
         ck_assert_int_eq(fe_product_accumulator(&p, &sq, sizeof(double)), FE_OK);
         ck_assert(p.merge == NULL);
     }
+}
+END_TEST
+
+/* A toy whose copy fails from an accumulation with a negative count (a
+   component that cannot copy, for the product's rollback). */
+static int toy_copy_or_fail(void *dst, const void *src, void *ctx)
+{
+    const toy_acc *b = src;
+    (void)ctx;
+    if (b->count < 0)
+        return FE_ENOTSUP;
+    *(toy_acc *)dst = *b;
+    return FE_OK;
+}
+
+START_TEST(product_merge_rolls_back_when_a_copy_fails)
+{
+    /* Part 0 merges, part 1's copy to its spare fails: the product's
+       merge is refused, part 0 is restored and part 1 untouched. */
+    fe_accumulator t0 = toy(), t1 = toy(), prod;
+    const fe_product_part parts[2] = {{&t0, 0}, {&t1, sizeof(double)}};
+    const fe_product spec = {parts, 2};
+    toy_acc a0 = {2, 3.0}, a1 = {-1, 7.0}, s0 = {0, 0}, s1 = {5, 5.0};
+    toy_acc b0 = {4, 10.0}, b1 = {1, 1.0}, c0 = {0, 0}, c1 = {0, 0};
+    void *aa[2] = {&a0, &a1}, *as[2] = {&s0, &s1}, *ba[2] = {&b0, &b1}, *bs[2] = {&c0, &c1};
+    fe_product_acc pa = {aa, as}, pb = {ba, bs};
+    t1.copy = toy_copy_or_fail;
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 2 * sizeof(double)), FE_OK);
+    ck_assert_int_eq(fe_merge(&prod, &pa, &pb), FE_ENOTSUP);
+    ck_assert_int_eq(a0.count, 2);
+    ck_assert_double_eq(a0.sum, 3.0);
+    ck_assert_int_eq(a1.count, -1);
+    ck_assert_double_eq(a1.sum, 7.0);
 }
 END_TEST
 
@@ -263,6 +303,7 @@ Suite *fe_fold_suite(void)
     tcase_add_test(t, product_runs_side_by_side);
     tcase_add_test(t, product_rolls_back_a_partial_step);
     tcase_add_test(t, product_merges_component_wise);
+    tcase_add_test(t, product_merge_rolls_back_when_a_copy_fails);
     tcase_add_test(t, product_rejects_bad_layout);
     suite_add_tcase(s, t);
     return s;

@@ -217,6 +217,51 @@ START_TEST(fd_source_read_error_is_an_io_error)
 }
 END_TEST
 
+/* A generator of three values that counts its calls: after FE_END it must
+   not be asked again until the source is rewound. */
+static int three_then_end(void *obs, size_t index, void *ctx)
+{
+    int *calls = ctx;
+    (*calls)++;
+    if (index >= 3)
+        return FE_END;
+    *(double *)obs = (double)index;
+    return FE_OK;
+}
+
+START_TEST(sources_at_their_edges)
+{
+    fe_source src;
+    fe_array_source as;
+    fe_generator_source gs;
+    const void *obs;
+    const unsigned char bytes[3] = {7, 8, 9};
+    double slot;
+    int calls = 0;
+    /* One-byte observations are observations; a NULL array of one is not. */
+    ck_assert_int_eq(fe_source_from_array(&src, &as, bytes, 3, 1), FE_OK);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+    ck_assert_int_eq(*(const unsigned char *)obs, 7);
+    ck_assert_int_eq(fe_source_from_array(&src, &as, NULL, 1, 8), FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_array(&src, &as, NULL, 0, 8), FE_OK);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_END);
+    /* A generator is not called past its end, and starts again when rewound. */
+    ck_assert_int_eq(fe_source_from_generator(&src, &gs, three_then_end, &calls, &slot,
+                                              sizeof slot), FE_OK);
+    for (int i = 0; i < 3; i++)
+        ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_END);
+    ck_assert_int_eq(calls, 4);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_END);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_END);
+    ck_assert_int_eq(calls, 4);
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+    ck_assert_double_eq(*(const double *)obs, 0.0);
+    ck_assert_int_eq(calls, 5);
+}
+END_TEST
+
 Suite *fe_stream_suite(void)
 {
     Suite *s = suite_create("stream");
@@ -228,6 +273,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, fd_source_on_a_pipe_cannot_rewind);
     tcase_add_test(t, batched_fold_stops_exactly_at_the_refused_observation);
     tcase_add_test(t, bad_arguments_and_mismatched_sizes);
+    tcase_add_test(t, sources_at_their_edges);
     tcase_add_test(t, fd_source_read_error_is_an_io_error);
     suite_add_tcase(s, t);
     return s;
