@@ -65,7 +65,7 @@ static int fe__arity(unsigned char op)
 /* The instructions ends here */
 /* [[file:../literate/expr.org::Parse an expression][Parse an expression]] */
 typedef struct fe__parser {
-    const char *text, *at;
+    const char *at;
     const char *const *names;
     size_t nnames;
     fe_expr *e;
@@ -337,7 +337,7 @@ int fe_expr_compile(fe_expr *e, const char *text, const char *const *names, size
         return FE_EINVAL;
     memset(e, 0, sizeof *e);
     memset(&p, 0, sizeof p);
-    p.text = p.at = text;
+    p.at = text;
     p.names = names;
     p.nnames = nnames;
     p.e = e;

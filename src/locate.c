@@ -403,6 +403,11 @@ int fe_region_describe(const fe_located *l, char *buf, size_t len)
 }
 /* Name a region ends here */
 /* [[file:../literate/locate.org::Start a residual map][Start a residual map]] */
+/* The roles of the map's state variables, in the order of its ranges and
+   bins: position, velocity, temperature. */
+static const unsigned fe__state_role[3] = {FE_ROLE_POSITION, FE_ROLE_VELOCITY,
+                                           FE_ROLE_TEMPERATURE};
+
 static void fe__add_region(fe_residual_map *m, fe_region r, double lo, double hi)
 {
     m->region[m->nregions] = r;
@@ -414,7 +419,6 @@ static void fe__add_region(fe_residual_map *m, fe_region r, double lo, double hi
 int fe_residual_map_init(fe_residual_map *m, size_t blocks, uint64_t fit, uint64_t row0,
                          unsigned roles, const double lo[3], const double hi[3])
 {
-    static const unsigned role[3] = {FE_ROLE_POSITION, FE_ROLE_VELOCITY, FE_ROLE_TEMPERATURE};
     if (m == NULL || (roles != 0 && (lo == NULL || hi == NULL)))
         return FE_EINVAL;
     if (blocks < 2 || blocks > FE_DISCOVER_MAX_BLOCKS)
@@ -422,7 +426,7 @@ int fe_residual_map_init(fe_residual_map *m, size_t blocks, uint64_t fit, uint64
     if (fit < 2 * (uint64_t)blocks)
         return FE_ETOOFEW;
     for (int v = 0; v < 3; v++)
-        if (roles & role[v]) {
+        if (roles & fe__state_role[v]) {
             if (!isfinite(lo[v]) || !isfinite(hi[v]))
                 return FE_ENONFINITE;
             if (lo[v] > hi[v])
@@ -435,7 +439,7 @@ int fe_residual_map_init(fe_residual_map *m, size_t blocks, uint64_t fit, uint64
     m->first_linked = 1;
     m->roles = roles & (FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE);
     for (int v = 0; v < 3; v++)
-        if (m->roles & role[v]) {
+        if (m->roles & fe__state_role[v]) {
             m->lo[v] = lo[v];
             m->hi[v] = hi[v];
         }
@@ -519,7 +523,7 @@ int fe_residual_map_add(fe_residual_map *m, const fe_sample *s, double before, d
     if (!isfinite(s->t) || !isfinite(before) || !isfinite(after))
         return FE_ENONFINITE;
     for (int v = 0; v < 3; v++)
-        if ((m->roles & (1u << v)) && !isfinite(x[v]))
+        if ((m->roles & fe__state_role[v]) && !isfinite(x[v]))
             return FE_ENONFINITE;
     i = m->row0 + m->n;
     k = i < m->fit ? (size_t)(i * m->blocks / m->fit) : m->blocks;
@@ -531,7 +535,7 @@ int fe_residual_map_add(fe_residual_map *m, const fe_sample *s, double before, d
             at[ncell++] = s->t;
         }
     for (int v = 0; v < 3; v++)
-        if (m->roles & (1u << v)) {
+        if (m->roles & fe__state_role[v]) {
             cell[ncell] = &m->bin[v][fe__band(x[v], m->lo[v], m->hi[v], FE_RESIDUAL_BINS)];
             at[ncell++] = x[v];
         }

@@ -1228,7 +1228,6 @@ typedef struct fe__run {
     unsigned roles;
     int kelvin[FE__ROLES];
     double lo[3], hi[3];                /* position, velocity, temperature */
-    size_t rows;
     size_t base[FE_DISCOVER_MAX_GROUPS], nbase;
     fe_discover_acc acc;
     double *storage, *work;
@@ -1292,7 +1291,7 @@ static int fe__run_scan(fe__run *u)
             u->lo[v] = x < u->lo[v] ? x : u->lo[v];
             u->hi[v] = x > u->hi[v] ? x : u->hi[v];
         }
-        u->rows++;
+        u->out.rows++;
     }
     if (rc != FE_END)
         return rc;
@@ -1312,12 +1311,11 @@ static int fe__run_scan(fe__run *u)
     u->scale.ambient_kelvin = u->kelvin[3];
     if (fe_catalog_init(&u->cat, u->roles, &u->scale) != FE_OK)
         return FE__OOM(u);
-    u->out.rows = u->rows;
-    u->out.heldout = (size_t)floor(u->a.holdout * (double)u->rows);
-    u->out.fit = u->rows - u->out.heldout;
+    u->out.heldout = (size_t)floor(u->a.holdout * (double)u->out.rows);
+    u->out.fit = u->out.rows - u->out.heldout;
     if (u->out.fit < 2 * (size_t)u->a.blocks + 10) {
         snprintf(u->err, sizeof u->err, "only %zu rows compared (%zu outside the simulation): "
-                 "too few for %ld blocks", u->rows, u->st.skipped, u->a.blocks);
+                 "too few for %ld blocks", u->out.rows, u->st.skipped, u->a.blocks);
         return FE_CLI_REFUSED;
     }
     return FE_CLI_OK;
@@ -1471,7 +1469,7 @@ static int fe__run_per_alloc(fe__run *u)
 static int fe__run_map(fe__run *u)
 {
     const fe_discover_result *r = u->res;
-    size_t i = 0, stride = u->rows / FE__PLOT_POINTS + 1;
+    size_t i = 0, stride = u->out.rows / FE__PLOT_POINTS + 1;
     int rc, new_pair, pair = 0;
     fe_sample s;
     double phi[FE_DISCOVER_MAX_COLUMNS];
