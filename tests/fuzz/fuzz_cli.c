@@ -28,14 +28,6 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     return 0;
 }
 
-static int named(const char *name, int argc, char **argv)
-{
-    for (int i = 0; i < argc; i++)
-        if (strcmp(argv[i], name) == 0)
-            return 1;
-    return 0;
-}
-
 /* Does an argument name `name`, as itself or as the value in --opt=name? */
 static int named_as_value(const char *name, int argc, char **argv)
 {
@@ -85,7 +77,7 @@ static void sweep(int argc, char **argv)
     while ((e = readdir(d)) != NULL) {
         if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
             continue;
-        if (strstr(e->d_name, ".tmp.") != NULL && !named(e->d_name, argc, argv)) {
+        if (strstr(e->d_name, ".tmp.") != NULL && !named_as_value(e->d_name, argc, argv)) {
             fprintf(stderr, "fuzz_cli: temporary file left behind: %s\n", e->d_name);
             abort();
         }
