@@ -309,6 +309,16 @@ static const char fe__discover_help[] =
     "                         at most 16; 0: none, batch means); each costs M^2 a row\n"
     "  --blocks K             time blocks for locating (and batch means) (default 20)\n"
     "  --alpha A              family-wise false discovery level (default 0.05)\n"
+    "  --order K              the time derivative the missing effect enters: 0 (default)\n"
+    "                         adds it to the channel (an offset, a gain, a sensor's\n"
+    "                         temperature coefficient); 2 to the channel's second\n"
+    "                         derivative (a force per mass on a position or angle);\n"
+    "                         1 to its first (a heat rate per capacity on a\n"
+    "                         temperature).  With K > 0 the simulation's dynamics are\n"
+    "                         identified from its columns, each term is carried through\n"
+    "                         them to the channel, and coefficients are per unit of the\n"
+    "                         K-th derivative; position and velocity (K = 2) or\n"
+    "                         temperature (K = 1) default to the simulated channel\n"
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
     "  --json                 print one JSON object instead of the story\n"
     "\n"
@@ -330,6 +340,7 @@ typedef struct fe__discover_args {
     long blocks, lags;
     int json;
     int noise;                  /* FE_DISCOVER_NOISE_AR or _BATCH */
+    long order;                 /* K: the derivative the effect enters (0 additive) */
 } fe__discover_args;
 
 static void fe__discover_usage(FILE *out)
@@ -410,6 +421,12 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
                 a->noise = FE_DISCOVER_NOISE_BATCH;
             else {
                 snprintf(err, errlen, "--noise: '%s' is not 'ar' or 'batch'", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--order") == 0) {
+            rc = fe_cli_parse_long(o, v, &a->order, err, errlen);
+            if (rc == FE_CLI_OK && (a->order < 0 || a->order > FE_DYNAMICS_MAX_ORDER)) {
+                snprintf(err, errlen, "--order: %s is not 0, 1 or 2", v);
                 rc = FE_CLI_USAGE;
             }
         } else if (strcmp(o, "--lags") == 0) {
@@ -510,6 +527,19 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
 }
 /* Open a pair and find its columns ends here */
 /* [[file:../../literate/cli_discover.org::Read the pairs as one stream][Read the pairs as one stream]] */
+/* With --order K the state the dynamics act on defaults to the simulated
+   channel: its value (position, temperature) and its derivative
+   (velocity) when no column has that role. */
+static void fe__fill_state(long order, const fe__pair *p, fe_sample *s)
+{
+    if (order == 2 && p->role_col[0] < 0)
+        s->position = s->sim;
+    if (order == 2 && p->role_col[1] < 0)
+        s->velocity = s->dsim;
+    if (order == 1 && p->role_col[2] < 0)
+        s->temperature = s->sim;
+}
+
 typedef struct fe__stream {
     fe__discover_args *a;
     size_t cur;
@@ -524,8 +554,10 @@ static int fe__stream_next(fe__stream *st, fe_sample *s, int *new_pair, char *er
     while (st->cur < st->a->npairs) {
         fe__pair *p = &st->a->pairs[st->cur];
         int rc = fe__pair_next(p, s, err, errlen);
-        if (rc == FE_OK)
+        if (rc == FE_OK) {
+            fe__fill_state(st->a->order, p, s);
             return FE_OK;
+        }
         if (rc != FE_END)
             return rc;
         st->skipped += p->skipped;
@@ -569,6 +601,8 @@ typedef struct fe__outcome {
     size_t npairs;
     double *per_coef, *per_se;                  /* npairs x ncols */
     double *per_rows, *per_held;                /* rows, held-out rows of each */
+    size_t order;                               /* --order K */
+    const fe_dynamics_fit *dyn;                 /* the simulation's, when K > 0 */
 } fe__outcome;
 
 static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
@@ -697,7 +731,7 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         const fe_term *t = &o->c->terms[r->added[s]];
         double se, coef = fe__coef_of(r, r->added[s], &se);
         char words[512];
-        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fe_dynamics_explain(t->name, o->order, coef, se, words, sizeof words);
         fprintf(f, "%s{\"name\": \"%s\", \"description\": ", s ? ", " : "", t->name);
         fe_cli_json_string(f, t->description);
         fe__json_pair(f, "coefficient", coef);
@@ -879,7 +913,7 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         const fe_term *t = &o->c->terms[r->added[s]];
         double se, coef = fe__coef_of(r, r->added[s], &se);
         char words[512];
-        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fe_dynamics_explain(t->name, o->order, coef, se, words, sizeof words);
         fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
                    "statistic %.2f, p = %.2g\n     %s\n",
                 s + 1, t->name, t->description, coef, se, coef - r->t_critical * se,
@@ -1215,7 +1249,7 @@ static int fe__discover_sphere_main(int argc, char **argv);
 static const fe_cli_option fe__discover_options[] = {
     {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
     {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--lags", 1}, {"--blocks", 1},
-    {"--alpha", 1},
+    {"--alpha", 1}, {"--order", 1},
     {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
 
 /* Everything one run of the command holds, from the arguments to the
@@ -1245,6 +1279,14 @@ typedef struct fe__run {
     fe_residual_cell *pblocks;
     size_t nplot, njoins;
     double joins[FE__MAX_PAIRS], held_x0, last_x, shift, step_x;
+    /* --order K: the span and fit of the simulation's dynamics, the
+       signatures, and the coefficients the states are corrected by
+       (zero until a first selection). */
+    fe_dynamics_span span;
+    fe_dynamics_fit dyn;
+    fe_dynamics_sens sens;
+    double theta[FE_DISCOVER_MAX_GROUPS];
+    double sig[FE_DISCOVER_MAX_GROUPS], sig_rate[FE_DISCOVER_MAX_GROUPS], sig_t;
     fe__outcome out;
     char err[2048];
 } fe__run;
@@ -1286,6 +1328,11 @@ static int fe__run_scan(fe__run *u)
     }
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         fe_catalog_scale_add(&u->scale, &s);
+        if (u->a.order > 0 && fe_dynamics_span_add(&u->span, &s) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "%.1000s:%zu: a state value is not finite at t = %g",
+                     u->a.pairs[u->st.cur].sim.name, u->a.pairs[u->st.cur].sim.line, s.t);
+            return FE_CLI_INPUT;
+        }
         for (int v = 0; v < 3; v++) {
             double x = *fe__role(&s, v);    /* position, velocity, temperature */
             u->lo[v] = x < u->lo[v] ? x : u->lo[v];
@@ -1309,7 +1356,9 @@ static int fe__run_scan(fe__run *u)
     memcpy(u->out.outside, u->st.outside, sizeof u->out.outside);
     u->scale.temperature_kelvin = u->kelvin[2];
     u->scale.ambient_kelvin = u->kelvin[3];
-    if (fe_catalog_init(&u->cat, u->roles, &u->scale) != FE_OK)
+    if ((u->a.order == 0 ? fe_catalog_init(&u->cat, u->roles, &u->scale)
+                         : fe_dynamics_catalog_init(&u->cat, (size_t)u->a.order, u->roles,
+                                                    &u->scale)) != FE_OK)
         return FE__OOM(u);
     u->out.heldout = (size_t)floor(u->a.holdout * (double)u->out.rows);
     u->out.fit = u->out.rows - u->out.heldout;
@@ -1326,6 +1375,8 @@ static int fe__run_base(fe__run *u)
 {
     char *list, *items[FE_DISCOVER_MAX_GROUPS];
     int n;
+    if (u->a.order > 0)                 /* the sensor's offset, always */
+        u->base[u->nbase++] = FE_DYNAMICS_OFFSET;
     if (u->a.base == NULL)
         return FE_CLI_OK;
     if ((list = malloc(strlen(u->a.base) + 1)) == NULL)
@@ -1340,10 +1391,83 @@ static int fe__run_base(fe__run *u)
             free(list);
             return FE_CLI_USAGE;
         }
+        if (u->a.order > 0 && j == FE_DYNAMICS_OFFSET)
+            continue;
         u->base[u->nbase++] = (size_t)j;
     }
     free(list);
     return FE_CLI_OK;
+}
+
+/* The pass that identifies the simulation's dynamics (--order K). */
+static int fe__run_ident(fe__run *u)
+{
+    fe_dynamics_ident id;
+    fe_sample s;
+    int rc, new_pair;
+    if (u->a.order == 0)
+        return FE_CLI_OK;
+    if (fe_dynamics_ident_init(&id, &u->span) != FE_OK
+        || fe_dynamics_sens_init(&u->sens, (size_t)u->a.order, u->cat.count - 1) != FE_OK)
+        return FE__OOM(u);
+    if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
+    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+        if (new_pair)
+            fe_dynamics_ident_break(&id);
+        if (fe_dynamics_ident_add(&id, &s) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "%.1000s:%zu: the simulation's state is not finite "
+                     "at t = %g", u->a.pairs[u->st.cur].sim.name,
+                     u->a.pairs[u->st.cur].sim.line, s.t);
+            return FE_CLI_INPUT;
+        }
+    }
+    if (rc != FE_END)
+        return rc;
+    if (fe_dynamics_ident_solve(&id, &u->dyn) != FE_OK) {
+        snprintf(u->err, sizeof u->err, "too few rows to identify the simulation's dynamics");
+        return FE_CLI_REFUSED;
+    }
+    return FE_CLI_OK;
+}
+
+/* The columns of one row: the catalog's terms (--order 0), or each term's
+   signature through the simulation's dynamics, the offset as it is.  With
+   coefficients in u->theta the terms are evaluated on the corrected
+   states. */
+static int fe__run_columns(fe__run *u, fe_sample *s, int new_pair, double *phi)
+{
+    size_t K = (size_t)u->a.order, m = u->cat.count;
+    double a[FE_DYNAMICS_MAX_ORDER], raw[FE_DISCOVER_MAX_COLUMNS];
+    int rc;
+    if (K == 0)
+        return fe_catalog_eval(&u->cat, s, phi);
+    if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
+        return rc;
+    if (new_pair || !u->sens.started) {
+        fe_dynamics_sens_restart(&u->sens);
+        memset(u->sig, 0, sizeof u->sig);
+        memset(u->sig_rate, 0, sizeof u->sig_rate);
+    } else {
+        double h = s->t - u->sig_t, dx = 0.0, dv = 0.0;
+        for (size_t j = 1; j < m; j++) {
+            dx += u->theta[j] * (u->sig[j] + h * u->sig_rate[j]);
+            dv += u->theta[j] * u->sig_rate[j];
+        }
+        if (K == 2) {
+            s->position += dx;
+            s->velocity += dv;
+        } else
+            s->temperature += dx;
+    }
+    if ((rc = fe_catalog_eval(&u->cat, s, raw)) != FE_OK
+        || (rc = fe_dynamics_sens_step(&u->sens, s->t, a, raw + 1, phi + 1, u->sig_rate + 1))
+               != FE_OK)
+        return rc;
+    phi[0] = raw[FE_DYNAMICS_OFFSET];
+    memcpy(u->sig + 1, phi + 1, (m - 1) * sizeof *phi);
+    u->sig_t = s->t;
+    return FE_OK;
 }
 
 /* Pass 2: every candidate term of every row into the engine's
@@ -1356,9 +1480,12 @@ static int fe__run_fold(fe__run *u)
     fe_sample s;
     int rc, new_pair;
     u->nwork = fe_discover_workspace_doubles(u->cat.count, (size_t)u->a.blocks);
-    u->storage = malloc(nst * sizeof *u->storage);
-    u->work = malloc(u->nwork * sizeof *u->work);
-    u->panel = p = malloc(sizeof *u->panel);
+    if (u->storage == NULL) {           /* a second fold (--order) reuses them */
+        u->storage = malloc(nst * sizeof *u->storage);
+        u->work = malloc(u->nwork * sizeof *u->work);
+        u->panel = malloc(sizeof *u->panel);
+    }
+    p = u->panel;
     if (u->storage == NULL || u->work == NULL || p == NULL)
         return FE__OOM(u);
     if (fe_discover_acc_init(&u->acc, u->cat.count, (size_t)u->a.blocks, u->out.fit, 0,
@@ -1367,6 +1494,7 @@ static int fe__run_fold(fe__run *u)
         return FE__OOM(u);
     if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    fe_dynamics_sens_restart(&u->sens);
     p->n = 0;
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         size_t k = p->n;
@@ -1379,7 +1507,7 @@ static int fe__run_fold(fe__run *u)
         p->line[k] = u->a.pairs[u->st.cur].real.line;
         p->file[k] = u->a.pairs[u->st.cur].real.name;
         p->t[k] = s.t;
-        if (fe_catalog_eval(&u->cat, &s, p->phi[k]) != FE_OK)
+        if (fe__run_columns(u, &s, new_pair, p->phi[k]) != FE_OK)
             break;
         p->n++;
     }
@@ -1397,7 +1525,7 @@ static int fe__run_select(fe__run *u)
     fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
     fe_discover_options opt = fe_discover_default_options();
     int rc;
-    if ((u->res = malloc(sizeof *u->res)) == NULL)
+    if (u->res == NULL && (u->res = malloc(sizeof *u->res)) == NULL)
         return FE__OOM(u);
     fe_catalog_groups(&u->cat, groups);
     opt.alpha = u->a.alpha;
@@ -1414,6 +1542,22 @@ static int fe__run_select(fe__run *u)
     memcpy(u->out.baseline_coef, u->res->path[0].coef,
            u->nbase * sizeof *u->out.baseline_coef);
     return FE_CLI_OK;
+}
+
+/* One Gauss-Newton step (--order K): the terms found evaluated on the
+   corrected states, folded and selected again. */
+static int fe__run_refine(fe__run *u)
+{
+    const fe_discover_result *r = u->res;
+    int rc;
+    if (u->a.order == 0 || r->steps == 0)
+        return FE_CLI_OK;
+    for (size_t j = 0; j < r->ncols; j++)
+        if (r->cols[j] != FE_DYNAMICS_OFFSET)
+            u->theta[r->cols[j]] = r->coef[j];
+    if ((rc = fe__run_fold(u)) != FE_CLI_OK)
+        return rc;
+    return fe__run_select(u);
 }
 
 /* The report folder, and the file of residual points in it. */
@@ -1481,6 +1625,7 @@ static int fe__run_map(fe__run *u)
     if ((rc = fe__run_open_report(u)) != FE_CLI_OK || (rc = fe__run_per_alloc(u)) != FE_CLI_OK
         || (rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    fe_dynamics_sens_restart(&u->sens);
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         double before = s.real - s.sim, after;
         for (; new_pair && pair < (int)u->st.cur; pair++)     /* a recording ends */
@@ -1489,7 +1634,10 @@ static int fe__run_map(fe__run *u)
         pair = (int)u->st.cur;
         if (i >= u->out.fit)
             u->out.per_held[pair] += 1.0;
-        fe_catalog_eval(&u->cat, &s, phi);
+        if (fe__run_columns(u, &s, new_pair, phi) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "a term is not finite at t = %g", s.t);
+            return FE_CLI_INPUT;
+        }
         for (size_t j = 0; j < u->nbase; j++)
             before -= u->out.baseline_coef[j] * phi[u->base[j]];
         after = s.real - s.sim;
@@ -1573,6 +1721,8 @@ static void fe__run_locate(fe__run *u)
     u->out.alpha = u->a.alpha;
     u->out.base = u->base;
     u->out.nbase = u->nbase;
+    u->out.order = (size_t)u->a.order;
+    u->out.dyn = u->a.order > 0 ? &u->dyn : NULL;
 }
 
 /* The report: the plot data, report.md and plots.gp, and the plots when
@@ -1639,6 +1789,10 @@ static int fe__run_open(fe__run *u)
             return rc;
     }
     u->st.a = &u->a;
+    if (u->a.order > 0) {               /* the state defaults to the channel */
+        u->roles |= u->a.order == 2 ? FE_ROLE_POSITION | FE_ROLE_VELOCITY : FE_ROLE_TEMPERATURE;
+        fe_dynamics_span_init(&u->span, (size_t)u->a.order);
+    }
     return FE_CLI_OK;
 }
 
@@ -1666,8 +1820,9 @@ int fe_cli_discover(int argc, char **argv)
         rc = FE_CLI_OK;
     } else if (rc == FE_CLI_OK) {
         if ((rc = fe__run_open(u)) == FE_CLI_OK && (rc = fe__run_scan(u)) == FE_CLI_OK
-            && (rc = fe__run_base(u)) == FE_CLI_OK && (rc = fe__run_fold(u)) == FE_CLI_OK
-            && (rc = fe__run_select(u)) == FE_CLI_OK && (rc = fe__run_map(u)) == FE_CLI_OK) {
+            && (rc = fe__run_base(u)) == FE_CLI_OK && (rc = fe__run_ident(u)) == FE_CLI_OK
+            && (rc = fe__run_fold(u)) == FE_CLI_OK && (rc = fe__run_select(u)) == FE_CLI_OK
+            && (rc = fe__run_refine(u)) == FE_CLI_OK && (rc = fe__run_map(u)) == FE_CLI_OK) {
             fe__run_per_recording(u);
             fe__run_locate(u);
             if (u->a.json)
