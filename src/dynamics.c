@@ -317,6 +317,53 @@ int fe_dynamics_fit_jacobian(const fe_sample *s, double *a, void *user)
     return FE_OK;
 }
 /* Solve the identification ends here */
+/* [[file:../literate/dynamics.org::The Runge-Kutta map of a substep][The Runge-Kutta map of a substep]] */
+/* dz/dtau at fraction l of the row step, Jacobian interpolated between
+   a0 (the last row's) and a1 (this row's). */
+static void fe__deriv(size_t K, const double *a0, const double *a1, double l, const double *z,
+                      double f, double *dz)
+{
+    double j0 = a0[0] + l * (a1[0] - a0[0]);
+    if (K == 1) {
+        dz[0] = j0 * z[0] + f;
+        dz[1] = 0.0;
+    } else {
+        double j1 = a0[1] + l * (a1[1] - a0[1]);
+        dz[0] = z[1];
+        dz[1] = j0 * z[0] + j1 * z[1] + f;
+    }
+}
+
+/* One RK4 step of length h from fraction l0 to l1 for state z and forcing
+   f0 at l0, f1 at l1 (linear between), into z. */
+static void fe__rk4(size_t K, const double *a0, const double *a1, double l0, double l1, double h,
+                    double *z, double f0, double f1)
+{
+    double lm = 0.5 * (l0 + l1), fm = 0.5 * (f0 + f1), k1[2], k2[2], k3[2], k4[2], y[2];
+    fe__deriv(K, a0, a1, l0, z, f0, k1);
+    y[0] = z[0] + 0.5 * h * k1[0], y[1] = z[1] + 0.5 * h * k1[1];
+    fe__deriv(K, a0, a1, lm, y, fm, k2);
+    y[0] = z[0] + 0.5 * h * k2[0], y[1] = z[1] + 0.5 * h * k2[1];
+    fe__deriv(K, a0, a1, lm, y, fm, k3);
+    y[0] = z[0] + h * k3[0], y[1] = z[1] + h * k3[1];
+    fe__deriv(K, a0, a1, l1, y, f1, k4);
+    for (int i = 0; i < 2; i++)
+        z[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+}
+
+/* The affine map of that step: z' = P z + q0 f0 + q1 f1. */
+static void fe__rk4_map(size_t K, const double *a0, const double *a1, double l0, double l1,
+                        double h, double P[2][2], double *q0, double *q1)
+{
+    double e0[2] = {1.0, 0.0}, e1[2] = {0.0, 1.0}, u0[2] = {0.0, 0.0}, u1[2] = {0.0, 0.0};
+    fe__rk4(K, a0, a1, l0, l1, h, e0, 0.0, 0.0);
+    fe__rk4(K, a0, a1, l0, l1, h, e1, 0.0, 0.0);
+    fe__rk4(K, a0, a1, l0, l1, h, u0, 1.0, 0.0);
+    fe__rk4(K, a0, a1, l0, l1, h, u1, 0.0, 1.0);
+    P[0][0] = e0[0], P[1][0] = e0[1], P[0][1] = e1[0], P[1][1] = e1[1];
+    q0[0] = u0[0], q0[1] = u0[1], q1[0] = u1[0], q1[1] = u1[1];
+}
+/* The Runge-Kutta map of a substep ends here */
 /* [[file:../literate/dynamics.org::Integrate the signatures][Integrate the signatures]] */
 int fe_dynamics_sens_init(fe_dynamics_sens *sn, size_t order, size_t m)
 {
@@ -339,12 +386,12 @@ void fe_dynamics_sens_restart(fe_dynamics_sens *sn)
 }
 
 /* The substeps of a row step of length h: enough that h lambda / n is at
-   most 0.1, lambda the fastest rate of the Jacobian at either end. */
+   most 0.2, lambda the fastest rate of the Jacobian at either end. */
 static size_t fe__substeps(size_t order, const double *a0, const double *a1, double h)
 {
     double l0 = order == 2 ? sqrt(fabs(a0[0])) + fabs(a0[1]) : fabs(a0[0]);
     double l1 = order == 2 ? sqrt(fabs(a1[0])) + fabs(a1[1]) : fabs(a1[0]);
-    double n = ceil(h * (l0 > l1 ? l0 : l1) / 0.1);
+    double n = ceil(h * (l0 > l1 ? l0 : l1) / 0.2);
     return n < 1.0 ? 1 : n > FE_DYNAMICS_MAX_SUBSTEPS ? FE_DYNAMICS_MAX_SUBSTEPS : (size_t)n;
 }
 
@@ -377,31 +424,15 @@ int fe_dynamics_sens_step(fe_dynamics_sens *sn, double t, const double *a, const
         h /= (double)nsub;
         for (size_t k = 0; k < nsub; k++) {
             double l0 = (double)k / (double)nsub, l1 = (double)(k + 1) / (double)nsub;
-            double b0 = sn->a[0] + l0 * (a[0] - sn->a[0]), b1 = sn->a[0] + l1 * (a[0] - sn->a[0]);
-            if (K == 1) {
-                double den = 1.0 - 0.5 * h * b1, p = (1.0 + 0.5 * h * b0) / den, qh = 0.5 * h / den;
-                for (size_t j = 0; j < m; j++) {
-                    double f0 = sn->phi[j] + l0 * (phi[j] - sn->phi[j]);
-                    double f1 = sn->phi[j] + l1 * (phi[j] - sn->phi[j]);
-                    z[j][0] = p * z[j][0] + qh * (f0 + f1);
-                }
-            } else {
-                double c0 = sn->a[1] + l0 * (a[1] - sn->a[1]), c1 = sn->a[1] + l1 * (a[1] - sn->a[1]);
-                /* M = [[1, -h/2], [-h/2 b1, 1 - h/2 c1]], N = I + h/2 A_k */
-                double m00 = 1.0, m01 = -0.5 * h, m10 = -0.5 * h * b1, m11 = 1.0 - 0.5 * h * c1;
-                double det = m00 * m11 - m01 * m10;
-                double i00 = m11 / det, i01 = -m01 / det, i10 = -m10 / det, i11 = m00 / det;
-                double n00 = 1.0, n01 = 0.5 * h, n10 = 0.5 * h * b0, n11 = 1.0 + 0.5 * h * c0;
-                double p00 = i00 * n00 + i01 * n10, p01 = i00 * n01 + i01 * n11;
-                double p10 = i10 * n00 + i11 * n10, p11 = i10 * n01 + i11 * n11;
-                double q0 = 0.5 * h * i01, q1 = 0.5 * h * i11;
-                for (size_t j = 0; j < m; j++) {
-                    double f = sn->phi[j] + l0 * (phi[j] - sn->phi[j])
-                               + sn->phi[j] + l1 * (phi[j] - sn->phi[j]);
-                    double s0 = z[j][0], s1 = z[j][1];
-                    z[j][0] = p00 * s0 + p01 * s1 + q0 * f;
-                    z[j][1] = p10 * s0 + p11 * s1 + q1 * f;
-                }
+            double P[2][2], q0[2], q1[2];
+            fe__rk4_map(K, sn->a, a, l0, l1, h, P, q0, q1);
+            for (size_t j = 0; j < m; j++) {
+                double f0 = sn->phi[j] + l0 * (phi[j] - sn->phi[j]);
+                double f1 = sn->phi[j] + l1 * (phi[j] - sn->phi[j]);
+                double s0 = z[j][0], s1 = K == 2 ? z[j][1] : 0.0;
+                z[j][0] = P[0][0] * s0 + P[0][1] * s1 + q0[0] * f0 + q1[0] * f1;
+                if (K == 2)
+                    z[j][1] = P[1][0] * s0 + P[1][1] * s1 + q0[1] * f0 + q1[1] * f1;
             }
         }
         for (size_t j = 0; j < m; j++)

@@ -637,6 +637,7 @@ static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
     fe__json_pair(f, "bic", fit->bic);
     fe__json_pair(f, "heldout_rms", fit->heldout_rms);
     fe__json_pair(f, "lag1", fit->lag1);
+    fe__json_pair(f, "floor", fit->floor);
     fprintf(f, ", \"params\": %zu}", fit->params);
 }
 
@@ -704,7 +705,14 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
             o->fit, o->heldout, o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END],
             o->outside[FE__IN_GAP]);
     fe_cli_json_bad_rows(f);
-    fprintf(f, ", ");
+    fprintf(f, ", \"order\": %zu, ", o->order);
+    if (o->dyn != NULL) {
+        fprintf(f, "\"simulation_dynamics\": {\"basis\": %zu, \"rows\": %.0f, \"r2\": ",
+                o->dyn->nused, o->dyn->n);
+        fe__json_number(f, o->dyn->r2);
+        fe__json_pair(f, "rms", o->dyn->rms);
+        fprintf(f, "}, ");
+    }
     fprintf(f, "\"base\": [");
     for (size_t i = 0; i < o->nbase; i++) {
         fprintf(f, "%s", i ? ", " : "");
@@ -875,6 +883,14 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     if (o->heldout > 0)
         fprintf(f, ", held-out RMS %.5g", r->baseline.heldout_rms);
     fprintf(f, ", lag-1 autocorrelation %.2f\n", r->baseline.lag1);
+    if (o->dyn != NULL) {
+        fprintf(f, "order %zu: the missing effect enters the %s derivative of the channel; the "
+                   "simulation's own dynamics fitted on %zu functions of its state, R^2 = %.6f\n",
+                o->order, o->order == 2 ? "second" : "first", o->dyn->nused, o->dyn->r2);
+        if (o->dyn->r2 < 0.99)
+            fprintf(f, "  warning: the simulation is not well described by those functions "
+                       "(R^2 below 0.99): the terms' signatures are approximate\n");
+    }
     fprintf(f, "\nwhere they differ:\n");
     if (o->nlocated == 0)
         fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
@@ -945,9 +961,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     if (r->steps > 0 && o->map->nregions > 0)
         fe__story_regions(f, o->map);
     rel = r->baseline.rms > 0 ? 100.0 * (r->final.rms / r->baseline.rms - 1.0) : 0.0;
-    fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f\n",
+    fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f; "
+               "high-frequency floor %.3g (RMS %.3g times it)\n",
             r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
-            r->baseline.lag1, r->final.lag1);
+            r->baseline.lag1, r->final.lag1, r->final.floor,
+            r->final.floor > 0 ? r->final.rms / r->final.floor : 0.0);
     if (o->heldout > 0)
         fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
                 r->baseline.heldout_rms, r->final.heldout_rms,
