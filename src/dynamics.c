@@ -154,6 +154,13 @@ static double fe__d3(double t0, double t1, double t2, double y0, double y1, doub
     return (h0 * h0 * y2 - h1 * h1 * y0 + (h1 * h1 - h0 * h0) * y1) / (h0 * h1 * (h0 + h1));
 }
 
+/* The three-point second derivative at the middle of (t0, t1, t2). */
+static double fe__dd3(double t0, double t1, double t2, double y0, double y1, double y2)
+{
+    double h0 = t1 - t0, h1 = t2 - t1;
+    return 2.0 * ((y2 - y1) / h1 - (y1 - y0) / h0) / (h0 + h1);
+}
+
 int fe_dynamics_ident_add(fe_dynamics_ident *id, const fe_sample *s)
 {
     const size_t dim = FE_DYNAMICS_BASIS + 1;
@@ -169,12 +176,15 @@ int fe_dynamics_ident_add(fe_dynamics_ident *id, const fe_sample *s)
     if (id->nwin > 0 && !(s->t > id->win[id->nwin - 1].t))
         return FE_EINVAL;
     if (id->nwin == 2) {
-        /* The middle row's K-th derivative (of the velocity for K = 2, of
-           the temperature for K = 1), and its basis. */
+        /* The middle row's K-th derivative of the state (the second
+           difference of the position for K = 2, the three-point derivative
+           of the temperature for K = 1), and its basis. */
         const fe_sample *a = &id->win[0], *b = &id->win[1];
         double x[FE_DYNAMICS_VARS], row[FE_DYNAMICS_BASIS + 1] = {0};
-        double y = fe__d3(a->t, b->t, s->t, fe__var(a, K, K - 1), fe__var(b, K, K - 1),
-                          fe__var(s, K, K - 1));
+        double y = K == 2 ? fe__dd3(a->t, b->t, s->t, fe__var(a, K, 0), fe__var(b, K, 0),
+                                    fe__var(s, K, 0))
+                          : fe__d3(a->t, b->t, s->t, fe__var(a, K, 0), fe__var(b, K, 0),
+                                   fe__var(s, K, 0));
         size_t nb;
         fe__scaled(id->centre, id->scale, b, K, x);
         nb = fe__basis(K, x, row, NULL, NULL);
