@@ -10,8 +10,9 @@ system again, here, from the files alone plus the rig's parameters written
 in truth.json: the input and ambient columns (held or interpolated as the
 truth says), the hidden terms evaluated from the conventions of README.md
 on the real states, the coefficient converted from the time column's unit
-(t_ms: 1e-3 s, t_min: 60 s, else seconds) to seconds, coulomb's scale from
-the simulation's velocity column at the recording's rows.  RK4 with
+(t_ms: 1e-3 s, t_min: 60 s, else seconds) to seconds, the velocity column
+in units per time-column unit, coulomb's scale from the simulation's
+velocity column at the recording's rows.  RK4 with
 SUBSTEPS (default 16) a simulation step.  Prints the largest difference
 between this trajectory and the recording (less the written offset) in
 noise sds, and the parting; with --quiet-noise the difference must be far
@@ -71,16 +72,17 @@ def main():
     terms = [(h["name"], h["coefficient"] / unit ** K) for h in t["truth"]]
 
     def term(name, x, v, u, ta, tau):
+        # x, u, ta as in the columns, v per second, tau seconds from the start
         if name == "bias":
             return 1.0
         if name == "drift":
             return tau / unit
         if name == "viscous_friction":
-            return v
+            return v * unit
         if name == "quadratic_drag":
-            return v * abs(v)
+            return v * unit * abs(v * unit)
         if name == "coulomb_friction":
-            return math.tanh(v / (0.002 * vmax))
+            return math.tanh(v * unit / (0.002 * vmax))
         if name == "linear_stiffness":
             return x
         if name == "cubic_stiffness":

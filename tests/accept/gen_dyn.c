@@ -606,18 +606,20 @@ static double steps_eval(const steps *s, double t)
 
 /* ------------------------------------------------------------------ dynamics */
 
-/* A catalog term at a state, from README.md's conventions: columns as
-   written (velocity per second, temperatures in the columns' unit), drift
-   in the time column's unit from the first row, coulomb with 0.002 max|v|
-   of the simulation, radiative in kelvin. */
+/* A catalog term at a state (x, v per second, u, ta, t seconds from the
+   start), from README.md's conventions, in the columns' units: velocity as
+   written, in units per time-column unit (v x seconds per unit), drift in
+   the time column's unit from the first row, coulomb with 0.002 max|v| of
+   the simulation's velocity column at the recording's rows, radiative in
+   kelvin. */
 static double term_at(const draw *d, int k, double x, double v, double u, double ta, double t)
 {
     switch (k) {
     case T_BIAS: return 1.0;
     case T_DRIFT: return t / d->csec;
-    case T_VISC: return v;
-    case T_QUAD: return v * fabs(v);
-    case T_COUL: return tanh(v / (0.002 * d->vmax));
+    case T_VISC: return v * d->csec;
+    case T_QUAD: return v * d->csec * fabs(v * d->csec);
+    case T_COUL: return tanh(v * d->csec / (0.002 * d->vmax));
     case T_LIN: return x;
     case T_CUB: return x * x * x;
     case T_THERM: return x - d->T1;
@@ -883,7 +885,7 @@ static void make_draw(draw *d, const dcase *cs, long seed, int attempt, uint64_t
                                    * (d->vs[j + 1] - d->vs[j]);
         }
         if (d->order == 2)
-            d->vmax = maxabs_of(vr, d->n);
+            d->vmax = maxabs_of(vr, d->n) * d->csec;   /* in the column's unit */
         free(vr);
     }
     d->T1 = d->x0;
@@ -1407,7 +1409,7 @@ int main(int argc, char **argv)
         fprintf(f, "%s,%s,%s,%s\n", time_column(d.clock), col_x(&d), col_amb(&d), col_u(&d));
     for (long i = 0; i < d.m; i++)
         fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", d.tcol_s[i], d.xs[i],
-                d.order == 2 ? d.vs[i] : d.amb_s[i], d.u_s[i]);
+                d.order == 2 ? d.vs[i] * d.csec : d.amb_s[i], d.u_s[i]);
     close_out(f);
     f = open_out(out, "real.csv");
     fprintf(f, "%s,%s\n", time_column(d.clock), col_x(&d));
@@ -1416,7 +1418,9 @@ int main(int argc, char **argv)
     close_out(f);
 
     /* The truth: coefficients in the K-th derivative per unit term, with
-       time in the time column's unit (coefficient_per_s: with seconds). */
+       time in the time column's unit, velocity and drift in that unit too
+       (coefficient_per_s: the same with every time in seconds, e.g. -c/m
+       in 1/s for viscous friction). */
     f = open_out(out, "truth.json");
     fprintf(f, "{\"case\": \"%s\", \"family\": \"%s\", \"seed\": %ld, \"rig\": \"%s\", \"order\": %d, "
                "\"noise\": \"%s\", \"clock\": \"%s\", \"rows\": %ld, \"sim_rows\": %ld, "
@@ -1430,7 +1434,9 @@ int main(int argc, char **argv)
     for (int j = 0; j < nt; j++)
         fprintf(f, "%s{\"name\": \"%s\", \"coefficient\": %.12g, \"coefficient_per_s\": %.12g, "
                    "\"design_z\": %.4g}",
-                j ? ", " : "", term_name[tr[j]], a[j] * pow(d.csec, d.order), a[j], g.z[j]);
+                j ? ", " : "", term_name[tr[j]], a[j] * pow(d.csec, d.order),
+                a[j] * (tr[j] == T_VISC ? d.csec : tr[j] == T_QUAD ? d.csec * d.csec
+                        : tr[j] == T_DRIFT ? 1.0 / d.csec : 1.0), g.z[j]);
     fprintf(f, "], \"identifiable\": %s, \"attempts\": %d, \"bumps\": %d, \"parting\": %.4g, "
                "\"rms_inflation\": %.4g, \"linearisation_error\": %.3g, \"sim_interp_error_sd\": %.3g, ",
             nt == 0 || identifiable ? "true" : "false", attempts, bumps, parting, inflation,
