@@ -107,6 +107,90 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* Output error (--order K): a cart's missing viscous friction named in its
+   acceleration with the synthetic truth inside the interval; a heated
+   stand's missing convective loss in its dT/dt; the additive mode on a
+   cart whose trajectories part widely is never "explained" and points to
+   --order; orders out of range are usage errors. */
+START_TEST(output_error_is_named_in_the_derivative_it_enters)
+{
+    static char out[65536];
+    char cmd[2048], *p;
+    double truth, lo, hi;
+    fe_synth g;
+    fe_synth_spec spec = fe_synth_default_spec("viscous_friction", 5);
+    fe_sample smp;
+    FILE *fr, *fs;
+    char path[256];
+    make_dir();
+    snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --order 2 --seed 3 --rows 6000 "
+             "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    p = strstr(out, "coefficient ");
+    ck_assert_ptr_nonnull(p);
+    truth = strtod(p + 12, NULL);
+    ck_assert_msg(strstr(out, "--order 2") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
+             "--role velocity=velocity --role input=input --order 2 --holdout 0.3 --json",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"order\": 2, \"simulation_dynamics\": {") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"viscous_friction\"") != NULL, "%s",
+                  out);
+    ck_assert_msg(strstr(out, "d2x/dt2 gains -c v") != NULL, "%s", out);
+    p = strstr(out, "\"interval95\": [");
+    ck_assert_ptr_nonnull(p);
+    ck_assert_int_eq(sscanf(p, "\"interval95\": [%lf, %lf]", &lo, &hi), 2);
+    ck_assert_msg(lo <= truth && truth <= hi, "%g not in [%g, %g]", truth, lo, hi);
+
+    snprintf(cmd, sizeof cmd, "%s synth --effect newton_cooling --order 1 --seed 2 --rows 8000 "
+             "--real %s/tr.csv --sim %s/ts.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/tr.csv --sim %s/ts.csv --channel temperature "
+             "--role ambient=ambient --role power=input --order 1 --holdout 0.3",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "1. newton_cooling") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "dT/dt gains -h (T - T_ambient)") != NULL, "%s", out);
+
+    /* Trajectories parting by about a hundred noise sds: the additive mode
+       must not call that explained. */
+    spec.order = 2;
+    spec.rows = 6000;
+    spec.parting = 100.0;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    snprintf(path, sizeof path, "%s/wr.csv", dir);
+    fr = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/ws.csv", dir);
+    fs = fopen(path, "w");
+    ck_assert(fr != NULL && fs != NULL);
+    fprintf(fr, "time,position\n");
+    fprintf(fs, "time,position,velocity,input\n");
+    while (fe_synth_next(&g, &smp) == FE_OK) {
+        fprintf(fr, "%.6f,%.12g\n", smp.t, smp.real);
+        fprintf(fs, "%.6f,%.12g,%.12g,%.12g\n", smp.t, smp.sim, smp.velocity, smp.input);
+    }
+    fclose(fr);
+    fclose(fs);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/wr.csv --sim %s/ws.csv --channel position "
+             "--role velocity=velocity --role input=input --holdout 0.3", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "verdict: mismatch not explained by the catalog") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "trajectories diverge") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "--order 2") != NULL, "%s", out);
+
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
+             "--order 3", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "--order: 3 is not 0, 1 or 2") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s synth --effect gain --order 2 --real %s/x.csv --sim %s/y.csv",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "describe the measurement") != NULL, "%s", out);
+    remove_dir();
+}
+END_TEST
+
 /* One input from standard input or a pipe, or compressed: the same
    answer as from the files; the copy of standard input leaves nothing in
    TMPDIR; two inputs from standard input are refused. */
@@ -715,6 +799,7 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, output_error_is_named_in_the_derivative_it_enters);
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);
     tcase_add_test(t, bursty_clocks_keep_every_covered_row);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));
