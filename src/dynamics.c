@@ -85,11 +85,14 @@ int fe_dynamics_span_add(fe_dynamics_span *sp, const fe_sample *s)
 /* The span of the variables ends here */
 /* [[file:../literate/dynamics.org::The basis][The basis]] */
 /* The basis at the scaled variables x[0..3]; d[0], d[1] (may be NULL)
-   receive each function's derivative in x[0] and x[1].  Returns the
-   number of functions. */
-static size_t fe__basis(size_t order, const double *x, double *f, double *d0, double *d1)
+   receive each function's derivative in x[0] and x[1]; wn (may be NULL:
+   the row's own) the scaled input at the rows before and after.  Returns
+   the number of functions. */
+static size_t fe__basis(size_t order, const double *x, const double *wn, double *f, double *d0,
+                        double *d1)
 {
     double p = x[0], v = x[1], w = x[2], b = x[3];
+    double wa = wn != NULL ? wn[0] : w, wb = wn != NULL ? wn[1] : w;
     double zero[FE_DYNAMICS_BASIS];
     if (d0 == NULL)
         d0 = zero;
@@ -109,7 +112,9 @@ static size_t fe__basis(size_t order, const double *x, double *f, double *d0, do
         f[7] = v * v * v, d1[7] = 3.0 * v * v;
         f[8] = p2 * p2 * p, d0[8] = 5.0 * p2 * p2;
         f[9] = p * v, d0[9] = v, d1[9] = p;
-        return 10;
+        f[10] = wa;
+        f[11] = wb;
+        return 12;
     }
     f[0] = 1.0;
     f[1] = p, d0[1] = 1.0;
@@ -120,7 +125,9 @@ static size_t fe__basis(size_t order, const double *x, double *f, double *d0, do
     f[6] = b * b;
     f[7] = p * b, d0[7] = b;
     f[8] = p * p * p * p, d0[8] = 4.0 * p * p * p;
-    return 9;
+    f[9] = wa;
+    f[10] = wb;
+    return 11;
 }
 
 static void fe__scaled(const double *centre, const double *scale, const fe_sample *s,
@@ -186,8 +193,10 @@ int fe_dynamics_ident_add(fe_dynamics_ident *id, const fe_sample *s)
                           : fe__d3(a->t, b->t, s->t, fe__var(a, K, 0), fe__var(b, K, 0),
                                    fe__var(s, K, 0));
         size_t nb;
+        double wn[2] = {(a->input - id->centre[2]) / id->scale[2],
+                        (s->input - id->centre[2]) / id->scale[2]};
         fe__scaled(id->centre, id->scale, b, K, x);
-        nb = fe__basis(K, x, row, NULL, NULL);
+        nb = fe__basis(K, x, wn, row, NULL, NULL);
         row[FE_DYNAMICS_BASIS] = y;
         if (!isfinite(y))
             return FE_ENONFINITE;
@@ -236,7 +245,7 @@ int fe_dynamics_ident_solve(const fe_dynamics_ident *id, fe_dynamics_fit *fit)
     const double *G;
     if (id == NULL || fit == NULL || !fe__order_ok(id->order))
         return FE_EINVAL;
-    nb = fe__basis(id->order, x0, f, NULL, NULL);
+    nb = fe__basis(id->order, x0, NULL, f, NULL, NULL);
     if (id->n < 2.0 * (double)nb)
         return FE_ETOOFEW;
     G = id->gram;
@@ -294,7 +303,7 @@ int fe_dynamics_fit_eval(const fe_sample *s, double *deriv, void *user)
     if (s == NULL || deriv == NULL || fit == NULL || !fe__order_ok(fit->order))
         return FE_EINVAL;
     fe__scaled(fit->centre, fit->scale, s, fit->order, x);
-    nb = fe__basis(fit->order, x, f, NULL, NULL);
+    nb = fe__basis(fit->order, x, NULL, f, NULL, NULL);
     for (size_t k = 0; k < nb; k++)
         v += fit->coef[k] * f[k];
     if (!isfinite(v))
@@ -312,7 +321,7 @@ int fe_dynamics_fit_jacobian(const fe_sample *s, double *a, void *user)
     if (s == NULL || a == NULL || fit == NULL || !fe__order_ok(fit->order))
         return FE_EINVAL;
     fe__scaled(fit->centre, fit->scale, s, fit->order, x);
-    nb = fe__basis(fit->order, x, f, d0, d1);
+    nb = fe__basis(fit->order, x, NULL, f, d0, d1);
     for (size_t k = 0; k < nb; k++) {
         a0 += fit->coef[k] * d0[k];
         a1 += fit->coef[k] * d1[k];
@@ -462,6 +471,112 @@ int fe_dynamics_sens_step(fe_dynamics_sens *sn, double t, const double *a, const
     return FE_OK;
 }
 /* Integrate the signatures ends here */
+/* [[file:../literate/dynamics.org::Integrate the deviation][Integrate the deviation]] */
+int fe_dynamics_deviation_init(fe_dynamics_deviation *dv, size_t order)
+{
+    if (dv == NULL || !fe__order_ok(order))
+        return FE_EINVAL;
+    memset(dv, 0, sizeof *dv);
+    dv->order = order;
+    return FE_OK;
+}
+
+void fe_dynamics_deviation_restart(fe_dynamics_deviation *dv)
+{
+    if (dv != NULL) {
+        dv->started = 0;
+        memset(dv->d, 0, sizeof dv->d);
+    }
+}
+
+/* The sample at fraction l between a and b, moved by the deviation d. */
+static fe_sample fe__between(const fe_sample *a, const fe_sample *b, double l)
+{
+    fe_sample m;
+    m.t = a->t + l * (b->t - a->t);
+    m.real = a->real + l * (b->real - a->real);
+    m.sim = a->sim + l * (b->sim - a->sim);
+    m.dsim = a->dsim + l * (b->dsim - a->dsim);
+    m.position = a->position + l * (b->position - a->position);
+    m.velocity = a->velocity + l * (b->velocity - a->velocity);
+    m.temperature = a->temperature + l * (b->temperature - a->temperature);
+    m.ambient = a->ambient + l * (b->ambient - a->ambient);
+    m.input = a->input + l * (b->input - a->input);
+    return m;
+}
+
+/* d(delta)/dt at fraction l of the row step, deviation z. */
+static int fe__dev_deriv(const fe_dynamics_deviation *dv, const fe_sample *b, double l,
+                         const double *z, fe_dynamics_fn *f, void *fu, fe_dynamics_fn *force,
+                         void *gu, double *dz)
+{
+    size_t K = dv->order;
+    fe_sample on = fe__between(&dv->prev, b, l), off = on;
+    double f0, f1, g;
+    int rc;
+    *fe__state(&off, K, 0) += z[0];
+    if (K == 2)
+        off.velocity += z[1];
+    if ((rc = f(&on, &f0, fu)) != 0 || (rc = f(&off, &f1, fu)) != 0
+        || (rc = force(&off, &g, gu)) != 0)
+        return rc;
+    if (K == 2) {
+        dz[0] = z[1];
+        dz[1] = f1 - f0 + g;
+    } else {
+        dz[0] = f1 - f0 + g;
+        dz[1] = 0.0;
+    }
+    return FE_OK;
+}
+
+int fe_dynamics_deviation_step(fe_dynamics_deviation *dv, const fe_sample *s, const double *a,
+                               fe_dynamics_fn *f, void *fuser, fe_dynamics_fn *force,
+                               void *forceuser, double *d)
+{
+    size_t K, nsub;
+    double z[2] = {0.0, 0.0}, h;
+    if (dv == NULL || s == NULL || a == NULL || f == NULL || force == NULL || d == NULL
+        || !fe__order_ok(dv->order))
+        return FE_EINVAL;
+    K = dv->order;
+    if (!isfinite(s->t) || !isfinite(a[0]) || (K == 2 && !isfinite(a[1])))
+        return FE_ENONFINITE;
+    if (dv->started) {
+        int rc;
+        if (!(s->t > dv->prev.t))
+            return FE_EINVAL;
+        memcpy(z, dv->d, sizeof z);
+        nsub = fe__substeps(K, dv->a, a, s->t - dv->prev.t);
+        h = (s->t - dv->prev.t) / (double)nsub;
+        for (size_t k = 0; k < nsub; k++) {
+            double l0 = (double)k / (double)nsub, l1 = (double)(k + 1) / (double)nsub;
+            double lm = 0.5 * (l0 + l1), k1[2], k2[2], k3[2], k4[2], y[2];
+            if ((rc = fe__dev_deriv(dv, s, l0, z, f, fuser, force, forceuser, k1)) != 0)
+                return rc;
+            y[0] = z[0] + 0.5 * h * k1[0], y[1] = z[1] + 0.5 * h * k1[1];
+            if ((rc = fe__dev_deriv(dv, s, lm, y, f, fuser, force, forceuser, k2)) != 0)
+                return rc;
+            y[0] = z[0] + 0.5 * h * k2[0], y[1] = z[1] + 0.5 * h * k2[1];
+            if ((rc = fe__dev_deriv(dv, s, lm, y, f, fuser, force, forceuser, k3)) != 0)
+                return rc;
+            y[0] = z[0] + h * k3[0], y[1] = z[1] + h * k3[1];
+            if ((rc = fe__dev_deriv(dv, s, l1, y, f, fuser, force, forceuser, k4)) != 0)
+                return rc;
+            for (int i = 0; i < 2; i++)
+                z[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+        if (!isfinite(z[0]) || !isfinite(z[1]))
+            return FE_ENONFINITE;
+    }
+    memcpy(dv->d, z, sizeof dv->d);
+    memcpy(dv->a, a, K * sizeof *a);
+    dv->prev = *s;
+    dv->started = 1;
+    memcpy(d, z, K * sizeof *d);
+    return FE_OK;
+}
+/* Integrate the deviation ends here */
 /* [[file:../literate/dynamics.org::The catalog of a dynamics analysis][The catalog of a dynamics analysis]] */
 static double fe__offset(const fe_sample *s, const fe_catalog_scale *c, void *u)
 {

@@ -15,7 +15,7 @@ extern "C" {
 
 enum {
     FE_DYNAMICS_MAX_ORDER = 2,      /* K: the derivative an effect enters */
-    FE_DYNAMICS_BASIS = 10,         /* functions the simulation is fitted on */
+    FE_DYNAMICS_BASIS = 12,         /* functions the simulation is fitted on */
     FE_DYNAMICS_VARS = 4,           /* state, rate, input, ambient */
     FE_DYNAMICS_MAX_SUBSTEPS = 256, /* substeps of one row step */
     FE_DYNAMICS_OFFSET = 0          /* the term of a dynamics catalog that
@@ -136,6 +136,35 @@ void fe_dynamics_sens_restart(fe_dynamics_sens *sn);
    allocation; about 8 m multiply-adds a substep. */
 int fe_dynamics_sens_step(fe_dynamics_sens *sn, double t, const double *a, const double *phi,
                           double *y, double *rate);
+
+/* The deviation of the real trajectory from the simulated one when the
+   forcing `force` (e.g. the discovered terms times their coefficients) is
+   added to the dynamics f: delta^(K) = f(sim + delta) - f(sim) +
+   force(sim + delta), from zero at the recording's first row.  Flat. */
+typedef struct fe_dynamics_deviation {
+    size_t order;
+    int started;
+    fe_sample prev;                             /* the last row, as given */
+    double a[FE_DYNAMICS_MAX_ORDER];            /* its Jacobian (for substeps) */
+    double d[FE_DYNAMICS_MAX_ORDER];            /* delta and its rate there */
+} fe_dynamics_deviation;
+
+/* fe_dynamics_deviation_init, _restart: an empty integrator of order K;
+   a new recording.  FE_EINVAL. */
+int fe_dynamics_deviation_init(fe_dynamics_deviation *dv, size_t order);
+void fe_dynamics_deviation_restart(fe_dynamics_deviation *dv);
+
+/* fe_dynamics_deviation_step: the row s (the simulation's states), with
+   the Jacobian a[0 .. K) there (it sets the substeps, as for the
+   signatures): delta and its rate at s into d[0 .. K).  Between rows every
+   field of the sample is taken linear in time and the deviation advances
+   by fourth-order Runge-Kutta.  Errors: FE_EINVAL (NULL, time not after
+   the last row's), FE_ENONFINITE, or a callback's nonzero return; the
+   state is then unchanged.  Cost: per substep 8 calls of f and 4 of
+   force. */
+int fe_dynamics_deviation_step(fe_dynamics_deviation *dv, const fe_sample *s, const double *a,
+                               fe_dynamics_fn *f, void *fuser, fe_dynamics_fn *force,
+                               void *forceuser, double *d);
 
 /* fe_dynamics_catalog_init: the catalog of order K for these roles: the
    sensor's offset first (FE_DYNAMICS_OFFSET, which enters the

@@ -1077,7 +1077,7 @@ static void fe__report_pending(const char *dir, int made)
 {
     static const char *const names[] = {"residuals.dat", "blocks.dat", "bins.dat",
                                         "report.md", "plots.gp", "residual_time.png",
-                                        "residual_state.png"};
+                                        "residual_state.png", "trajectory.png"};
     char path[4200];
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
@@ -1135,7 +1135,9 @@ static void fe__report_data(FILE *f, const fe__plot_info *pi)
                 pi->state_name, pi->state_name);
     fprintf(f, "- `residuals.dat`, every few rows: 1 time (the recording's own clock), "
                "2 residual before, 3 after, 4 position, 5 velocity, 6 temperature "
-               "(0 where the role is not given).\n"
+               "(0 where the role is not given; with --order, the states corrected by the "
+               "discovered terms), 7 the recording, 8 the simulation (column 7 minus column 3 "
+               "is the simulation corrected by the discovered terms).\n"
                "- `plots.gp`, the gnuplot script: `gnuplot plots.gp` in this folder "
                "draws the plots again.\n");
 }
@@ -1210,6 +1212,16 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
         fprintf(f, "Mean residual in 40 equal bins of `%s` (the %s), all rows, with %s1 "
                    "standard error.\n\n", pi->state_name, pi->state_var, pm);
     }
+    if (o->order > 0) {
+        fprintf(f, "## Recording, simulation and corrected simulation\n\n");
+        if (plots)
+            fprintf(f, "![recording, simulation and corrected simulation](trajectory.png)\n\n");
+        fprintf(f, "`%s` as recorded, as simulated, and as simulated with the discovered terms "
+                   "in its dynamics (to first order: the simulation plus each term's signature "
+                   "times its coefficient, plus the sensor's offset)%s.\n\n", pi->channel,
+                pi->held ? "; the grey band is held out, never seen by selection or fitting"
+                         : "");
+    }
     fe__report_data(f, pi);
     if ((rc = fe_cli_output_commit(&out, err, errlen)) != FE_CLI_OK)
         return rc;
@@ -1248,6 +1260,33 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
                    "set xlabel '%s'\n", qchan, qstate, pm, qstate);
         fe__plot_series(f, "bins.dat", NULL, terms, 0);
     }
+    if (o->order > 0)
+        {
+            fprintf(f, "unset object 1\nunset label 1\nunset arrow\n"
+                       "set output 'trajectory.png'\n"
+                       "set title '%s: recording, simulation and corrected simulation'\n"
+                       "set xlabel '%s'\nset ylabel '%s%s%s%s'\n",
+                    qchan, qtime, qchan, unit[0] ? " [" : "", qunit, unit[0] ? "]" : "");
+            if (pi->held && pi->njoins == 0)
+                fprintf(f, "set object 1 rect from first %.15g, graph 0 to first %.15g, graph 1 behind "
+                           "fillcolor rgb '#e6e6e6' fillstyle solid 1.0 noborder\n",
+                        pi->held0, pi->held1);
+            fprintf(f, "set terminal pngcairo size 1000,900 noenhanced\n"
+                       "set output 'trajectory.png'\nset multiplot layout 2,1\n"
+                       "plot 'residuals.dat' using 1:7 with points pt 7 ps 0.3 lc rgb '#808080' "
+                       "title 'recording', \\\n"
+                       "     '' using 1:8 with lines lw 2 lc rgb '#c0504d' title 'simulation', \\\n"
+                       "     '' using 1:($7-$3) with lines lw 2 lc rgb '#1f4e79' "
+                       "title 'corrected simulation'\n"
+                       "set title 'the same, less the simulation: how the trajectories part'\n"
+                       "set ylabel 'against the simulation%s%s%s'\n"
+                       "plot 'residuals.dat' using 1:2 with points pt 7 ps 0.3 lc rgb '#808080' "
+                       "title 'recording %s simulation (less the offset)', \\\n"
+                       "     '' using 1:($2-$3) with lines lw 2 lc rgb '#1f4e79' "
+                       "title 'corrected %s simulation'\n"
+                       "unset multiplot\n",
+                    unit[0] ? " [" : "", qunit, unit[0] ? "]" : "", minus, minus);
+        }
     if (fclose(f) != 0) {
         snprintf(err, errlen, "%.1000s: cannot write: %s", script, strerror(errno));
         return FE_CLI_IO;
@@ -1303,8 +1342,10 @@ typedef struct fe__run {
     fe_dynamics_span span;
     fe_dynamics_fit dyn;
     fe_dynamics_sens sens;
+    fe_dynamics_deviation dev;
+    int refine;                         /* Gauss-Newton: about x(theta) */
     double theta[FE_DISCOVER_MAX_GROUPS];
-    double sig[FE_DISCOVER_MAX_GROUPS], sig_rate[FE_DISCOVER_MAX_GROUPS], sig_t;
+    double adj;                         /* the row's residual adjustment */
     fe__outcome out;
     char err[2048];
 } fe__run;
@@ -1417,31 +1458,92 @@ static int fe__run_base(fe__run *u)
     return FE_CLI_OK;
 }
 
-/* The pass that identifies the simulation's dynamics (--order K). */
+/* Row r of window w (0..2) of a simulation as a sample: its time,
+   channel and roles, the channel's three-point derivative as dsim (one
+   sided at a gap or an end), the state filled in as the stream does. */
+static fe_sample fe__sim_sample(const fe__pair *p, long order, const fe__simrow *w)
+{
+    fe_sample s;
+    const fe__simrow *a = fe__linked(p, &w[0], &w[1]) ? &w[0] : NULL;
+    const fe__simrow *b = fe__linked(p, &w[1], &w[2]) ? &w[2] : NULL;
+    memset(&s, 0, sizeof s);
+    s.t = w[1].t;
+    s.sim = w[1].s;
+    for (int r = 0; r < FE__ROLES; r++)
+        *fe__role(&s, r) = w[1].role[r];
+    if (a != NULL && b != NULL) {
+        double h0 = w[1].t - a->t, h1 = b->t - w[1].t;
+        s.dsim = (h0 * h0 * b->s - h1 * h1 * a->s + (h1 * h1 - h0 * h0) * w[1].s)
+                 / (h0 * h1 * (h0 + h1));
+    } else if (a != NULL || b != NULL) {
+        const fe__simrow *o = a != NULL ? a : b;
+        s.dsim = (w[1].s - o->s) / (w[1].t - o->t);
+    }
+    fe__fill_state(order, p, &s);
+    return s;
+}
+
+/* The pass that identifies the simulation's dynamics (--order K), from
+   the simulation's own rows: the recording's times may be uneven and the
+   simulation interpolated onto them, and the second difference of an
+   interpolated position is mostly the interpolation's kinks. */
 static int fe__run_ident(fe__run *u)
 {
     fe_dynamics_ident id;
-    fe_sample s;
-    int rc, new_pair;
     if (u->a.order == 0)
         return FE_CLI_OK;
     if (fe_dynamics_ident_init(&id, &u->span) != FE_OK
-        || fe_dynamics_sens_init(&u->sens, (size_t)u->a.order, u->cat.count - 1) != FE_OK)
+        || fe_dynamics_sens_init(&u->sens, (size_t)u->a.order, u->cat.count - 1) != FE_OK
+        || fe_dynamics_deviation_init(&u->dev, (size_t)u->a.order) != FE_OK)
         return FE__OOM(u);
-    if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
-        return rc;
-    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
-        if (new_pair)
-            fe_dynamics_ident_break(&id);
-        if (fe_dynamics_ident_add(&id, &s) != FE_OK) {
-            snprintf(u->err, sizeof u->err, "%.1000s:%zu: the simulation's state is not finite "
-                     "at t = %g", u->a.pairs[u->st.cur].sim.name,
-                     u->a.pairs[u->st.cur].sim.line, s.t);
-            return FE_CLI_INPUT;
+    for (size_t q = 0; q < u->a.npairs; q++) {
+        fe__pair *p = &u->a.pairs[q];
+        fe__simrow w[3];
+        double v[2 + FE__ROLES];
+        size_t k = 2, n = 0;
+        int rc;
+        for (int r = 0; r < FE__ROLES; r++)
+            if (p->role_col[r] >= 0 && (size_t)p->role_col[r] + 1 > k)
+                k = (size_t)p->role_col[r] + 1;
+        if ((rc = fe_cli_table_rewind(&p->sim, u->err, sizeof u->err)) != FE_CLI_OK)
+            return rc;
+        fe_dynamics_ident_break(&id);
+        memset(w, 0, sizeof w);
+        for (;;) {
+            rc = fe_cli_table_next(&p->sim, p->sim_cols, k, v, u->err, sizeof u->err);
+            if (rc != FE_OK && rc != FE_END)
+                return rc;
+            w[0] = w[1];
+            w[1] = w[2];
+            w[2].valid = rc == FE_OK;
+            if (rc == FE_OK) {
+                w[2].t = v[0];
+                w[2].s = v[1];
+                for (int r = 0; r < FE__ROLES; r++)
+                    w[2].role[r] = p->role_col[r] >= 0 ? v[p->role_col[r]] : 0.0;
+            }
+            if (w[1].valid) {
+                fe_sample s = fe__sim_sample(p, u->a.order, w);
+                int gap = w[0].valid && !fe__linked(p, &w[0], &w[1]);
+                if (gap)
+                    fe_dynamics_ident_break(&id);
+                rc = fe_dynamics_ident_add(&id, &s);
+                if (rc == FE_EINVAL) {
+                    snprintf(u->err, sizeof u->err, "%.1000s:%zu: simulation time does not "
+                             "increase", p->sim.name, p->sim.line);
+                    return FE_CLI_INPUT;
+                }
+                if (rc != FE_OK) {
+                    snprintf(u->err, sizeof u->err, "%.1000s:%zu: the simulation's state is not "
+                             "finite at t = %g", p->sim.name, p->sim.line, s.t);
+                    return FE_CLI_INPUT;
+                }
+                n++;
+            }
+            if (!w[2].valid && n > 0)
+                break;
         }
     }
-    if (rc != FE_END)
-        return rc;
     if (fe_dynamics_ident_solve(&id, &u->dyn) != FE_OK) {
         snprintf(u->err, sizeof u->err, "too few rows to identify the simulation's dynamics");
         return FE_CLI_REFUSED;
@@ -1449,42 +1551,58 @@ static int fe__run_ident(fe__run *u)
     return FE_CLI_OK;
 }
 
+/* The discovered terms times their coefficients at a sample: the forcing
+   of the deviation (an fe_dynamics_fn). */
+static int fe__run_force(const fe_sample *s, double *g, void *user)
+{
+    const fe__run *u = user;
+    double phi[FE_DISCOVER_MAX_COLUMNS], sum = 0.0;
+    int rc = fe_catalog_eval(&u->cat, s, phi);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t j = 1; j < u->cat.count; j++)
+        sum += u->theta[j] * phi[j];
+    *g = sum;
+    return FE_OK;
+}
+
 /* The columns of one row: the catalog's terms (--order 0), or each term's
-   signature through the simulation's dynamics, the offset as it is.  With
-   coefficients in u->theta the terms are evaluated on the corrected
-   states. */
+   signature through the simulation's dynamics, the offset as it is.  Once
+   refining (u->refine), about the corrected trajectory: the deviation
+   under u->theta moves the sample's states (the caller sees them moved),
+   the Jacobian and the terms are taken there, and u->adj receives the
+   residual's adjustment -delta + sum theta_j s_j. */
 static int fe__run_columns(fe__run *u, fe_sample *s, int new_pair, double *phi)
 {
     size_t K = (size_t)u->a.order, m = u->cat.count;
-    double a[FE_DYNAMICS_MAX_ORDER], raw[FE_DISCOVER_MAX_COLUMNS];
+    double a[FE_DYNAMICS_MAX_ORDER], raw[FE_DISCOVER_MAX_COLUMNS], d[FE_DYNAMICS_MAX_ORDER] = {0};
     int rc;
+    u->adj = 0.0;
     if (K == 0)
         return fe_catalog_eval(&u->cat, s, phi);
-    if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
-        return rc;
     if (new_pair || !u->sens.started) {
         fe_dynamics_sens_restart(&u->sens);
-        memset(u->sig, 0, sizeof u->sig);
-        memset(u->sig_rate, 0, sizeof u->sig_rate);
-    } else {
-        double h = s->t - u->sig_t, dx = 0.0, dv = 0.0;
-        for (size_t j = 1; j < m; j++) {
-            dx += u->theta[j] * (u->sig[j] + h * u->sig_rate[j]);
-            dv += u->theta[j] * u->sig_rate[j];
-        }
-        if (K == 2) {
-            s->position += dx;
-            s->velocity += dv;
-        } else
-            s->temperature += dx;
+        fe_dynamics_deviation_restart(&u->dev);
+    }
+    if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
+        return rc;
+    if (u->refine) {
+        if ((rc = fe_dynamics_deviation_step(&u->dev, s, a, fe_dynamics_fit_eval, &u->dyn,
+                                             fe__run_force, u, d)) != FE_OK)
+            return rc;
+        *(K == 2 ? &s->position : &s->temperature) += d[0];
+        if (K == 2)
+            s->velocity += d[1];
+        if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
+            return rc;
     }
     if ((rc = fe_catalog_eval(&u->cat, s, raw)) != FE_OK
-        || (rc = fe_dynamics_sens_step(&u->sens, s->t, a, raw + 1, phi + 1, u->sig_rate + 1))
-               != FE_OK)
+        || (rc = fe_dynamics_sens_step(&u->sens, s->t, a, raw + 1, phi + 1, NULL)) != FE_OK)
         return rc;
     phi[0] = raw[FE_DYNAMICS_OFFSET];
-    memcpy(u->sig + 1, phi + 1, (m - 1) * sizeof *phi);
-    u->sig_t = s->t;
+    u->adj = -d[0];
+    for (size_t j = 1; j < m; j++)
+        u->adj += u->theta[j] * phi[j];
     return FE_OK;
 }
 
@@ -1521,12 +1639,12 @@ static int fe__run_fold(fe__run *u)
         if (new_pair)
             fe_discover_break(&u->acc);
         k = p->n;
-        p->r[k] = s.real - s.sim;
         p->line[k] = u->a.pairs[u->st.cur].real.line;
         p->file[k] = u->a.pairs[u->st.cur].real.name;
         p->t[k] = s.t;
         if (fe__run_columns(u, &s, new_pair, p->phi[k]) != FE_OK)
             break;
+        p->r[k] = s.real - s.sim + u->adj;
         p->n++;
     }
     if (rc == FE_OK || (rc == FE_END && fe__flush_panel(&u->acc, p) != FE_OK)) {
@@ -1562,20 +1680,55 @@ static int fe__run_select(fe__run *u)
     return FE_CLI_OK;
 }
 
-/* One Gauss-Newton step (--order K): the terms found evaluated on the
-   corrected states, folded and selected again. */
-static int fe__run_refine(fe__run *u)
+/* Gauss-Newton (--order K): fold and select again about the trajectory
+   corrected by the terms found, until the coefficients stop moving (a
+   fiftieth of a standard error) or FE__GN_ITERATIONS folds.  The baseline
+   (the simulation with its offset) stays the first fold's; the map pass
+   then integrates the deviation under the final coefficients. */
+enum { FE__GN_ITERATIONS = 4 };
+
+static void fe__run_theta(fe__run *u)
 {
     const fe_discover_result *r = u->res;
-    int rc;
-    if (u->a.order == 0 || r->steps == 0)
-        return FE_CLI_OK;
+    memset(u->theta, 0, sizeof u->theta);
     for (size_t j = 0; j < r->ncols; j++)
         if (r->cols[j] != FE_DYNAMICS_OFFSET)
             u->theta[r->cols[j]] = r->coef[j];
-    if ((rc = fe__run_fold(u)) != FE_CLI_OK)
-        return rc;
-    return fe__run_select(u);
+}
+
+static int fe__run_refine(fe__run *u)
+{
+    fe_discover_step base0;
+    fe_discover_fit baseline0;
+    int rc;
+    if (u->a.order == 0 || u->res->steps == 0)
+        return FE_CLI_OK;
+    base0 = u->res->path[0];
+    baseline0 = u->res->baseline;
+    u->refine = 1;
+    for (int it = 0; it < FE__GN_ITERATIONS; it++) {
+        double before[FE_DISCOVER_MAX_GROUPS];
+        int moved = 0;
+        memcpy(before, u->theta, sizeof before);
+        fe__run_theta(u);
+        for (size_t j = 0; j < u->res->ncols; j++) {
+            size_t c = u->res->cols[j];
+            if (fabs(u->theta[c] - before[c]) > 0.02 * u->res->stderr_[j])
+                moved = 1;
+        }
+        for (size_t c = 1; c < u->cat.count; c++)
+            if (before[c] != 0.0 && u->theta[c] == 0.0)
+                moved = 1;                  /* a term left the model */
+        if (it > 0 && !moved)
+            break;
+        if ((rc = fe__run_fold(u)) != FE_CLI_OK || (rc = fe__run_select(u)) != FE_CLI_OK)
+            return rc;
+    }
+    fe__run_theta(u);
+    u->res->path[0] = base0;
+    u->res->baseline = baseline0;
+    memcpy(u->out.baseline_coef, base0.coef, u->nbase * sizeof *u->out.baseline_coef);
+    return FE_CLI_OK;
 }
 
 /* The report folder, and the file of residual points in it. */
@@ -1658,7 +1811,7 @@ static int fe__run_map(fe__run *u)
         }
         for (size_t j = 0; j < u->nbase; j++)
             before -= u->out.baseline_coef[j] * phi[u->base[j]];
-        after = s.real - s.sim;
+        after = s.real - s.sim + u->adj;
         for (size_t j = 0; j < r->ncols; j++)
             after -= r->coef[j] * phi[r->cols[j]];
         if (fe_residual_map_add(u->map, &s, before, after) != FE_OK) {
@@ -1692,8 +1845,8 @@ static int fe__run_map(fe__run *u)
             fe_lsq_add(&u->per[pair], row, s.real - s.sim, 1.0);
         }
         if (u->pts != NULL && i % stride == 0)
-            fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
-                    s.position, s.velocity, s.temperature);
+            fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g %.10g %.10g\n", s.t, before, after,
+                    s.position, s.velocity, s.temperature, s.real, s.sim);
         i++;
     }
     return rc == FE_END ? FE_CLI_OK : rc;
