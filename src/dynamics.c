@@ -460,7 +460,8 @@ int fe_dynamics_sens_step(fe_dynamics_sens *sn, double t, const double *a, const
     }
     memcpy(sn->z, z, sizeof z);
     memcpy(sn->a, a, K * sizeof *a);
-    memcpy(sn->phi, phi, m * sizeof *phi);
+    if (m > 0)
+        memcpy(sn->phi, phi, m * sizeof *phi);
     sn->t = t;
     sn->started = 1;
     for (size_t j = 0; j < m; j++) {

@@ -19,13 +19,14 @@ _foldest()
         stats) opts="--columns --skip --json" ;;
         calibrate) opts="--model --columns --apply --skip --json --trace" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
-                        --alpha --report --json --sphere --columns" ;;
-        synth) opts="--effect --real --sim --seed --rows" ;;
+                        --alpha --order --report --json --sphere --columns" ;;
+        synth) opts="--effect --real --sim --seed --rows --order" ;;
         *) return 0 ;;
     esac
     case "$prev" in
         --model) COMPREPLY=($(compgen -W "sphere axial ellipsoid" -- "$cur")); return 0 ;;
         --noise) COMPREPLY=($(compgen -W "ar batch" -- "$cur")); return 0 ;;
+        --order) COMPREPLY=($(compgen -W "0 1 2" -- "$cur")); return 0 ;;
         --effect) COMPREPLY=($(compgen -W "bias drift gain delay viscous_friction quadratic_drag
                         coulomb_friction linear_stiffness cubic_stiffness thermal_sensitivity
                         newton_cooling radiative_cooling input_gain none none_thermal" -- "$cur"))
