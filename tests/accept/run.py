@@ -283,6 +283,13 @@ def real_recordings():
         print("real recordings: %d of %d pass" % (sum(lines), len(lines)))
 
 
+def user_terms_table():
+    """The outside_cogging cases with and without the right --term (user_terms.py)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import user_terms
+    user_terms.user_term_cases(FOLDEST, GEN, OUT, SEEDS, KEEP, MODES)
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     cases = [l.split()[0] for l in subprocess.run([GEN, "--list"], capture_output=True, text=True,
@@ -303,6 +310,7 @@ def main():
         json.dump(runs, f)
     print_tables(runs)
     real_recordings()
+    user_terms_table()
     print("\nper-run results: %s; %.0f s" % (os.path.join(OUT, "results.json"), time.time() - t0))
 
 
