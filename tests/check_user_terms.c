@@ -123,8 +123,8 @@ static const struct {
     {"--only nosuch", NULL, 2, "--only: no term 'nosuch'; terms: bias drift gain delay"},
     {"--term 'x=velocity' --exclude x,nosuch", NULL, 2, "--exclude: no term 'nosuch'"},
     {"--terms TERMS", "# a lab's terms\n\nok = velocity : fine\n  bad = sqrt(abs(pos) : no\n",
-     3, "terms.txt:4:23: missing ')'\n    bad = sqrt(abs(pos) : no\n"
-        "                        ^"},
+     3, "terms.txt:4:22: missing ')'\n    bad = sqrt(abs(pos) : no\n"
+        "                       ^"},
     {"--terms TERMS", "x = exp(velocity) : a\n# x again\nx = velocity\n", 3,
      "terms.txt:3: a term 'x' is already defined"},
     {"--terms TERMS-missing", NULL, 4, "cannot read"},
@@ -206,7 +206,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
     ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
     d = strstr(out, "\"discovered\": [{\"name\": \"cogging\", \"description\": "
                     "\"periodic force of the motor poles\", \"expression\": "
-                    "\" sin(2*pi*position/0.01) \"");
+                    "\"sin(2*pi*position/0.01)\"");
     ck_assert_msg(d != NULL, "%s", out);
     lo = json_number_after(d, "\"interval95\": [");
     hi = json_number_after(strstr(d, "\"interval95\": [") + 16, ", ");
@@ -225,7 +225,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
     ck_assert_int_eq(run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "1. cogging (periodic force of the motor poles): coefficient")
                   != NULL, "%s", out);
-    ck_assert_msg(strstr(out, "per unit of  sin(2*pi*position/0.01)") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "per unit of sin(2*pi*position/0.01)") != NULL, "%s", out);
     snprintf(path, sizeof path, "%s/rep/report.md", dir);
     {
         FILE *f = fopen(path, "r");

@@ -736,22 +736,18 @@ static int fe__terms_add(fe__user_terms *ut, const char *orig, const char *file,
             quote = *end;
         else if (*end == ':')
             break;
-    u->text = eq + 1;
     u->description = NULL;
     if (*end == ':') {
         *end = '\0';
         u->description = fe__trim(end + 1);
     }
+    u->text = fe__trim(eq + 1);         /* columns still count from orig */
     for (const char *c = u->description; c != NULL && *c != '\0'; c++)
         if ((unsigned char)*c < 0x20 || *c == 0x7f)
             return fe__term_error(u, (size_t)(c - u->spec) + 1,
                                   "a control character in the description", err, errlen);
-    if (u->description == NULL || *u->description == '\0') {
-        char *t = (char *)u->text;
-        while (*t == ' ' || *t == '\t')
-            t++;
-        u->description = t;             /* the expression describes itself */
-    }
+    if (u->description == NULL || *u->description == '\0')
+        u->description = u->text;       /* the expression describes itself */
     return FE_CLI_OK;
 }
 /* Split a term's text and check its name ends here */
