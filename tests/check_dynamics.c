@@ -257,10 +257,22 @@ START_TEST(an_identification_split_at_a_break_merges_to_the_whole)
     }
     ck_assert_int_eq(fe_dynamics_ident_merge(&first, &second), FE_OK);
     ck_assert(first.n == whole.n);
+    /* The sums agree to rounding; the fits' coefficients of nearly
+       collinear functions (the input and its neighbours) amplify that, so
+       what is compared after the solve is what the fit is for: the
+       Jacobian along the trajectory. */
+    for (size_t i = 0; i < sizeof whole.gram / sizeof whole.gram[0]; i++)
+        ck_assert_msg(fabs(first.gram[i] - whole.gram[i]) <= 1e-12 * (fabs(whole.gram[i]) + 1.0),
+                      "gram[%zu]: %.17g against %.17g", i, first.gram[i], whole.gram[i]);
     ck_assert_int_eq(fe_dynamics_ident_solve(&whole, &fw), FE_OK);
     ck_assert_int_eq(fe_dynamics_ident_solve(&first, &fm), FE_OK);
-    for (int k = 0; k < FE_DYNAMICS_BASIS; k++)
-        FE_ASSERT_REL(fm.coef[k] + 1.0, fw.coef[k] + 1.0, 1e-9);
+    for (size_t i = 100; i < NSIM; i += 350) {
+        double aw[2], am[2];
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], aw, &fw), FE_OK);
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], am, &fm), FE_OK);
+        FE_ASSERT_REL(am[0], aw[0], 1e-9);
+        FE_ASSERT_REL(am[1], aw[1], 1e-7);
+    }
     second.order = 1;
     ck_assert_int_eq(fe_dynamics_ident_merge(&first, &second), FE_EMISMATCH);
 }

@@ -19,7 +19,8 @@ _foldest()
         stats) opts="--columns --skip --json" ;;
         calibrate) opts="--model --columns --apply --skip --json --trace" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
-                        --alpha --order --report --json --sphere --columns" ;;
+                        --alpha --order --report --json --sphere --columns --term --terms
+                        --only --exclude" ;;
         synth) opts="--effect --real --sim --seed --rows --order" ;;
         *) return 0 ;;
     esac
@@ -34,7 +35,8 @@ _foldest()
         --role) COMPREPLY=($(compgen -W "position velocity temperature ambient input" -- "${cur#*=}"))
                 [ "${cur#*=}" != "$cur" ] && COMPREPLY=("${COMPREPLY[@]/#/${cur%%=*}=}")
                 return 0 ;;
-        --columns|--channel|--time|--base|--holdout|--lags|--blocks|--alpha|--seed|--rows|--skip) return 0 ;;
+        --columns|--channel|--time|--base|--holdout|--lags|--blocks|--alpha|--seed|--rows|--skip|--term|--only|--exclude) return 0 ;;
+        --terms) COMPREPLY=($(compgen -f -- "$cur")); return 0 ;;
         --report) COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     esac
     if [[ "$cur" == -* ]]; then

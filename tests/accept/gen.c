@@ -975,6 +975,11 @@ static void free_draw(draw *d)
         free(d->phi[k]);
 }
 
+/* The cogging effect as a term a user could write (foldest discover
+   --term): its period in position and its true coefficient, for the
+   user-term run of tests/accept/user_terms.py. */
+static double cogging_period, cogging_coefficient;
+
 /* An effect outside the catalog, added to (or, for clipping, applied to)
    the recording's channel.  Returns its RMS in noise sds. */
 static double outside_effect(draw *d, const char *what)
@@ -989,6 +994,7 @@ static double outside_effect(draw *d, const char *what)
             hi = fmax(hi, d->role_i[ROLE_POS][i]);
         }
         period = (hi - lo) / unif2(8, 20);
+        cogging_period = period;
         for (long i = 0; i < n; i++)
             e[i] = sin(2 * PI * d->role_i[ROLE_POS][i] / period);
     } else if (strcmp(what, "saturation") == 0) {
@@ -1075,6 +1081,7 @@ static double outside_effect(draw *d, const char *what)
         double s = rms_of(e, n);
         for (long i = 0; i < n; i++)
             d->y[i] += e[i] * (s > 0 ? target / s : 0);
+        cogging_coefficient = s > 0 ? target / s : 0;
     }
     free(e);
     return target / d->sigma;
@@ -1332,7 +1339,11 @@ int main(int argc, char **argv)
         fprintf(f, "\"competitor\": null, \"competitor_delta\": null, ");
     if (cs->pair >= 0)
         fprintf(f, "\"rival\": \"%s\", ", term_name[cs->pair]);
-    if (cs->outside != NULL)
+    if (cs->outside != NULL && strcmp(cs->outside, "cogging") == 0)
+        fprintf(f, "\"outside\": \"%s\", \"outside_rms_sd\": %.4g, \"outside_term\": "
+                   "{\"expression\": \"sin(2*pi*position/%.17g)\", \"coefficient\": %.12g}}\n",
+                cs->outside, outside_rms, cogging_period, cogging_coefficient);
+    else if (cs->outside != NULL)
         fprintf(f, "\"outside\": \"%s\", \"outside_rms_sd\": %.4g}\n", cs->outside, outside_rms);
     else
         fprintf(f, "\"outside\": null}\n");

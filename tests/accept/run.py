@@ -419,6 +419,13 @@ def save(key, runs):
         json.dump(data, f)
 
 
+def user_terms_table():
+    """The outside_cogging cases with and without the right --term (user_terms.py)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import user_terms
+    user_terms.user_term_cases(FOLDEST, GEN, OUT, SEEDS, KEEP, MODES)
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     if "--dynamics" in sys.argv[1:]:
@@ -442,6 +449,7 @@ def main():
     save("static", runs)
     print_tables(runs)
     real_recordings()
+    user_terms_table()
     save("dynamics", dynamics())
     print("\nper-run results: %s (keys static, dynamics); %.0f s"
           % (os.path.join(OUT, "results.json"), time.time() - t0))
