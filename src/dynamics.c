@@ -603,6 +603,7 @@ int fe_dynamics_catalog_init(fe_catalog *c, size_t order, unsigned roles,
     c->terms[c->count].eval = fe__offset;
     c->terms[c->count].user = NULL;
     c->terms[c->count].needs = 0;
+    c->terms[c->count].expr = NULL;
     c->count++;
     for (size_t j = 0; j < all.count; j++)
         if (strcmp(all.terms[j].name, "gain") != 0 && strcmp(all.terms[j].name, "delay") != 0)
