@@ -319,7 +319,7 @@ START_TEST(spans_and_finite_differences_at_zero)
     fe_dynamics_span sp;
     fe_sample s;
     double a[2];
-    const double x[4] = {0.3, -1.2, 2.5, 0.9};
+    const double x[4] = {-1.2, 0.3, 2.5, 0.9};     /* the least first */
     ck_assert_int_eq(fe_dynamics_span_init(NULL, 2), FE_EINVAL);
     ck_assert_int_eq(fe_dynamics_span_init(&sp, 0), FE_EINVAL);
     ck_assert_int_eq(fe_dynamics_span_init(&sp, 2), FE_OK);
