@@ -256,11 +256,11 @@ check-install: lib
 # (output-error) cases of tests/accept/gen_dyn.c, with and without their
 # --order K; long, so outside `make check` and CI.  SEEDS=20 by default,
 # QUICK=1 for three seeds.  `make accept-dynamics`: the dynamics section only.
-$(B)/accept/gen: tests/accept/gen.c $(B)/.deps
+$(B)/accept/gen: tests/accept/gen.c tests/accept/common.h $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) $(CFLAGS) -o $@ $< -lm
 
-$(B)/accept/gen_dyn: tests/accept/gen_dyn.c $(B)/.deps
+$(B)/accept/gen_dyn: tests/accept/gen_dyn.c tests/accept/common.h $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) $(CFLAGS) -o $@ $< -lm
 

@@ -35,6 +35,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "common.h"
+
 /* ------------------------------------------------------------------ macros */
 
 #define PI 3.14159265358979323846
@@ -145,40 +147,11 @@ typedef struct {
 
 /* ------------------------------------------------------------------ random numbers */
 
-static uint64_t rng_s[4];
 
-static uint64_t splitmix64(uint64_t *x)
-{
-    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
 
-static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
-static uint64_t xoshiro(void)
-{
-    uint64_t r = rotl(rng_s[1] * 5, 7) * 9, t = rng_s[1] << 17;
-    rng_s[2] ^= rng_s[0];
-    rng_s[3] ^= rng_s[1];
-    rng_s[1] ^= rng_s[2];
-    rng_s[0] ^= rng_s[3];
-    rng_s[2] ^= t;
-    rng_s[3] = rotl(rng_s[3], 45);
-    return r;
-}
 
-static void rng_seed(uint64_t seed)
-{
-    for (int i = 0; i < 4; i++)
-        rng_s[i] = splitmix64(&seed);
-}
 
-static double unif(void) { return ((double)(xoshiro() >> 11) + 0.5) * 0x1.0p-53; }
-static double unif2(double a, double b) { return a + (b - a) * unif(); }
-static double logunif(double a, double b) { return exp(unif2(log(a), log(b))); }
-static double sgn_rand(void) { return unif() < 0.5 ? -1.0 : 1.0; }
 
 static int gauss_have;
 static double gauss_spare;
@@ -197,13 +170,6 @@ static double gauss(void)
     return sqrt(-2.0 * log(u)) * cos(2.0 * PI * v);
 }
 
-static uint64_t hash_str(const char *s)
-{
-    uint64_t h = 1469598103934665603ULL;
-    while (*s)
-        h = (h ^ (unsigned char)*s++) * 1099511628211ULL;
-    return h;
-}
 
 /* ------------------------------------------------------------------ small helpers */
 
@@ -219,37 +185,9 @@ static void *alloc(long n, size_t size)
 
 static double *vec(long n) { return alloc(n, sizeof(double)); }
 
-static double mean_of(const double *x, long n)
-{
-    double s = 0;
-    for (long i = 0; i < n; i++)
-        s += x[i];
-    return s / (double)n;
-}
 
-static double sd_of(const double *x, long n)
-{
-    double m = mean_of(x, n), s = 0;
-    for (long i = 0; i < n; i++)
-        s += (x[i] - m) * (x[i] - m);
-    return sqrt(s / (double)(n - 1));
-}
 
-static double rms_of(const double *x, long n)
-{
-    double s = 0;
-    for (long i = 0; i < n; i++)
-        s += x[i] * x[i];
-    return sqrt(s / (double)n);
-}
 
-static double maxabs_of(const double *x, long n)
-{
-    double m = 0;
-    for (long i = 0; i < n; i++)
-        m = fabs(x[i]) > m ? fabs(x[i]) : m;
-    return m;
-}
 
 static double maxdiff_of(const double *x, const double *y, long n)
 {
@@ -259,7 +197,6 @@ static double maxdiff_of(const double *x, const double *y, long n)
     return m;
 }
 
-static double clampd(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* ------------------------------------------------------------------ least squares */
 
@@ -428,36 +365,7 @@ static void noise_draw(int type, long n, double *x)
     }
 }
 
-/* Levinson-Durbin: AR(p) prediction coefficients a[1..p] from r[0..p]. */
-static void levinson(const double *r, int p, double *a)
-{
-    double e = r[0], tmp[64];
-    memset(a, 0, (size_t)(p + 1) * sizeof *a);
-    for (int k = 1; k <= p; k++) {
-        double acc = r[k], kap;
-        for (int j = 1; j < k; j++)
-            acc -= a[j] * r[k - j];
-        kap = e > 0 ? acc / e : 0;
-        for (int j = 1; j < k; j++)
-            tmp[j] = a[j] - kap * a[k - j];
-        for (int j = 1; j < k; j++)
-            a[j] = tmp[j];
-        a[k] = kap;
-        e *= 1 - kap * kap;
-    }
-}
 
-/* The innovations of x under the AR(p) filter a, rows p .. n - 1 only (the
-   conditional GLS, as gen.c: the first p rows are not innovations). */
-static void whiten(const double *a, int p, const double *x, double *out, long n)
-{
-    for (long i = p; i < n; i++) {
-        double v = x[i];
-        for (int k = 1; k <= p; k++)
-            v -= a[k] * x[i - k];
-        out[i - p] = v;
-    }
-}
 
 /* ------------------------------------------------------------------ clocks */
 
@@ -582,7 +490,6 @@ static double multisine_eval(const multisine *m, double t)
 }
 
 /* Random levels switched at 8 to 32 random instants, with short ramps. */
-typedef struct { int k; double edge[32], level[33], ramp; } steps;
 
 static steps steps_draw(double D, double lo, double hi, double ramp)
 {
@@ -596,13 +503,6 @@ static steps steps_draw(double D, double lo, double hi, double ramp)
     return s;
 }
 
-static double steps_eval(const steps *s, double t)
-{
-    double v = s->level[0];
-    for (int i = 0; i < s->k; i++)
-        v += (s->level[i + 1] - s->level[i]) * clampd((t - s->edge[i]) / s->ramp + 0.5, 0, 1);
-    return v;
-}
 
 /* ------------------------------------------------------------------ dynamics */
 
