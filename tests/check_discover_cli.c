@@ -39,23 +39,7 @@ static void make_dir(void)
     ck_assert_ptr_nonnull(mkdtemp(dir));
 }
 
-static void remove_dir(void)
-{
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    ck_assert_int_eq(system(cmd), 0);
-}
 
-static void write_file(const char *name, const char *text)
-{
-    char path[256];
-    FILE *f;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
 
 START_TEST(concealed_drag_is_named_and_the_null_is_not)
 {
@@ -103,7 +87,7 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     ck_assert_int_eq(run(cmd, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 1") != NULL
                   || strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 0") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -187,7 +171,7 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
              FE_TEST_CLI, dir, dir);
     ck_assert_int_eq(run(cmd, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "describe the measurement") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -232,7 +216,7 @@ START_TEST(inputs_from_a_pipe_and_compressed)
     snprintf(cmd, sizeof cmd, "%s discover --real - --sim - %s < %s/r.csv", FE_TEST_CLI, roles, dir);
     ck_assert_int_eq(run(cmd, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "standard input can be read only once") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -332,7 +316,7 @@ START_TEST(bursty_clocks_keep_every_covered_row)
              FE_TEST_CLI, dir, dir);
     run(cmd, out, sizeof out);
     ck_assert_msg(strstr(out, "same unit of time") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -380,8 +364,8 @@ START_TEST(bad_inputs)
     char cmd[2048], out[8192];
     int status;
     make_dir();
-    write_file("real.csv", c->real);
-    write_file("sim.csv", c->sim);
+    fe_test_write_file(dir, "real.csv", c->real);
+    fe_test_write_file(dir, "sim.csv", c->sim);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/sim.csv %s", FE_TEST_CLI,
              dir, dir, c->args);
     status = run(cmd, out, sizeof out);
@@ -410,7 +394,7 @@ START_TEST(bad_inputs)
         ck_assert_msg(strstr(out, c->expect) != NULL, "%s: output lacks \"%s\":\n%s", c->what,
                       c->expect, out);
     }
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -590,7 +574,7 @@ START_TEST(report_data_and_plots_a_physicist_keeps)
             ck_assert_int_eq(memcmp(magic, "\x89PNG\r\n\x1a\n", 8), 0);
         }
     }
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -614,7 +598,7 @@ START_TEST(report_axis_carries_the_channels_unit)
              unit_cases[_i][1]);
     ck_assert_msg(strstr(text, want) != NULL, "%s: want \"%s\" in:\n%s", unit_cases[_i][0], want,
                   text);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -656,7 +640,7 @@ START_TEST(report_lays_recordings_end_to_end)
     ck_assert_msg(strstr(text, "set xlabel 't [s] (recordings end to end)'") != NULL, "%s", text);
     ck_assert_msg(strstr(text, "set arrow 1 from first ") != NULL, "%s", text);
     ck_assert_msg(strstr(text, "held out") == NULL, "no rows held out, yet:\n%s", text);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -710,7 +694,7 @@ START_TEST(report_keeps_an_epoch_clock)
     ck_assert_msg(fabs(first - (1.7e9 + 0.123 + t0)) < 1e-5, "first time %.6f, want %.6f", first,
                   1.7e9 + 0.123 + t0);
     ck_assert_msg(t > first && t < 1.7e9 + t1 + 1, "middle time %.6f", t);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -754,7 +738,7 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
                 && (second == NULL || second > strstr(q, "\"per_recording\""));
     }
     ck_assert_msg(good >= 10, "quadratic drag alone, k in [0.010, 0.030], in %d of 12 drops", good);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 

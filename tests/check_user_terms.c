@@ -84,22 +84,7 @@ static void write_pair(void)
              "--role vel=velocity --base bias,gain", FE_TEST_CLI, dir, dir);
 }
 
-static void remove_pair(void)
-{
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    ck_assert_int_eq(system(cmd), 0);
-}
 
-static void write_file(const char *name, const char *text)
-{
-    char path[256];
-    FILE *f;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    ck_assert_ptr_nonnull(f = fopen(path, "w"));
-    fputs(text, f);
-    fclose(f);
-}
 
 /* The number after `key` in the JSON object that starts at `at`. */
 static double json_number_after(const char *at, const char *key)
@@ -156,14 +141,14 @@ START_TEST(errors_name_their_column)
         snprintf(args + (t - args), sizeof args - (size_t)(t - args), "%s/terms.txt%s", dir, rest);
     }
     if (bad[_i].file != NULL)
-        write_file("terms.txt", bad[_i].file);
+        fe_test_write_file(dir, "terms.txt", bad[_i].file);
     snprintf(cmd, sizeof cmd, "%s %s", base_args, args);
     ck_assert_int_eq(run(cmd, 1, out, sizeof out), bad[_i].status);
     ck_assert_msg(strstr(out, bad[_i].says) != NULL, "%s\nwant: %s\ngot: %s", args,
                   bad[_i].says, out);
     ck_assert_int_eq(run(cmd, 0, out, sizeof out), bad[_i].status);
     ck_assert_str_eq(out, "");
-    remove_pair();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -189,7 +174,7 @@ START_TEST(a_term_not_finite_is_refused_at_its_row)
     snprintf(cmd, sizeof cmd, "%s --term 'nan=sqrt(gate - 1.5)' --json", base_args);
     ck_assert_int_eq(run(cmd, 1, out, sizeof out), 3);
     ck_assert_msg(strstr(out, "real.csv:2: term 'nan' is NaN at t = 0") != NULL, "%s", out);
-    remove_pair();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -205,7 +190,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
     const char *d;
     double lo, hi, se;
     write_pair();
-    write_file("terms.txt",
+    fe_test_write_file(dir, "terms.txt",
                "# motor rig: pole pitch 10 mm\n"
                "\n"
                "cogging = sin(2*pi*position/0.01) : periodic force of the motor poles\n"
@@ -250,7 +235,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
         ck_assert_msg(strstr(out, "cogging (periodic force of the motor poles)") != NULL, "%s",
                       out);
     }
-    remove_pair();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -279,7 +264,7 @@ START_TEST(only_and_exclude_choose_among_all_terms)
     ck_assert_msg(strstr(out, "\"base\": [\"bias\", \"gain\"]") != NULL, "%s", out);
     ck_assert_msg(strstr(strstr(out, "\"ranking\""), "\"decoy\"") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") == NULL, "%s", out);
-    remove_pair();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
