@@ -59,7 +59,7 @@ export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
         check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
-        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept mutate
+        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
 
 all: lib cli examples
 
@@ -252,14 +252,25 @@ check-install: lib
 # ---------------------------------------------------------------- acceptance
 # `make accept`: foldest discover on cases drawn by an independent generator
 # (tests/accept/gen.c: its own random numbers, rigs, noise and clocks; it
-# includes nothing of foldest) and on the real recordings; long, so outside
-# `make check` and CI.  SEEDS=20 by default, QUICK=1 for three seeds.
-$(B)/accept/gen: tests/accept/gen.c $(B)/.deps
+# includes nothing of foldest) and on the real recordings, then the dynamics
+# (output-error) cases of tests/accept/gen_dyn.c, with and without their
+# --order K; long, so outside `make check` and CI.  SEEDS=20 by default,
+# QUICK=1 for three seeds.  `make accept-dynamics`: the dynamics section only.
+$(B)/accept/gen: tests/accept/gen.c tests/accept/common.h $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) $(CFLAGS) -o $@ $< -lm
 
-accept: all $(B)/accept/gen
-	FOLDEST=$(CLI) GEN=$(B)/accept/gen ACCEPT_OUT=$(B)/accept/runs python3 tests/accept/run.py
+$(B)/accept/gen_dyn: tests/accept/gen_dyn.c tests/accept/common.h $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) $(CFLAGS) -o $@ $< -lm
+
+ACCEPT_ENV = FOLDEST=$(CLI) GEN=$(B)/accept/gen GEN_DYN=$(B)/accept/gen_dyn ACCEPT_OUT=$(B)/accept/runs
+
+accept: all $(B)/accept/gen $(B)/accept/gen_dyn
+	$(ACCEPT_ENV) python3 tests/accept/run.py
+
+accept-dynamics: all $(B)/accept/gen_dyn
+	$(ACCEPT_ENV) python3 tests/accept/run.py --dynamics
 
 # ---------------------------------------------------------------- mutation testing
 # `make mutate`: single-point mutants generated from src/*.c by

@@ -3,7 +3,8 @@
 # make demo: the main job.  foldest finds what a simulation left out:
 #   1. a synthetic experiment whose recording hides quadratic drag (at most
 #      0.3 noise standard deviations per sample, coloured noise), generated
-#      here, and a negative control with nothing hidden;
+#      here, and a negative control with nothing hidden; then a cart whose
+#      simulation lacks a viscous friction that changes its motion (--order 2);
 #   2. the phone free-fall recordings (../shared/data/freefall-drag, or
 #      $FOLDEST_DATA), each drop against a vacuum free-fall simulation of it;
 #   3. magnetometer recordings against the best sphere through them;
@@ -26,6 +27,17 @@ say "1b. The negative control: the same rig with nothing hidden"
 "$FOLDEST" discover --real "$OUT/null_real.csv" --sim "$OUT/null_sim.csv" --channel acceleration \
   --role position=position --role velocity=velocity --role input=input \
   --base bias,gain --holdout 0.3 | tail -n 4
+
+say "1c. When the missing physics changes the motion: a driven cart missing a viscous friction"
+"$FOLDEST" synth --effect viscous_friction --order 2 --seed 3 --rows 6000 \
+  --real "$OUT/cart_real.csv" --sim "$OUT/cart_sim.csv"
+echo "adding terms to the position (the first mode) misses it:"
+"$FOLDEST" discover --real "$OUT/cart_real.csv" --sim "$OUT/cart_sim.csv" --channel position \
+  --role velocity=velocity --role input=input --holdout 0.3 | sed -n '/^verdict/,$p'
+echo "the effect in the cart's acceleration (--order 2):"
+"$FOLDEST" discover --real "$OUT/cart_real.csv" --sim "$OUT/cart_sim.csv" --channel position \
+  --role velocity=velocity --role input=input --order 2 --holdout 0.3 --report "$OUT/dynamics" |
+  sed -n '/^order/p;/^what was left out/,/^$/p;/^held out/p;/^verdict/,$p'
 
 say "2. Real recordings: a phone in free fall against a vacuum simulation, drop by drop"
 DATA=${FOLDEST_DATA:-../shared/data}

@@ -21,6 +21,7 @@ extern "C" {
 #include "foldest/catalog.h"
 #include "foldest/synth.h"
 #include "foldest/model.h"
+#include "foldest/dynamics.h"
 #include "foldest/lsq.h"
 #include "foldest/schur.h"
 #include "foldest/lm.h"

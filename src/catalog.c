@@ -54,22 +54,25 @@ static double fe__input(const fe_sample *s, const fe_catalog_scale *c, void *u)
 { (void)c; (void)u; return s->input; }
 
 static const fe_term fe__builtin[] = {
-    {"bias", "constant sensor or actuator offset", fe__bias, 0, 0},
-    {"drift", "offset drifting with time", fe__drift, 0, 0},
-    {"gain", "scale-factor error", fe__gain, 0, 0},
-    {"delay", "time lag between simulation and recording", fe__delay, 0, 0},
+    {"bias", "constant sensor or actuator offset", fe__bias, 0, 0, NULL},
+    {"drift", "offset drifting with time", fe__drift, 0, 0, NULL},
+    {"gain", "scale-factor error", fe__gain, 0, 0, NULL},
+    {"delay", "time lag between simulation and recording", fe__delay, 0, 0, NULL},
     {"viscous_friction", "force proportional to velocity (viscous damping, Stokes drag)",
-     fe__viscous, 0, FE_ROLE_VELOCITY},
-    {"quadratic_drag", "aerodynamic (turbulent) drag", fe__quadratic, 0, FE_ROLE_VELOCITY},
-    {"coulomb_friction", "dry friction", fe__coulomb, 0, FE_ROLE_VELOCITY},
-    {"linear_stiffness", "missing spring or restoring force", fe__linear, 0, FE_ROLE_POSITION},
-    {"cubic_stiffness", "hardening or softening spring", fe__cubic, 0, FE_ROLE_POSITION},
-    {"thermal_sensitivity", "temperature coefficient", fe__thermal, 0, FE_ROLE_TEMPERATURE},
+     fe__viscous, 0, FE_ROLE_VELOCITY, NULL},
+    {"quadratic_drag", "aerodynamic (turbulent) drag", fe__quadratic, 0, FE_ROLE_VELOCITY,
+     NULL},
+    {"coulomb_friction", "dry friction", fe__coulomb, 0, FE_ROLE_VELOCITY, NULL},
+    {"linear_stiffness", "missing spring or restoring force", fe__linear, 0, FE_ROLE_POSITION,
+     NULL},
+    {"cubic_stiffness", "hardening or softening spring", fe__cubic, 0, FE_ROLE_POSITION, NULL},
+    {"thermal_sensitivity", "temperature coefficient", fe__thermal, 0, FE_ROLE_TEMPERATURE,
+     NULL},
     {"newton_cooling", "convective heat loss", fe__newton, 0,
-     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
+     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT, NULL},
     {"radiative_cooling", "thermal radiation", fe__radiative, 0,
-     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
-    {"input_gain", "actuator gain error", fe__input, 0, FE_ROLE_INPUT},
+     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT, NULL},
+    {"input_gain", "actuator gain error", fe__input, 0, FE_ROLE_INPUT, NULL},
 };
 
 const fe_term *fe_catalog_builtin_terms(size_t *count)
@@ -130,16 +133,39 @@ int fe_catalog_add(fe_catalog *c, const char *name, const char *description,
     c->terms[c->count].eval = eval;
     c->terms[c->count].user = user;
     c->terms[c->count].needs = 0;
+    c->terms[c->count].expr = NULL;
     c->count++;
+    return FE_OK;
+}
+
+int fe_catalog_remove(fe_catalog *c, const char *name)
+{
+    long j = fe_catalog_find(c, name);
+    if (j < 0)
+        return FE_EINVAL;
+    memmove(&c->terms[j], &c->terms[j + 1], (c->count - (size_t)j - 1) * sizeof c->terms[0]);
+    c->count--;
     return FE_OK;
 }
 
 int fe_catalog_eval(const fe_catalog *c, const fe_sample *s, double *phi)
 {
+    double row[FE_CATALOG_VARS];
     if (c == NULL || s == NULL || phi == NULL)
         return FE_EINVAL;
+    fe_catalog_row(s, row);
     for (size_t j = 0; j < c->count; j++) {
-        phi[j] = c->terms[j].eval(s, &c->scale, c->terms[j].user);
+        const fe_term *k = &c->terms[j];
+        if (k->expr != NULL) {
+            int rc;
+            if (k->expr->nvars > FE_CATALOG_VARS)
+                return FE_EINVAL;
+            rc = fe_expr_eval(k->expr, row, &phi[j]);
+            if (rc != FE_OK)
+                return rc;
+        } else {
+            phi[j] = k->eval(s, &c->scale, k->user);
+        }
         if (!isfinite(phi[j]))
             return FE_ENONFINITE;
     }
@@ -155,6 +181,111 @@ void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups)
     }
 }
 /* Build and evaluate a catalog ends here */
+/* [[file:../literate/catalog.org::Evaluate expression terms][Evaluate expression terms]] */
+static const char *const fe__var_names[FE_CATALOG_VARS] = {
+    "t", "sim", "dsim", "position", "velocity", "temperature", "ambient", "input"};
+
+const char *const *fe_catalog_var_names(size_t *count)
+{
+    if (count != NULL)
+        *count = FE_CATALOG_VARS;
+    return fe__var_names;
+}
+
+int fe_catalog_add_expr(fe_catalog *c, const char *name, const char *description,
+                        const fe_expr *e)
+{
+    size_t nb;
+    const fe_term *b = fe_catalog_builtin_terms(&nb);
+    if (c == NULL || name == NULL || e == NULL || fe_catalog_find(c, name) >= 0)
+        return FE_EINVAL;
+    for (size_t i = 0; i < nb; i++)
+        if (strcmp(b[i].name, name) == 0)
+            return FE_EINVAL;
+    if (c->count >= FE_DISCOVER_MAX_GROUPS)
+        return FE_ESIZE;
+    memset(&c->terms[c->count], 0, sizeof c->terms[0]);
+    c->terms[c->count].name = name;
+    c->terms[c->count].description = description != NULL ? description : "user term";
+    c->terms[c->count].expr = e;
+    c->count++;
+    return FE_OK;
+}
+
+void fe_catalog_row(const fe_sample *s, double *row)
+{
+    row[FE_CATALOG_VAR_T] = s->t;
+    row[FE_CATALOG_VAR_SIM] = s->sim;
+    row[FE_CATALOG_VAR_DSIM] = s->dsim;
+    row[FE_CATALOG_VAR_POSITION] = s->position;
+    row[FE_CATALOG_VAR_VELOCITY] = s->velocity;
+    row[FE_CATALOG_VAR_TEMPERATURE] = s->temperature;
+    row[FE_CATALOG_VAR_AMBIENT] = s->ambient;
+    row[FE_CATALOG_VAR_INPUT] = s->input;
+}
+
+/* The sample a row stands for (real is not a variable: 0). */
+static void fe__row_sample(const double *row, fe_sample *s)
+{
+    memset(s, 0, sizeof *s);
+    s->t = row[FE_CATALOG_VAR_T];
+    s->sim = row[FE_CATALOG_VAR_SIM];
+    s->dsim = row[FE_CATALOG_VAR_DSIM];
+    s->position = row[FE_CATALOG_VAR_POSITION];
+    s->velocity = row[FE_CATALOG_VAR_VELOCITY];
+    s->temperature = row[FE_CATALOG_VAR_TEMPERATURE];
+    s->ambient = row[FE_CATALOG_VAR_AMBIENT];
+    s->input = row[FE_CATALOG_VAR_INPUT];
+}
+
+size_t fe_catalog_work_doubles(size_t n)
+{
+    return n + fe_expr_work_doubles(n);
+}
+
+int fe_catalog_eval_rows(const fe_catalog *c, const double *rows, size_t ldv, size_t n,
+                         double *phi, size_t ldphi, double *work, size_t *bad)
+{
+    int callbacks = 0;
+    if (c == NULL || rows == NULL || phi == NULL || work == NULL || ldv < FE_CATALOG_VARS
+        || ldphi < c->count)
+        return FE_EINVAL;
+    for (size_t j = 0; j < c->count; j++) {
+        if (c->terms[j].expr != NULL && c->terms[j].expr->nvars > ldv)
+            return FE_EINVAL;
+        if (c->terms[j].expr == NULL && c->terms[j].eval == NULL)
+            return FE_EINVAL;
+        callbacks |= c->terms[j].expr == NULL;
+    }
+    /* The expression terms: a column each, then scattered into phi. */
+    for (size_t j = 0; j < c->count; j++) {
+        int rc;
+        if (c->terms[j].expr == NULL)
+            continue;
+        rc = fe_expr_eval_rows(c->terms[j].expr, rows, ldv, n, work, work + n, NULL);
+        if (rc != FE_OK && rc != FE_ENONFINITE)
+            return rc;
+        for (size_t t = 0; t < n; t++)
+            phi[t * ldphi + j] = work[t];
+    }
+    /* The C terms, row by row. */
+    for (size_t t = 0; t < n && callbacks; t++) {
+        fe_sample s;
+        fe__row_sample(rows + t * ldv, &s);
+        for (size_t j = 0; j < c->count; j++)
+            if (c->terms[j].expr == NULL)
+                phi[t * ldphi + j] = c->terms[j].eval(&s, &c->scale, c->terms[j].user);
+    }
+    for (size_t t = 0; t < n; t++)
+        for (size_t j = 0; j < c->count; j++)
+            if (!isfinite(phi[t * ldphi + j])) {
+                if (bad != NULL)
+                    *bad = t;
+                return FE_ENONFINITE;
+            }
+    return FE_OK;
+}
+/* Evaluate expression terms ends here */
 /* [[file:../literate/catalog.org::Read a coefficient in words][Read a coefficient in words]] */
 int fe_catalog_explain(const char *name, double coef, double se, char *buf,
                        size_t len)

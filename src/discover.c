@@ -1380,6 +1380,7 @@ static int fe__fit(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     den = fit->rss;
     rho = den > 0.0 ? num / den : 0.0;
     fit->lag1 = rho;
+    fit->floor = sqrt(den > num ? (den - num) / n : 0.0);
     if (rho < 0.0)
         rho = 0.0;
     if (rho > 0.99)
@@ -1944,6 +1945,7 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     fit->params = ncols;
     fit->rms = sqrt(fit->rss / n);
     fit->lag1 = fit->rss > 0.0 ? w->q[1] / fit->rss : 0.0;
+    fit->floor = sqrt(w->q[0] > w->q[1] ? (w->q[0] - w->q[1]) / n : 0.0);
     fit->n_eff = nz->n_eff;
     fit->bic = n * log(rsst > 0.0 ? rsst / n : 1e-300)
                + (double)(ncols + nz->order) * log(n);

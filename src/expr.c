@@ -151,7 +151,8 @@ static void fe__unknown(fe__parser *p, const char *at, const char *name, size_t 
     size_t k = (size_t)snprintf(what, sizeof what, "unknown name '%.*s'; names: pi",
                                 (int)(len < 64 ? len : 64), name);
     for (size_t i = 0; i < p->nnames && k < sizeof what; i++)
-        k += (size_t)snprintf(what + k, sizeof what - k, ", %s", p->names[i]);
+        if (p->names[i] != NULL)
+            k += (size_t)snprintf(what + k, sizeof what - k, ", %s", p->names[i]);
     fe__fail(p, FE_EPARSE, at, what);
 }
 
@@ -455,3 +456,12 @@ int fe_expr_eval_rows(const fe_expr *e, const double *v, size_t ldv, size_t n, d
     return FE_OK;
 }
 /* Evaluate ends here */
+/* [[file:../literate/expr.org::Which variables a program reads][Which variables a program reads]] */
+int fe_expr_reads(const fe_expr *e, size_t j)
+{
+    for (size_t i = 0; e != NULL && i < e->ncode && i < FE_EXPR_MAX_CODE; i++)
+        if (e->op[i] == FE__VAR && e->arg[i] == (double)j)
+            return 1;
+    return 0;
+}
+/* Which variables a program reads ends here */

@@ -760,11 +760,17 @@ double fe_residual_map_largest_after(const fe_residual_map *m, double worth)
 }
 /* Test the residual after the terms ends here */
 /* [[file:../literate/locate.org::Decide the verdict][Decide the verdict]] */
+/* When the residual left counts as diverging trajectories. */
+#define FE_DIVERGE_LAG1 0.98
+#define FE_DIVERGE_RATIO 10.0
+
 fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_map *m,
                                size_t nlocated, double alpha)
 {
     if (r == NULL || m == NULL)
         return FE_VERDICT_NO_MISMATCH;
+    if (r->final.lag1 >= FE_DIVERGE_LAG1 && r->final.rms >= FE_DIVERGE_RATIO * r->final.floor)
+        return FE_VERDICT_DIVERGES;
     if (r->steps == 0)
         return nlocated > 0 ? FE_VERDICT_UNEXPLAINED : FE_VERDICT_NO_MISMATCH;
     if (r->noise.kind == FE_DISCOVER_NOISE_AR && r->noise.portmanteau_p < 0.001)
@@ -793,6 +799,12 @@ const char *fe_verdict_why(fe_verdict v)
     case FE_VERDICT_OUT_OF_LINE:
         return "terms were found, but a time window or state region stays out of line "
                "after them";
+    case FE_VERDICT_DIVERGES:
+        return "the residual left stays correlated (lag one 0.98 or more) at ten times its "
+               "high-frequency floor or more: the trajectories diverge, as they do when the "
+               "missing physics acts on the motion; try foldest discover --order 2 (a force "
+               "on a position or angle) or --order 1 (a heat rate on a temperature), from C "
+               "fe_dynamics";
     default: return NULL;
     }
 }

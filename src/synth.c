@@ -8,6 +8,11 @@
 #include "foldest/synth.h"
 
 static const double fe__two_pi = 6.283185307179586476925286766559;
+static const double fe__w0 = 6.283185307179586476925286766559 * 0.4;  /* the cart's */
+static const double fe__tau = 20.0;                                    /* the stand's */
+
+struct fe_synth;
+static double fe__synth_term(const struct fe_synth *g, const fe_sample *s);
 /* Synthetic Includes ends here */
 /* [[file:../literate/synth.org::Effects and rigs][Effects and rigs]] */
 static const char *const fe__synth_effects[] = {
@@ -47,7 +52,7 @@ static double fe__synth_sign(const char *effect)
 
 fe_synth_spec fe_synth_default_spec(const char *effect, uint64_t seed)
 {
-    fe_synth_spec s = {effect, seed, 200000, 1.0, 0.5, 0.3};
+    fe_synth_spec s = {effect, seed, 200000, 1.0, 0.5, 0.3, 0, 3.0};
     return s;
 }
 /* Effects and rigs ends here */
@@ -60,10 +65,10 @@ static void fe__synth_reset(fe_synth *g)
     g->physics = fe_rng_seed(g->spec.seed * 2 + 1);
     g->noise = fe_rng_seed(g->spec.seed * 2 + 2);
     g->row = 0;
-    g->x = g->v = 0.0;
-    g->temp = 20.0;
+    g->x = g->v = g->xr = g->vr = 0.0;
+    g->temp = g->tempr = 20.0;
     g->load = 0.0;
-    g->e = g->spec.noise_sd * fe_rng_normal(&g->noise);
+    g->e = g->sigma * fe_rng_normal(&g->noise);
 }
 
 /* The simulation's row i (real not yet set). */
@@ -73,7 +78,7 @@ static void fe__synth_physics(fe_synth *g, size_t i, fe_sample *s)
     memset(s, 0, sizeof *s);
     s->t = t;
     if (!g->thermal) {
-        const double w0 = fe__two_pi * 0.4, zeta = 0.15;
+        const double w0 = fe__w0, zeta = 0.15;
         const double *ph = g->phase;
         double u, a;
         u = (t < 10.0 ? t / 10.0 : 1.0)         /* a soft start */
@@ -83,20 +88,38 @@ static void fe__synth_physics(fe_synth *g, size_t i, fe_sample *s)
         s->input = u;
         s->position = g->x;
         s->velocity = g->v;
-        s->sim = a;
+        s->sim = g->spec.order == 2 ? g->x : a;
         g->v += a * g->dt;              /* semi-implicit Euler */
         g->x += g->v * g->dt;
+        if (g->spec.order == 2) {       /* the real cart, with the effect */
+            fe_sample r = *s;
+            r.position = g->xr;
+            r.velocity = g->vr;
+            s->real = g->xr;
+            g->vr += (u - w0 * w0 * g->xr - 2.0 * zeta * w0 * g->vr
+                      + g->coefficient * fe__synth_term(g, &r)) * g->dt;
+            g->xr += g->vr * g->dt;
+        }
     } else {
-        double tau = 20.0, ambient, power;
+        double tau = fe__tau, ambient, power;
         ambient = 20.0 + 25.0 * sin(fe__two_pi * t / (total / 2.3) + 0.3);
         power = fmod(t, 600.0) < 300.0 ? 60.0 : 0.0;   /* heater on half the time */
         if (i == 0)
-            g->temp = ambient;
+            g->temp = g->tempr = ambient;
         s->temperature = g->temp;
         s->ambient = ambient;
+        if (g->spec.order == 1) {       /* the real stand, with the effect */
+            fe_sample r;
+            s->input = power;           /* the heater is a column here */
+            r = *s;
+            r.temperature = g->tempr;
+            s->real = g->tempr;
+            g->tempr += ((ambient + power - g->tempr) / tau
+                         + g->coefficient * fe__synth_term(g, &r)) * g->dt;
+        }
         /* load: Ornstein-Uhlenbeck, time constant 5 s, unit spread */
         g->load += -g->load * g->dt / 5.0 + sqrt(2.0 * g->dt / 5.0) * fe_rng_normal(&g->physics);
-        s->sim = 2.0 + g->load;
+        s->sim = g->spec.order == 1 ? g->temp : 2.0 + g->load;
         g->temp += (ambient + power - g->temp) * g->dt / tau;
     }
 }
@@ -138,7 +161,7 @@ int fe_synth_init(fe_synth *g, const fe_synth_spec *spec)
 {
     size_t nb;
     const fe_term *terms = fe_catalog_builtin_terms(&nb);
-    double maxphi = 0.0;
+    double maxphi = 0.0, lo = 0.0, hi = 0.0;
     if (g == NULL || spec == NULL || spec->effect == NULL)
         return FE_EINVAL;
     if (spec->rows < 100)
@@ -147,10 +170,17 @@ int fe_synth_init(fe_synth *g, const fe_synth_spec *spec)
         return FE_EINVAL;
     memset(g, 0, sizeof *g);
     g->spec = *spec;
-    g->thermal = fe__synth_is_thermal(spec->effect);
+    if (spec->order > 2 || (spec->order > 0 && !(spec->parting > 0.0))
+        || (spec->order > 0 && (strcmp(spec->effect, "gain") == 0
+                                || strcmp(spec->effect, "delay") == 0))
+        || (spec->order == 2 && fe__synth_is_thermal(spec->effect)))
+        return FE_EINVAL;
+    g->thermal = fe__synth_is_thermal(spec->effect) || spec->order == 1;
     g->dt = g->thermal ? 0.05 : 0.01;
     g->roles = g->thermal ? FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT
                           : FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT;
+    if (spec->order == 1)
+        g->roles |= FE_ROLE_INPUT;      /* the heater's power */
     g->effect = -1;
     if (strncmp(spec->effect, "none", 4) != 0) {
         for (size_t i = 0; i < nb; i++)
@@ -162,6 +192,7 @@ int fe_synth_init(fe_synth *g, const fe_synth_spec *spec)
     /* First pass: the scale discovery will see, and the term's largest
        size.  Only coulomb_friction depends on the largest speed, which the
        pass is still finding; its largest size is tanh(500) = 1. */
+    g->sigma = spec->noise_sd;
     fe__synth_reset(g);
     for (g->row = 0; g->row < spec->rows; g->row++) {
         double phi;
@@ -170,11 +201,18 @@ int fe_synth_init(fe_synth *g, const fe_synth_spec *spec)
         phi = fabs(fe__synth_term(g, &g->cur));
         if (phi > maxphi)
             maxphi = phi;
+        lo = g->row == 0 || g->cur.sim < lo ? g->cur.sim : lo;
+        hi = g->row == 0 || g->cur.sim > hi ? g->cur.sim : hi;
     }
+    if (spec->order > 0)                    /* a sensor reading to 0.1 % of the span */
+        g->sigma = spec->noise_sd * 1e-3 * (hi - lo);
     if (g->effect >= 0 && strcmp(spec->effect, "coulomb_friction") == 0)
         maxphi = tanh(500.0);
     g->coefficient = maxphi > 0.0
         ? fe__synth_sign(spec->effect) * spec->effect_size * spec->noise_sd / maxphi : 0.0;
+    if (spec->order > 0 && maxphi > 0.0)    /* the static response: / w0^2, x tau */
+        g->coefficient = fe__synth_sign(spec->effect) * spec->parting * g->sigma / maxphi
+                         * (spec->order == 2 ? fe__w0 * fe__w0 : 1.0 / fe__tau);
     fe__synth_reset(g);
     return FE_OK;
 }
@@ -186,9 +224,10 @@ int fe_synth_next(fe_synth *g, fe_sample *s)
         return FE_END;
     fe__synth_advance(g);
     if (g->row > 0)
-        g->e = rho * g->e + sqrt(1.0 - rho * rho) * g->spec.noise_sd * fe_rng_normal(&g->noise);
+        g->e = rho * g->e + sqrt(1.0 - rho * rho) * g->sigma * fe_rng_normal(&g->noise);
     *s = g->cur;
-    s->real = s->sim + g->coefficient * fe__synth_term(g, s) + g->e;
+    s->real = g->spec.order > 0 ? g->cur.real + g->e
+                                : s->sim + g->coefficient * fe__synth_term(g, s) + g->e;
     g->row++;
     return FE_OK;
 }

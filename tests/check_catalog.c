@@ -89,6 +89,92 @@ START_TEST(user_terms_and_a_full_catalog)
 }
 END_TEST
 
+/* A term given by expression is a term like the others: it evaluates to
+   its formula, from a sample or from a row with the caller's own columns,
+   a panel equals its rows, and its refusals leave the catalog as it was. */
+START_TEST(expression_terms_through_the_catalog)
+{
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_expr drag, load, bad;
+    size_t nv, col = 0, bad_row = 99;
+    const char *const *vn = fe_catalog_var_names(&nv);
+    const char *names[FE_CATALOG_VARS + 1];
+    enum { N = 7, LDV = FE_CATALOG_VARS + 1 };
+    double rows[N * LDV], phi[N * 16], one[16], work[64 * N];
+    fe_sample s[N];
+    ck_assert_uint_eq(nv, FE_CATALOG_VARS);
+    ck_assert_str_eq(vn[FE_CATALOG_VAR_VELOCITY], "velocity");
+    for (size_t i = 0; i < nv; i++)
+        names[i] = vn[i];
+    names[nv] = "load [N]";
+    ck_assert_int_eq(fe_expr_compile(&drag, "velocity*abs(velocity)", names, nv, &col, NULL, 0),
+                     FE_OK);
+    ck_assert_int_eq(fe_expr_compile(&load, "2*`load [N]` + t", names, nv + 1, &col, NULL, 0),
+                     FE_OK);
+    ck_assert_int_eq(fe_expr_compile(&bad, "log(position)", names, nv, &col, NULL, 0), FE_OK);
+    scale.vmax = 1.0;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_VELOCITY, &scale), FE_OK);
+    /* Refusals: a built-in's name (present or not), a name twice, NULLs. */
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "quadratic_drag", "", &drag), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "cubic_stiffness", "", &drag), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "mine", "", NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(NULL, "mine", "", &drag), FE_EINVAL);
+    ck_assert_uint_eq(c.count, 7);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "my_drag", "drag, mine", &drag), FE_OK);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "my_drag", "again", &load), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "load", NULL, &load), FE_OK);
+    ck_assert_str_eq(c.terms[fe_catalog_find(&c, "my_drag")].description, "drag, mine");
+    ck_assert_str_eq(c.terms[fe_catalog_find(&c, "load")].description, "user term");
+    for (size_t t = 0; t < N; t++) {
+        memset(&s[t], 0, sizeof s[t]);
+        s[t].t = 0.5 * (double)t;
+        s[t].sim = 1.0 + (double)t;
+        s[t].velocity = -1.5 + 0.5 * (double)t;
+        s[t].position = 1.0;
+        fe_catalog_row(&s[t], rows + t * LDV);
+        ck_assert(rows[t * LDV + FE_CATALOG_VAR_VELOCITY] == s[t].velocity);
+        rows[t * LDV + FE_CATALOG_VARS] = 10.0 * (double)t;      /* load [N] */
+    }
+    /* A panel: every term equals its formula, the built-in ones too. */
+    ck_assert_uint_ge(sizeof work / sizeof work[0], fe_catalog_work_doubles(N));
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 16, work, &bad_row), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double v = s[t].velocity;
+        ck_assert(phi[t * 16 + (size_t)fe_catalog_find(&c, "my_drag")] == v * fabs(v));
+        ck_assert(phi[t * 16 + (size_t)fe_catalog_find(&c, "quadratic_drag")] == v * fabs(v));
+        ck_assert(phi[t * 16 + (size_t)fe_catalog_find(&c, "gain")] == s[t].sim);
+        ck_assert(phi[t * 16 + (size_t)fe_catalog_find(&c, "load")] == 20.0 * (double)t + s[t].t);
+    }
+    /* One sample: the same, for terms that read only the sample; a term
+       that reads the caller's column cannot be evaluated from a sample. */
+    ck_assert_int_eq(fe_catalog_eval(&c, &s[2], one), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_remove(&c, "load"), FE_OK);
+    ck_assert_int_eq(fe_catalog_remove(&c, "load"), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_find(&c, "my_drag"), 7);        /* order kept */
+    ck_assert_int_eq(fe_catalog_eval(&c, &s[2], one), FE_OK);
+    ck_assert(one[7] == s[2].velocity * fabs(s[2].velocity));
+    /* Rows too short for an expression, phi too narrow: refused. */
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "load", NULL, &load), FE_OK);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, N, phi, 16, work, NULL),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 3, work, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 16, NULL, NULL), FE_EINVAL);
+    /* A term not finite on row 4 (log of a negative position): that row
+       is named, and the panel's values are complete (row 6 too). */
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "logx", "", &bad), FE_OK);
+    rows[4 * LDV + FE_CATALOG_VAR_POSITION] = -1.0;
+    for (size_t i = 0; i < N * 16; i++)
+        phi[i] = 12345.0;
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 16, work, &bad_row),
+                     FE_ENONFINITE);
+    ck_assert_uint_eq(bad_row, 4);
+    ck_assert(isnan(phi[4 * 16 + (size_t)fe_catalog_find(&c, "logx")]));
+    ck_assert(phi[6 * 16 + (size_t)fe_catalog_find(&c, "logx")] == 0.0);
+    ck_assert(phi[6 * 16 + (size_t)fe_catalog_find(&c, "bias")] == 1.0);
+}
+END_TEST
+
 START_TEST(every_coefficient_in_words)
 {
     const struct { const char *name; double coef; const char *words; } w[] = {
@@ -219,6 +305,7 @@ Suite *fe_catalog_suite(void)
     TCase *t = tcase_create("terms");
     tcase_add_test(t, every_builtin_term_is_its_formula);
     tcase_add_test(t, user_terms_and_a_full_catalog);
+    tcase_add_test(t, expression_terms_through_the_catalog);
     tcase_add_test(t, every_coefficient_in_words);
     tcase_add_test(t, three_axis_terms_are_their_formulas);
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);

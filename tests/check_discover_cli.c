@@ -39,23 +39,7 @@ static void make_dir(void)
     ck_assert_ptr_nonnull(mkdtemp(dir));
 }
 
-static void remove_dir(void)
-{
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    ck_assert_int_eq(system(cmd), 0);
-}
 
-static void write_file(const char *name, const char *text)
-{
-    char path[256];
-    FILE *f;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    f = fopen(path, "w");
-    ck_assert_ptr_nonnull(f);
-    fputs(text, f);
-    fclose(f);
-}
 
 START_TEST(concealed_drag_is_named_and_the_null_is_not)
 {
@@ -103,7 +87,91 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     ck_assert_int_eq(run(cmd, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 1") != NULL
                   || strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 0") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
+/* Output error (--order K): a cart's missing viscous friction named in its
+   acceleration with the synthetic truth inside the interval; a heated
+   stand's missing convective loss in its dT/dt; the additive mode on a
+   cart whose trajectories part widely is never "explained" and points to
+   --order; orders out of range are usage errors. */
+START_TEST(output_error_is_named_in_the_derivative_it_enters)
+{
+    static char out[65536];
+    char cmd[2048], *p;
+    double truth, lo, hi;
+    fe_synth g;
+    fe_synth_spec spec = fe_synth_default_spec("viscous_friction", 5);
+    fe_sample smp;
+    FILE *fr, *fs;
+    char path[256];
+    make_dir();
+    snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --order 2 --seed 3 --rows 6000 "
+             "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    p = strstr(out, "coefficient ");
+    ck_assert_ptr_nonnull(p);
+    truth = strtod(p + 12, NULL);
+    ck_assert_msg(strstr(out, "--order 2") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
+             "--role velocity=velocity --role input=input --order 2 --holdout 0.3 --json",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"order\": 2, \"simulation_dynamics\": {") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"viscous_friction\"") != NULL, "%s",
+                  out);
+    ck_assert_msg(strstr(out, "d2x/dt2 gains -c v") != NULL, "%s", out);
+    p = strstr(out, "\"interval95\": [");
+    ck_assert_ptr_nonnull(p);
+    ck_assert_int_eq(sscanf(p, "\"interval95\": [%lf, %lf]", &lo, &hi), 2);
+    ck_assert_msg(lo <= truth && truth <= hi, "%g not in [%g, %g]", truth, lo, hi);
+
+    snprintf(cmd, sizeof cmd, "%s synth --effect newton_cooling --order 1 --seed 2 --rows 8000 "
+             "--real %s/tr.csv --sim %s/ts.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/tr.csv --sim %s/ts.csv --channel temperature "
+             "--role ambient=ambient --role power=input --order 1 --holdout 0.3",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "1. newton_cooling") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "dT/dt gains -h (T - T_ambient)") != NULL, "%s", out);
+
+    /* Trajectories parting by about a hundred noise sds: the additive mode
+       must not call that explained. */
+    spec.order = 2;
+    spec.rows = 6000;
+    spec.parting = 100.0;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    snprintf(path, sizeof path, "%s/wr.csv", dir);
+    fr = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/ws.csv", dir);
+    fs = fopen(path, "w");
+    ck_assert(fr != NULL && fs != NULL);
+    fprintf(fr, "time,position\n");
+    fprintf(fs, "time,position,velocity,input\n");
+    while (fe_synth_next(&g, &smp) == FE_OK) {
+        fprintf(fr, "%.6f,%.12g\n", smp.t, smp.real);
+        fprintf(fs, "%.6f,%.12g,%.12g,%.12g\n", smp.t, smp.sim, smp.velocity, smp.input);
+    }
+    fclose(fr);
+    fclose(fs);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/wr.csv --sim %s/ws.csv --channel position "
+             "--role velocity=velocity --role input=input --holdout 0.3", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "verdict: mismatch not explained by the catalog") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "trajectories diverge") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "--order 2") != NULL, "%s", out);
+
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
+             "--order 3", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "--order: 3 is not 0, 1 or 2") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s synth --effect gain --order 2 --real %s/x.csv --sim %s/y.csv",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_msg(strstr(out, "describe the measurement") != NULL, "%s", out);
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -148,7 +216,7 @@ START_TEST(inputs_from_a_pipe_and_compressed)
     snprintf(cmd, sizeof cmd, "%s discover --real - --sim - %s < %s/r.csv", FE_TEST_CLI, roles, dir);
     ck_assert_int_eq(run(cmd, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "standard input can be read only once") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -248,7 +316,7 @@ START_TEST(bursty_clocks_keep_every_covered_row)
              FE_TEST_CLI, dir, dir);
     run(cmd, out, sizeof out);
     ck_assert_msg(strstr(out, "same unit of time") != NULL, "%s", out);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -296,8 +364,8 @@ START_TEST(bad_inputs)
     char cmd[2048], out[8192];
     int status;
     make_dir();
-    write_file("real.csv", c->real);
-    write_file("sim.csv", c->sim);
+    fe_test_write_file(dir, "real.csv", c->real);
+    fe_test_write_file(dir, "sim.csv", c->sim);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/sim.csv %s", FE_TEST_CLI,
              dir, dir, c->args);
     status = run(cmd, out, sizeof out);
@@ -326,7 +394,7 @@ START_TEST(bad_inputs)
         ck_assert_msg(strstr(out, c->expect) != NULL, "%s: output lacks \"%s\":\n%s", c->what,
                       c->expect, out);
     }
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -506,7 +574,7 @@ START_TEST(report_data_and_plots_a_physicist_keeps)
             ck_assert_int_eq(memcmp(magic, "\x89PNG\r\n\x1a\n", 8), 0);
         }
     }
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -530,7 +598,7 @@ START_TEST(report_axis_carries_the_channels_unit)
              unit_cases[_i][1]);
     ck_assert_msg(strstr(text, want) != NULL, "%s: want \"%s\" in:\n%s", unit_cases[_i][0], want,
                   text);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -572,7 +640,7 @@ START_TEST(report_lays_recordings_end_to_end)
     ck_assert_msg(strstr(text, "set xlabel 't [s] (recordings end to end)'") != NULL, "%s", text);
     ck_assert_msg(strstr(text, "set arrow 1 from first ") != NULL, "%s", text);
     ck_assert_msg(strstr(text, "held out") == NULL, "no rows held out, yet:\n%s", text);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -626,7 +694,7 @@ START_TEST(report_keeps_an_epoch_clock)
     ck_assert_msg(fabs(first - (1.7e9 + 0.123 + t0)) < 1e-5, "first time %.6f, want %.6f", first,
                   1.7e9 + 0.123 + t0);
     ck_assert_msg(t > first && t < 1.7e9 + t1 + 1, "middle time %.6f", t);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -670,7 +738,7 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
                 && (second == NULL || second > strstr(q, "\"per_recording\""));
     }
     ck_assert_msg(good >= 10, "quadratic drag alone, k in [0.010, 0.030], in %d of 12 drops", good);
-    remove_dir();
+    fe_test_remove_dir(dir);
 }
 END_TEST
 
@@ -715,6 +783,7 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, output_error_is_named_in_the_derivative_it_enters);
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);
     tcase_add_test(t, bursty_clocks_keep_every_covered_row);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));

@@ -212,6 +212,32 @@ START_TEST(a_panel_equals_its_rows)
 }
 END_TEST
 
+/* Which variables a program reads; a NULL name is a hole: never matched,
+   never listed. */
+START_TEST(what_a_program_reads)
+{
+    const char *holes[] = {"position", NULL, "t", "T (C)", NULL};
+    fe_expr e;
+    size_t col = 0;
+    char msg[256];
+    ck_assert_int_eq(fe_expr_compile(&e, "t*`T (C)` + t", names, NV, &col, msg, sizeof msg),
+                     FE_OK);
+    ck_assert_int_eq(fe_expr_reads(&e, 2), 1);
+    ck_assert_int_eq(fe_expr_reads(&e, 3), 1);
+    ck_assert_int_eq(fe_expr_reads(&e, 0), 0);
+    ck_assert_int_eq(fe_expr_reads(&e, 4), 0);
+    ck_assert_int_eq(fe_expr_reads(NULL, 2), 0);
+    ck_assert_int_eq(fe_expr_compile(&e, "2 + 3", names, NV, &col, msg, sizeof msg), FE_OK);
+    ck_assert_int_eq(fe_expr_reads(&e, 0), 0);   /* a constant's argument is no variable */
+    ck_assert_int_eq(fe_expr_compile(&e, "velocity", holes, 5, &col, msg, sizeof msg),
+                     FE_EPARSE);
+    ck_assert_uint_eq(col, 1);
+    ck_assert_str_eq(msg, "unknown name 'velocity'; names: pi, position, t, T (C)");
+    ck_assert_int_eq(fe_expr_compile(&e, "t", holes, 5, &col, msg, sizeof msg), FE_OK);
+    ck_assert_int_eq(fe_expr_reads(&e, 2), 1);
+}
+END_TEST
+
 Suite *fe_expr_suite(void)
 {
     Suite *s = suite_create("expr");
@@ -222,6 +248,7 @@ Suite *fe_expr_suite(void)
     tcase_add_test(t, values_that_are_not_finite_are_refused);
     tcase_add_test(t, a_program_not_made_by_the_compiler_is_refused);
     tcase_add_test(t, a_panel_equals_its_rows);
+    tcase_add_test(t, what_a_program_reads);
     suite_add_tcase(s, t);
     return s;
 }

@@ -76,4 +76,24 @@ static inline size_t fe_test_read_file(const char *path, char *buf, size_t len)
     return got;
 }
 
+/* Write `text` to dir/name; the test fails when it cannot. */
+static inline void fe_test_write_file(const char *dir, const char *name, const char *text)
+{
+    char path[512];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    f = fopen(path, "w");
+    ck_assert_msg(f != NULL, "cannot write %s", path);
+    fputs(text, f);
+    ck_assert_int_eq(fclose(f), 0);
+}
+
+/* Remove the folder `dir` (made by mkdtemp) and everything in it. */
+static inline void fe_test_remove_dir(const char *dir)
+{
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    ck_assert_int_eq(system(cmd), 0);
+}
+
 #endif /* FE_TESTUTIL_H */

@@ -19,13 +19,15 @@ _foldest()
         stats) opts="--columns --skip --json" ;;
         calibrate) opts="--model --columns --apply --skip --json --trace" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
-                        --alpha --report --json --sphere --columns" ;;
-        synth) opts="--effect --real --sim --seed --rows" ;;
+                        --alpha --order --report --json --sphere --columns --term --terms
+                        --only --exclude" ;;
+        synth) opts="--effect --real --sim --seed --rows --order" ;;
         *) return 0 ;;
     esac
     case "$prev" in
         --model) COMPREPLY=($(compgen -W "sphere axial ellipsoid" -- "$cur")); return 0 ;;
         --noise) COMPREPLY=($(compgen -W "ar batch" -- "$cur")); return 0 ;;
+        --order) COMPREPLY=($(compgen -W "0 1 2" -- "$cur")); return 0 ;;
         --effect) COMPREPLY=($(compgen -W "bias drift gain delay viscous_friction quadratic_drag
                         coulomb_friction linear_stiffness cubic_stiffness thermal_sensitivity
                         newton_cooling radiative_cooling input_gain none none_thermal" -- "$cur"))
@@ -33,7 +35,8 @@ _foldest()
         --role) COMPREPLY=($(compgen -W "position velocity temperature ambient input" -- "${cur#*=}"))
                 [ "${cur#*=}" != "$cur" ] && COMPREPLY=("${COMPREPLY[@]/#/${cur%%=*}=}")
                 return 0 ;;
-        --columns|--channel|--time|--base|--holdout|--lags|--blocks|--alpha|--seed|--rows|--skip) return 0 ;;
+        --columns|--channel|--time|--base|--holdout|--lags|--blocks|--alpha|--seed|--rows|--skip|--term|--only|--exclude) return 0 ;;
+        --terms) COMPREPLY=($(compgen -f -- "$cur")); return 0 ;;
         --report) COMPREPLY=($(compgen -d -- "$cur")); return 0 ;;
     esac
     if [[ "$cur" == -* ]]; then

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "foldest/discover.h"
+#include "foldest/expr.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,14 +41,25 @@ typedef struct fe_catalog_scale {
 typedef double fe_term_fn(const fe_sample *s, const fe_catalog_scale *scale,
                           void *user);
 
-/* A named term. */
+/* A named term: a C function of a sample (eval), or an expression over a
+   row of variables (expr; eval is then NULL). */
 typedef struct fe_term {
     const char *name;
     const char *description;    /* one line of physics */
     fe_term_fn *eval;
     void *user;
     unsigned needs;             /* fe_role bits it needs */
+    const fe_expr *expr;        /* an expression term, or NULL */
 } fe_term;
+
+/* The variables of a row, in this order: what an expression term reads,
+   and what fe_catalog_eval_rows takes.  A caller may append its own
+   (other columns of its data) after FE_CATALOG_VARS. */
+enum fe_catalog_var {
+    FE_CATALOG_VAR_T, FE_CATALOG_VAR_SIM, FE_CATALOG_VAR_DSIM, FE_CATALOG_VAR_POSITION,
+    FE_CATALOG_VAR_VELOCITY, FE_CATALOG_VAR_TEMPERATURE, FE_CATALOG_VAR_AMBIENT,
+    FE_CATALOG_VAR_INPUT, FE_CATALOG_VARS
+};
 
 /* A catalog: the terms one analysis tests. */
 typedef struct fe_catalog {
@@ -74,12 +86,49 @@ int fe_catalog_init(fe_catalog *c, unsigned roles, const fe_catalog_scale *scale
 int fe_catalog_add(fe_catalog *c, const char *name, const char *description,
                    fe_term_fn *eval, void *user);
 
+/* fe_catalog_var_names: the names of the FE_CATALOG_VARS variables of a
+   row ("t", "sim", "dsim", "position", ...), to compile expressions
+   against (fe_expr_compile), the caller's own names appended. */
+const char *const *fe_catalog_var_names(size_t *count);
+
+/* fe_catalog_add_expr: a user term given by a compiled expression over a
+   row of variables (fe_catalog_var_names, then the caller's).  The
+   catalog keeps the pointers: name, description and e must outlive it.
+   FE_ESIZE when the catalog is full; FE_EINVAL for a NULL name or e, or a
+   name already present or of a built-in term (whose readings in words,
+   fe_catalog_explain, would then be wrong). */
+int fe_catalog_add_expr(fe_catalog *c, const char *name, const char *description,
+                        const fe_expr *e);
+
+/* fe_catalog_remove: drop the term called `name`, the others keeping
+   their order.  FE_EINVAL when there is none. */
+int fe_catalog_remove(fe_catalog *c, const char *name);
+
 /* fe_catalog_find: the index of the term called `name`, or -1. */
 long fe_catalog_find(const fe_catalog *c, const char *name);
 
 /* fe_catalog_eval: phi[j] = term j at sample s, j < c->count.
-   FE_ENONFINITE if a term is not finite (phi is then incomplete). */
+   FE_ENONFINITE if a term is not finite (phi is then incomplete);
+   FE_EINVAL if an expression term reads a variable beyond
+   FE_CATALOG_VARS (a sample does not have it: use fe_catalog_eval_rows). */
 int fe_catalog_eval(const fe_catalog *c, const fe_sample *s, double *phi);
+
+/* fe_catalog_row: the FE_CATALOG_VARS variables of sample s into row. */
+void fe_catalog_row(const fe_sample *s, double *row);
+
+/* fe_catalog_work_doubles: the workspace fe_catalog_eval_rows needs for
+   n rows. */
+size_t fe_catalog_work_doubles(size_t n);
+
+/* fe_catalog_eval_rows: phi[t * ldphi + j] = term j at row t, for the n
+   rows whose variable k is rows[t * ldv + k]; expression terms a panel
+   at a time (fe_expr_eval_rows), the others row by row.  work holds
+   fe_catalog_work_doubles(n) doubles.  FE_ENONFINITE when a term is not
+   finite: *bad (if not NULL) is then the first such row, and phi is
+   complete.  FE_EINVAL on NULL, ldv < FE_CATALOG_VARS or below what an
+   expression reads, or ldphi < c->count.  No allocation. */
+int fe_catalog_eval_rows(const fe_catalog *c, const double *rows, size_t ldv, size_t n,
+                         double *phi, size_t ldphi, double *work, size_t *bad);
 
 /* fe_catalog_groups: one single-column group per term, for the engine. */
 void fe_catalog_groups(const fe_catalog *c, fe_discover_group *groups);

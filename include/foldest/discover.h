@@ -306,6 +306,10 @@ typedef struct fe_discover_fit {
                                    sample size */
     double heldout_rms;         /* NaN when nothing is held out */
     double lag1;                /* lag-one autocorrelation of the residual */
+    double floor;               /* its high-frequency floor, sqrt(sum (e_t -
+                                   e_{t-1})^2 / 2n): the noise's standard
+                                   deviation when the residual is a smooth
+                                   signal plus white noise */
     double n, n_eff, heldout_n;
     size_t params;
 } fe_discover_fit;

@@ -53,6 +53,11 @@ size_t fe_expr_work_doubles(size_t n);
 int fe_expr_eval_rows(const fe_expr *e, const double *v, size_t ldv, size_t n, double *out,
                       double *work, size_t *bad);
 
+/* fe_expr_reads: 1 when the program reads variable j, else 0 (also for
+   NULL e).  A caller that gathers its variables from files reads only the
+   columns some expression needs. */
+int fe_expr_reads(const fe_expr *e, size_t j);
+
 #ifdef __cplusplus
 }
 #endif

@@ -216,8 +216,11 @@ typedef enum fe_verdict {
     FE_VERDICT_UNEXPLAINED,         /* located, but nothing named */
     FE_VERDICT_NOT_WHITE,           /* named, but the whitened residual left
                                        is not white */
-    FE_VERDICT_OUT_OF_LINE          /* named, but a window or region stays
+    FE_VERDICT_OUT_OF_LINE,         /* named, but a window or region stays
                                        out of line after the terms */
+    FE_VERDICT_DIVERGES             /* the residual left stays correlated far
+                                       above its high-frequency floor: the
+                                       trajectories part (output error) */
 } fe_verdict;
 
 /* fe_discover_verdict: the verdict of the result r, whose map is m and

@@ -18,9 +18,17 @@ typedef struct fe_synth_spec {
     const char *effect;         /* a built-in term's name, or "none" */
     uint64_t seed;
     size_t rows;                /* 200000 */
-    double noise_sd;            /* sigma: 1 */
+    double noise_sd;            /* sigma: 1 (order > 0: in 0.1 % of the
+                                   channel's span) */
     double noise_rho;           /* lag-one correlation: 0.5 */
     double effect_size;         /* max |effect| / sigma: 0.3 */
+    size_t order;               /* 0: the effect is added to the channel;
+                                   2: to the cart's acceleration, 1: to the
+                                   stand's dT/dt, integrated into the motion
+                                   (output error; the channel is then the
+                                   position or the temperature) */
+    double parting;             /* order > 0: the static response to the
+                                   largest forcing, in noise sds: 3 */
 } fe_synth_spec;
 
 /* fe_synth_default_spec: the concealed case for `effect` and `seed`. */
@@ -32,6 +40,9 @@ typedef struct fe_synth {
     int thermal;                /* 0 mechanical rig, 1 thermal rig */
     long effect;                /* index in the built-in table; -1: none */
     double coefficient;         /* the truth */
+    double sigma;               /* the noise's sd in channel units: noise_sd,
+                                   times 1e-3 of the channel's span when
+                                   order > 0 */
     unsigned roles;             /* roles the rig's columns have */
     fe_catalog_scale scale;     /* what discovery's first pass finds */
     double dt;
@@ -40,16 +51,19 @@ typedef struct fe_synth {
     fe_rng physics, noise;
     size_t row;
     double x, v, temp, load, e;
+    double xr, vr, tempr;       /* the real system's state (order > 0) */
     fe_sample prev, cur, next;
 } fe_synth;
 
 /* fe_synth_init: a generator for `spec`.  FE_EINVAL for an unknown effect
-   or a rig that has no column the term needs; FE_ETOOFEW for fewer than
-   100 rows. */
+   or a rig that has no column the term needs (with order 2 the mechanical
+   rig, with order 1 the thermal one; gain and delay are not forcings);
+   FE_ETOOFEW for fewer than 100 rows. */
 int fe_synth_init(fe_synth *g, const fe_synth_spec *spec);
 
-/* fe_synth_next: the next row, with `real` = `sim` + effect + noise.
-   FE_END after spec.rows rows. */
+/* fe_synth_next: the next row, with `real` = `sim` + effect + noise (order
+   0), or the real system's position or temperature + noise (order > 0,
+   `sim` then the simulated one).  FE_END after spec.rows rows. */
 int fe_synth_next(fe_synth *g, fe_sample *s);
 
 /* fe_synth_rewind: start again; the same rows follow. */

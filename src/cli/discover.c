@@ -11,6 +11,11 @@
 
 enum { FE__MAX_PAIRS = 64, FE__ROLES = 5, FE__PLOT_POINTS = 4000, FE__MAX_LOCATED = 128 };
 
+/* User terms (--term): the other columns they may read, and the row of
+   variables a term reads (the catalog's, then those columns). */
+enum { FE__MAX_EXTRA = 16, FE__MAX_VARS = FE_CATALOG_VARS + FE__MAX_EXTRA,
+       FE__MAX_USER = FE_DISCOVER_MAX_GROUPS, FE__MAX_TERM_FILES = 8 };
+
 static const char *const fe__role_names[FE__ROLES] = {
     "position", "velocity", "temperature", "ambient", "input"};
 
@@ -29,18 +34,24 @@ static double *fe__role(fe_sample *s, int r)
 }
 /* Discover Command Includes ends here */
 /* [[file:../../literate/cli_discover.org::Align a recording with its simulation][Align a recording with its simulation]] */
-/* One simulation row: time, channel and the role columns. */
+/* One simulation row: time, channel, the role columns, then the other
+   columns user terms read. */
 typedef struct fe__simrow {
-    double t, s, role[FE__ROLES];
+    double t, s, role[FE__ROLES + FE__MAX_EXTRA];
     int valid;
 } fe__simrow;
 
 typedef struct fe__pair {
     const char *real_path, *sim_path;
     fe_cli_table real, sim;
-    size_t real_cols[2];            /* time, channel */
-    size_t sim_cols[2 + FE__ROLES]; /* time, channel, roles present */
-    int role_col[FE__ROLES];        /* index into sim_cols, -1 absent */
+    size_t real_cols[2 + FE__MAX_EXTRA];            /* time, channel, user terms' */
+    size_t sim_cols[2 + FE__ROLES + FE__MAX_EXTRA]; /* time, channel, roles, user terms' */
+    int role_col[FE__ROLES + FE__MAX_EXTRA];        /* index into sim_cols, -1 absent */
+    /* The columns user terms read: of the simulation (interpolated like
+       the roles, after them in role_col) and of the recording; their
+       values at the current row. */
+    size_t nsimx, nrealx;
+    double simx[FE__MAX_EXTRA], realx[FE__MAX_EXTRA];
     fe__simrow w[4];
     double min_step, last_real_t;
     int started;
@@ -58,14 +69,14 @@ enum { FE__BEFORE_START, FE__AFTER_END, FE__IN_GAP };
 /* Read the next simulation row into w[3], shifting the window left. */
 static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
 {
-    double v[2 + FE__ROLES];
+    double v[2 + FE__ROLES + FE__MAX_EXTRA];
     size_t k = 2;
-    int rc;
+    int rc, nr = FE__ROLES + (int)p->nsimx;
     p->w[0] = p->w[1];
     p->w[1] = p->w[2];
     p->w[2] = p->w[3];
     p->w[3].valid = 0;
-    for (int r = 0; r < FE__ROLES; r++)
+    for (int r = 0; r < nr; r++)
         if (p->role_col[r] >= 0)
             k = (size_t)p->role_col[r] + 1 > k ? (size_t)p->role_col[r] + 1 : k;
     rc = fe_cli_table_next(&p->sim, p->sim_cols, k, v, err, errlen);
@@ -75,7 +86,7 @@ static int fe__sim_advance(fe__pair *p, char *err, size_t errlen)
         return rc;
     p->w[3].t = v[0];
     p->w[3].s = v[1];
-    for (int r = 0; r < FE__ROLES; r++)
+    for (int r = 0; r < nr; r++)
         p->w[3].role[r] = p->role_col[r] >= 0 ? v[p->role_col[r]] : 0.0;
     p->w[3].valid = 1;
     if (p->w[2].valid) {
@@ -170,12 +181,19 @@ static double fe__dsim(const fe__pair *p, int i)
     return b->t > a->t ? (b->s - a->s) / (b->t - a->t) : 0.0;
 }
 
+/* Where role slot r of a row goes: a field of the sample, or (after the
+   roles) a column a user term reads. */
+static double *fe__slot(fe__pair *p, fe_sample *s, int r)
+{
+    return r < FE__ROLES ? fe__role(s, r) : &p->simx[r - FE__ROLES];
+}
+
 /* The next recording row that the simulation covers, as a sample.
    Returns FE_OK, FE_END, or an exit status with a message. */
 static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
 {
-    double v[2];
-    int rc;
+    double v[2 + FE__MAX_EXTRA];
+    int rc, nr = FE__ROLES + (int)p->nsimx;
     if (!p->started) {
         for (int i = 0; i < 3; i++)
             if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
@@ -185,12 +203,13 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
     }
     for (;;) {
         double t, lambda;
-        rc = fe_cli_table_next(&p->real, p->real_cols, 2, v, err, errlen);
+        rc = fe_cli_table_next(&p->real, p->real_cols, 2 + p->nrealx, v, err, errlen);
         if (rc == FE_END)
             fe__check_spans(p);
         if (rc != FE_OK)
             return rc;
         t = v[0];
+        memcpy(p->realx, v + 2, p->nrealx * sizeof *v);
         if (p->real.rows == 1)
             p->first_real_t = t;
         if (!(t > p->last_real_t)) {
@@ -221,8 +240,8 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
                 out->real = v[1];
                 out->sim = p->w[2].s;
                 out->dsim = fe__dsim(p, 2);
-                for (int r = 0; r < FE__ROLES; r++)
-                    *fe__role(out, r) = p->w[2].role[r];
+                for (int r = 0; r < nr; r++)
+                    *fe__slot(p, out, r) = p->w[2].role[r];
                 return FE_OK;
             }
         }
@@ -232,14 +251,14 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
         if (!p->w[2].valid || t == p->w[1].t) {
             out->sim = p->w[1].s;
             out->dsim = fe__dsim(p, 1);
-            for (int r = 0; r < FE__ROLES; r++)
-                *fe__role(out, r) = p->w[1].role[r];
+            for (int r = 0; r < nr; r++)
+                *fe__slot(p, out, r) = p->w[1].role[r];
         } else {
             lambda = (t - p->w[1].t) / (p->w[2].t - p->w[1].t);
             out->sim = p->w[1].s + lambda * (p->w[2].s - p->w[1].s);
             out->dsim = fe__dsim(p, 1) + lambda * (fe__dsim(p, 2) - fe__dsim(p, 1));
-            for (int r = 0; r < FE__ROLES; r++)
-                *fe__role(out, r) = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
+            for (int r = 0; r < nr; r++)
+                *fe__slot(p, out, r) = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
         }
         return FE_OK;
     }
@@ -262,20 +281,30 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
 /* Rows waiting to be folded, with where each came from. */
 typedef struct fe__panel {
     size_t n;
+    double vars[FE_DISCOVER_PANEL_ROWS][FE__MAX_VARS];
     double phi[FE_DISCOVER_PANEL_ROWS][FE_DISCOVER_MAX_COLUMNS];
     double r[FE_DISCOVER_PANEL_ROWS], t[FE_DISCOVER_PANEL_ROWS];
     size_t line[FE_DISCOVER_PANEL_ROWS];
     const char *file[FE_DISCOVER_PANEL_ROWS];
 } fe__panel;
 
-/* Fold the panel's rows; on a refusal, p->n is the refused row's index
-   (the rows before it are folded). */
-static int fe__flush_panel(fe_discover_acc *acc, fe__panel *p)
+/* Evaluate the catalog's terms on the panel's rows (work: for
+   fe_catalog_eval_rows) and fold them; on a refusal, p->n is the refused
+   row's index (the rows before it are folded, unless a term was not
+   finite: then none of the panel is).  With c NULL the panel's columns
+   are already there (the signatures of --order). */
+static int fe__flush_panel(const fe_catalog *c, fe_discover_acc *acc, fe__panel *p,
+                           double *work)
 {
     size_t done = 0;
-    int rc = p->n > 0 ? fe_discover_add_rows(acc, p->phi[0], FE_DISCOVER_MAX_COLUMNS, p->r,
-                                             p->n, &done)
-                      : FE_OK;
+    int rc = FE_OK;
+    if (p->n == 0)
+        return FE_OK;
+    if (c != NULL)
+        rc = fe_catalog_eval_rows(c, p->vars[0], FE__MAX_VARS, p->n, p->phi[0],
+                                  FE_DISCOVER_MAX_COLUMNS, work, &done);
+    if (rc == FE_OK)
+        rc = fe_discover_add_rows(acc, p->phi[0], FE_DISCOVER_MAX_COLUMNS, p->r, p->n, &done);
     p->n = rc == FE_OK ? 0 : done;
     return rc;
 }
@@ -299,6 +328,16 @@ static const char fe__discover_help[] =
     "                         unless the name ends in _K); other columns are ignored\n"
     "  --base TERM,...        terms always fitted (the model's own parameters),\n"
     "                         e.g. bias,gain; default none\n"
+    "  --term NAME=EXPR[:DESCRIPTION]  a candidate term of your own, e.g.\n"
+    "                         'cogging=sin(2*pi*position/0.002):motor poles'; EXPR:\n"
+    "                         + - * / ^ ( ), numbers, pi, abs sign sqrt exp log sin cos\n"
+    "                         tan tanh atan2 min max, the variables t sim dsim and the\n"
+    "                         roles given, and any other column by name (quoted with\n"
+    "                         \" or ` when it has spaces or units); repeatable\n"
+    "  --terms FILE           the same, one NAME=EXPR[:DESCRIPTION] a line ('#'\n"
+    "                         starts a comment line); repeatable\n"
+    "  --only TERM,...        test only these candidates (built-in or yours)\n"
+    "  --exclude TERM,...     do not test these (--base terms are always kept)\n"
     "  --holdout F            keep the last fraction F of rows out of selection and\n"
     "                         fitting, and report the RMS on them (default 0.2; 0: none)\n"
     "  --noise MODEL          how the noise's correlation is handled: 'ar' (default),\n"
@@ -309,6 +348,16 @@ static const char fe__discover_help[] =
     "                         at most 16; 0: none, batch means); each costs M^2 a row\n"
     "  --blocks K             time blocks for locating (and batch means) (default 20)\n"
     "  --alpha A              family-wise false discovery level (default 0.05)\n"
+    "  --order K              the time derivative the missing effect enters: 0 (default)\n"
+    "                         adds it to the channel (an offset, a gain, a sensor's\n"
+    "                         temperature coefficient); 2 to the channel's second\n"
+    "                         derivative (a force per mass on a position or angle);\n"
+    "                         1 to its first (a heat rate per capacity on a\n"
+    "                         temperature).  With K > 0 the simulation's dynamics are\n"
+    "                         identified from its columns, each term is carried through\n"
+    "                         them to the channel, and coefficients are per unit of the\n"
+    "                         K-th derivative; position and velocity (K = 2) or\n"
+    "                         temperature (K = 1) default to the simulated channel\n"
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
     "  --json                 print one JSON object instead of the story\n"
     "\n"
@@ -325,11 +374,14 @@ typedef struct fe__discover_args {
     fe__pair *pairs;
     size_t npairs;
     const char *channel, *time, *report, *base;
+    const char *term[FE__MAX_USER], *terms_file[FE__MAX_TERM_FILES], *only, *exclude;
+    size_t nterm, nterms_file;
     const char *role_column[FE__ROLES];
     double holdout, alpha;
     long blocks, lags;
     int json;
     int noise;                  /* FE_DISCOVER_NOISE_AR or _BATCH */
+    long order;                 /* K: the derivative the effect enters (0 additive) */
 } fe__discover_args;
 
 static void fe__discover_usage(FILE *out)
@@ -389,6 +441,20 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
             a->time = v;
         } else if (strcmp(o, "--base") == 0) {
             a->base = v;
+        } else if (strcmp(o, "--term") == 0 || strcmp(o, "--terms") == 0) {
+            int file = o[6] == 's';
+            if ((file ? a->nterms_file : a->nterm) >= (file ? FE__MAX_TERM_FILES : FE__MAX_USER)) {
+                snprintf(err, errlen, "%s: at most %d", o, file ? FE__MAX_TERM_FILES : FE__MAX_USER);
+                return FE_CLI_USAGE;
+            }
+            if (file)
+                a->terms_file[a->nterms_file++] = v;
+            else
+                a->term[a->nterm++] = v;
+        } else if (strcmp(o, "--only") == 0) {
+            a->only = v;
+        } else if (strcmp(o, "--exclude") == 0) {
+            a->exclude = v;
         } else if (strcmp(o, "--report") == 0) {
             a->report = v;
         } else if (strcmp(o, "--holdout") == 0) {
@@ -410,6 +476,12 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
                 a->noise = FE_DISCOVER_NOISE_BATCH;
             else {
                 snprintf(err, errlen, "--noise: '%s' is not 'ar' or 'batch'", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--order") == 0) {
+            rc = fe_cli_parse_long(o, v, &a->order, err, errlen);
+            if (rc == FE_CLI_OK && (a->order < 0 || a->order > FE_DYNAMICS_MAX_ORDER)) {
+                snprintf(err, errlen, "--order: %s is not 0, 1 or 2", v);
                 rc = FE_CLI_USAGE;
             }
         } else if (strcmp(o, "--lags") == 0) {
@@ -510,6 +582,19 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
 }
 /* Open a pair and find its columns ends here */
 /* [[file:../../literate/cli_discover.org::Read the pairs as one stream][Read the pairs as one stream]] */
+/* With --order K the state the dynamics act on defaults to the simulated
+   channel: its value (position, temperature) and its derivative
+   (velocity) when no column has that role. */
+static void fe__fill_state(long order, const fe__pair *p, fe_sample *s)
+{
+    if (order == 2 && p->role_col[0] < 0)
+        s->position = s->sim;
+    if (order == 2 && p->role_col[1] < 0)
+        s->velocity = s->dsim;
+    if (order == 1 && p->role_col[2] < 0)
+        s->temperature = s->sim;
+}
+
 typedef struct fe__stream {
     fe__discover_args *a;
     size_t cur;
@@ -524,8 +609,10 @@ static int fe__stream_next(fe__stream *st, fe_sample *s, int *new_pair, char *er
     while (st->cur < st->a->npairs) {
         fe__pair *p = &st->a->pairs[st->cur];
         int rc = fe__pair_next(p, s, err, errlen);
-        if (rc == FE_OK)
+        if (rc == FE_OK) {
+            fe__fill_state(st->a->order, p, s);
             return FE_OK;
+        }
         if (rc != FE_END)
             return rc;
         st->skipped += p->skipped;
@@ -550,6 +637,388 @@ static int fe__stream_rewind(fe__stream *st, char *err, size_t errlen)
     return FE_CLI_OK;
 }
 /* Read the pairs as one stream ends here */
+/* [[file:../../literate/cli_discover.org::Candidate terms of the user's own][Candidate terms of the user's own]] */
+/* One user term: the text as given, a copy split in place into name,
+   expression and description, and the compiled program. */
+typedef struct fe__user_term {
+    const char *orig;           /* NAME=EXPR[:DESCRIPTION], as given */
+    char *spec;                 /* its copy, split */
+    const char *name, *text, *description;
+    const char *file;           /* --terms FILE, or NULL for --term */
+    size_t line;                /* the line in FILE */
+    fe_expr e;
+} fe__user_term;
+
+typedef struct fe__user_terms {
+    size_t n;
+    fe__user_term t[FE__MAX_USER];
+    char *buf[FE__MAX_TERM_FILES];      /* the --terms files' text */
+    /* The columns the terms read, after the catalog's variables, and
+       whether each is the recording's (else the simulation's). */
+    size_t nextra;
+    const char *extra[FE__MAX_EXTRA];
+    int extra_real[FE__MAX_EXTRA];
+} fe__user_terms;
+
+static void fe__terms_free(fe__user_terms *ut)
+{
+    for (size_t i = 0; i < ut->n; i++)
+        free(ut->t[i].spec);
+    for (size_t i = 0; i < FE__MAX_TERM_FILES; i++)
+        free(ut->buf[i]);
+}
+
+/* An error at column col (from 1; 0: none) of term u's text as given:
+   "--term 'SPEC': col C: WHAT" or "FILE:LINE:C: WHAT", then the text with
+   a caret under the column.  Returns the exit status. */
+static int fe__term_error(const fe__user_term *u, size_t col, const char *what, char *err,
+                          size_t errlen)
+{
+    int k;
+    if (u->file != NULL)
+        k = col > 0 ? snprintf(err, errlen, "%.1000s:%zu:%zu: %s", u->file, u->line, col, what)
+                    : snprintf(err, errlen, "%.1000s:%zu: %s", u->file, u->line, what);
+    else
+        k = col > 0 ? snprintf(err, errlen, "--term '%.500s': col %zu: %s", u->orig, col, what)
+                    : snprintf(err, errlen, "--term '%.500s': %s", u->orig, what);
+    if (col > 0 && k > 0 && (size_t)k < errlen && strlen(u->orig) < 500)
+        snprintf(err + k, errlen - (size_t)k, "\n  %s\n  %*s^", u->orig, (int)(col - 1), "");
+    return u->file != NULL ? FE_CLI_INPUT : FE_CLI_USAGE;
+}
+
+/* `s` without leading and trailing blanks (in place). */
+static char *fe__trim(char *s)
+{
+    size_t n;
+    while (*s == ' ' || *s == '\t')
+        s++;
+    n = strlen(s);
+    while (n > 0 && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+        s[--n] = '\0';
+    return s;
+}
+
+/* Whether `name` is one of the comma-separated names of `list`. */
+static int fe__in_list(const char *list, const char *name)
+{
+    size_t len = strlen(name);
+    for (const char *q = list; q != NULL && *q != '\0';) {
+        const char *comma = strchr(q, ',');
+        size_t l = comma != NULL ? (size_t)(comma - q) : strlen(q);
+        if (l == len && strncmp(q, name, len) == 0)
+            return 1;
+        q = comma != NULL ? comma + 1 : NULL;
+    }
+    return 0;
+}
+
+static int fe__is_builtin(const char *name)
+{
+    size_t nb;
+    const fe_term *b = fe_catalog_builtin_terms(&nb);
+    for (size_t i = 0; i < nb; i++)
+        if (strcmp(b[i].name, name) == 0)
+            return 1;
+    return 0;
+}
+/* Candidate terms of the user's own ends here */
+/* [[file:../../literate/cli_discover.org::Split a term's text and check its name][Split a term's text and check its name]] */
+static int fe__terms_add(fe__user_terms *ut, const char *orig, const char *file, size_t line,
+                         char *err, size_t errlen)
+{
+    fe__user_term *u;
+    char *eq, *end, quote = 0;
+    if (ut->n >= FE__MAX_USER) {
+        snprintf(err, errlen, "more than %d user terms", FE__MAX_USER);
+        return FE_CLI_USAGE;
+    }
+    u = &ut->t[ut->n];
+    memset(u, 0, sizeof *u);
+    u->orig = orig;
+    u->file = file;
+    u->line = line;
+    if ((u->spec = malloc(strlen(orig) + 1)) == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    strcpy(u->spec, orig);
+    ut->n++;
+    if ((eq = strchr(u->spec, '=')) == NULL)
+        return fe__term_error(u, 0, "want NAME=EXPR[:DESCRIPTION]", err, errlen);
+    *eq = '\0';
+    u->name = fe__trim(u->spec);
+    if (*u->name == '\0' || (*u->name >= '0' && *u->name <= '9')
+        || strspn(u->name, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
+               != strlen(u->name))
+        return fe__term_error(u, 0, "the name must be letters, digits and '_', not starting "
+                                    "with a digit", err, errlen);
+    if (fe__is_builtin(u->name)) {
+        char what[256];
+        snprintf(what, sizeof what, "'%s' is a built-in term's name: choose another", u->name);
+        return fe__term_error(u, 0, what, err, errlen);
+    }
+    for (size_t i = 0; i + 1 < ut->n; i++)
+        if (strcmp(ut->t[i].name, u->name) == 0) {
+            char what[256];
+            snprintf(what, sizeof what, "a term '%s' is already defined", u->name);
+            return fe__term_error(u, 0, what, err, errlen);
+        }
+    for (end = eq + 1; *end != '\0'; end++)
+        if (quote != 0)
+            quote = *end == quote ? 0 : quote;
+        else if (*end == '"' || *end == '`')
+            quote = *end;
+        else if (*end == ':')
+            break;
+    u->description = NULL;
+    if (*end == ':') {
+        *end = '\0';
+        u->description = fe__trim(end + 1);
+    }
+    u->text = fe__trim(eq + 1);         /* columns still count from orig */
+    for (const char *c = u->description; c != NULL && *c != '\0'; c++)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f)
+            return fe__term_error(u, (size_t)(c - u->spec) + 1,
+                                  "a control character in the description", err, errlen);
+    if (u->description == NULL || *u->description == '\0')
+        u->description = u->text;       /* the expression describes itself */
+    return FE_CLI_OK;
+}
+/* Split a term's text and check its name ends here */
+/* [[file:../../literate/cli_discover.org::Read the user's terms][Read the user's terms]] */
+static int fe__terms_read_file(fe__user_terms *ut, size_t k, const char *path, char *err,
+                               size_t errlen)
+{
+    FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
+    size_t len = 0, cap = 4096, line = 0;
+    char *buf = malloc(cap), *at;
+    int rc = FE_CLI_OK;
+    if (f == NULL) {
+        free(buf);
+        snprintf(err, errlen, "--terms %.1000s: cannot read: %s", path, strerror(errno));
+        return FE_CLI_IO;
+    }
+    if (buf == NULL) {
+        if (f != stdin)
+            fclose(f);
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    for (size_t got; (got = fread(buf + len, 1, cap - len - 1, f)) > 0;) {
+        len += got;
+        if (cap - len == 1) {
+            char *more = realloc(buf, 2 * cap);
+            if (more == NULL) {
+                rc = FE_CLI_IO;
+                break;
+            }
+            buf = more;
+            cap *= 2;
+        }
+    }
+    if (ferror(f) && rc == FE_CLI_OK)
+        rc = FE_CLI_IO;
+    if (f != stdin)
+        fclose(f);
+    buf[len] = '\0';
+    ut->buf[k] = buf;
+    if (rc != FE_CLI_OK) {
+        snprintf(err, errlen, "--terms %.1000s: cannot read", path);
+        return rc;
+    }
+    for (at = buf; at < buf + len && rc == FE_CLI_OK;) {
+        char *nl = strchr(at, '\n'), *p;
+        if (nl != NULL)
+            *nl = '\0';
+        if (nl != NULL && nl > at && nl[-1] == '\r')
+            nl[-1] = '\0';
+        line++;
+        for (p = at; *p == ' ' || *p == '\t'; p++)
+            ;
+        if (*p != '\0' && *p != '#')
+            rc = fe__terms_add(ut, at, path, line, err, errlen);
+        if (nl == NULL)
+            break;
+        at = nl + 1;
+    }
+    return rc;
+}
+/* Read the user's terms ends here */
+/* [[file:../../literate/cli_discover.org::Compile the user's terms][Compile the user's terms]] */
+static int fe__terms_compile(fe__user_terms *ut, const fe__discover_args *a, unsigned roles,
+                             char *err, size_t errlen)
+{
+    const fe__pair *p0 = &a->pairs[0];
+    size_t nv, k, nall;
+    const char *const *vn = fe_catalog_var_names(&nv);
+    const char **names;
+    int *is_real, rc = FE_CLI_OK;
+    for (size_t i = 0; i < a->nterm && rc == FE_CLI_OK; i++)
+        rc = fe__terms_add(ut, a->term[i], NULL, 0, err, errlen);
+    for (size_t i = 0; i < a->nterms_file && rc == FE_CLI_OK; i++)
+        rc = fe__terms_read_file(ut, i, a->terms_file[i], err, errlen);
+    if (rc != FE_CLI_OK || ut->n == 0)
+        return rc;
+    nall = nv + p0->sim.ncols + p0->real.ncols;
+    names = malloc(nall * sizeof *names);
+    is_real = malloc(nall * sizeof *is_real);
+    if (names == NULL || is_real == NULL) {
+        free(names);
+        free(is_real);
+        snprintf(err, errlen, "out of memory");
+        return FE_CLI_IO;
+    }
+    for (k = 0; k < nv; k++) {
+        size_t r = k - FE_CATALOG_VAR_POSITION;     /* the role, for the role variables */
+        names[k] = k >= FE_CATALOG_VAR_POSITION && !(roles & (1u << r)) ? NULL : vn[k];
+        is_real[k] = 0;
+    }
+    for (size_t c = 0; c < p0->sim.ncols; c++)
+        if (c != p0->sim_cols[0] && c != p0->sim_cols[1]) {
+            names[k] = p0->sim.names[c];
+            is_real[k++] = 0;
+        }
+    for (size_t c = 0; c < p0->real.ncols; c++) {
+        int in_sim = 0;
+        for (size_t j = 0; j < p0->sim.ncols; j++)
+            in_sim |= strcmp(p0->sim.names[j], p0->real.names[c]) == 0;
+        if (c != p0->real_cols[0] && c != p0->real_cols[1] && !in_sim) {
+            names[k] = p0->real.names[c];
+            is_real[k++] = 1;
+        }
+    }
+    for (size_t i = 0; i < ut->n && rc == FE_CLI_OK; i++) {
+        fe__user_term *u = &ut->t[i];
+        size_t col = 0;
+        char msg[600];
+        if (fe_expr_compile(&u->e, u->text, names, k, &col, msg, sizeof msg) != FE_OK)
+            rc = fe__term_error(u, (size_t)(u->text - u->spec) + col, msg, err, errlen);
+    }
+    ut->nextra = 0;
+    for (size_t j = nv; j < k && rc == FE_CLI_OK; j++) {
+        int used = 0;
+        for (size_t i = 0; i < ut->n; i++)
+            used |= fe_expr_reads(&ut->t[i].e, j);
+        if (!used)
+            continue;
+        if (ut->nextra == FE__MAX_EXTRA) {
+            snprintf(err, errlen, "the terms read more than %d columns", FE__MAX_EXTRA);
+            rc = FE_CLI_USAGE;
+            break;
+        }
+        ut->extra[ut->nextra] = names[j];
+        ut->extra_real[ut->nextra++] = is_real[j];
+    }
+    for (size_t i = 0; i < ut->nextra; i++)
+        names[nv + i] = ut->extra[i];
+    for (size_t i = 0; i < ut->n && rc == FE_CLI_OK; i++)
+        if (fe_expr_compile(&ut->t[i].e, ut->t[i].text, names, nv + ut->nextra, NULL, NULL, 0)
+            != FE_OK) {
+            snprintf(err, errlen, "internal error: term '%s' did not compile again", ut->t[i].name);
+            rc = FE_CLI_IO;
+        }
+    free(names);
+    free(is_real);
+    return rc;
+}
+/* Compile the user's terms ends here */
+/* [[file:../../literate/cli_discover.org::Find the terms' columns in a pair][Find the terms' columns in a pair]] */
+static int fe__terms_open(const fe__user_terms *ut, fe__pair *p, char *err, size_t errlen)
+{
+    size_t k = 2;
+    for (int r = 0; r < FE__ROLES; r++)
+        if (p->role_col[r] >= 0 && (size_t)p->role_col[r] + 1 > k)
+            k = (size_t)p->role_col[r] + 1;
+    p->nsimx = p->nrealx = 0;
+    for (size_t i = 0; i < ut->nextra; i++) {
+        int rc;
+        if (ut->extra_real[i]) {
+            rc = fe_cli_table_column(&p->real, ut->extra[i], &p->real_cols[2 + p->nrealx++],
+                                     err, errlen);
+        } else {
+            rc = fe_cli_table_column(&p->sim, ut->extra[i], &p->sim_cols[k], err, errlen);
+            p->role_col[FE__ROLES + p->nsimx++] = (int)k++;
+        }
+        if (rc != FE_CLI_OK)
+            return rc;
+    }
+    return FE_CLI_OK;
+}
+
+/* The row of variables of sample s of pair p: the catalog's, then the
+   columns the terms read. */
+static void fe__terms_row(const fe__user_terms *ut, const fe__pair *p, const fe_sample *s,
+                          double *row)
+{
+    size_t ks = 0, kr = 0;
+    fe_catalog_row(s, row);
+    for (size_t i = 0; i < ut->nextra; i++)
+        row[FE_CATALOG_VARS + i] = ut->extra_real[i] ? p->realx[kr++] : p->simx[ks++];
+}
+/* Find the terms' columns in a pair ends here */
+/* [[file:../../literate/cli_discover.org::Add the user's terms to the catalog][Add the user's terms to the catalog]] */
+static int fe__terms_choose(fe_catalog *c, const char *opt, const char *list, int keep,
+                            const char *base, char *err, size_t errlen)
+{
+    const char *q = list;
+    if (list == NULL)
+        return FE_CLI_OK;
+    while (q != NULL) {
+        const char *comma = strchr(q, ',');
+        size_t l = comma != NULL ? (size_t)(comma - q) : strlen(q);
+        char name[256];
+        snprintf(name, sizeof name, "%.*s", (int)(l < 255 ? l : 255), q);
+        if (fe_catalog_find(c, name) < 0 && !fe__is_builtin(name)) {
+            int n = snprintf(err, errlen, "%s: no term '%s'; terms:", opt, name);
+            for (size_t j = 0; j < c->count && n > 0 && (size_t)n < errlen; j++)
+                n += snprintf(err + n, errlen - (size_t)n, " %s", c->terms[j].name);
+            return FE_CLI_USAGE;
+        }
+        q = comma != NULL ? comma + 1 : NULL;
+    }
+    for (size_t j = c->count; j-- > 0;) {
+        const char *name = c->terms[j].name;
+        if (fe__in_list(list, name) != keep && !fe__in_list(base, name)
+            && strcmp(name, "offset") != 0)     /* --order's sensor offset stays */
+            fe_catalog_remove(c, name);
+    }
+    return FE_CLI_OK;
+}
+
+static int fe__terms_catalog(fe__user_terms *ut, const fe__discover_args *a, fe_catalog *c,
+                             char *err, size_t errlen)
+{
+    int rc;
+    if (a->order > 0 && ut->nextra > 0) {
+        snprintf(err, errlen, "--order %ld: a term may read only t, sim, dsim and the roles "
+                 "(it is evaluated between rows too, where other columns are not known): "
+                 "'%.200s' is read", a->order, ut->extra[0]);
+        return FE_CLI_USAGE;
+    }
+    for (size_t i = 0; i < ut->n; i++)
+        if ((rc = fe_catalog_add_expr(c, ut->t[i].name, ut->t[i].description, &ut->t[i].e))
+            != FE_OK) {
+            if (rc == FE_ESIZE)
+                snprintf(err, errlen, "too many terms: at most %d with the built-in ones",
+                         FE_DISCOVER_MAX_GROUPS);
+            else
+                snprintf(err, errlen, "term '%.200s' refused by the catalog", ut->t[i].name);
+            return FE_CLI_USAGE;
+        }
+    if ((rc = fe__terms_choose(c, "--only", a->only, 1, a->base, err, errlen)) != FE_CLI_OK)
+        return rc;
+    return fe__terms_choose(c, "--exclude", a->exclude, 0, a->base, err, errlen);
+}
+
+/* The expression of catalog term j when it is the user's, else NULL. */
+static const char *fe__terms_text(const fe__user_terms *ut, const fe_catalog *c, size_t j)
+{
+    for (size_t i = 0; i < ut->n && c->terms[j].expr != NULL; i++)
+        if (c->terms[j].expr == &ut->t[i].e)
+            return ut->t[i].text;
+    return NULL;
+}
+/* Add the user's terms to the catalog ends here */
 /* [[file:../../literate/cli_discover.org::Print the story][Print the story]] */
 typedef struct fe__outcome {
     const fe_catalog *c;
@@ -569,7 +1038,30 @@ typedef struct fe__outcome {
     size_t npairs;
     double *per_coef, *per_se;                  /* npairs x ncols */
     double *per_rows, *per_held;                /* rows, held-out rows of each */
+    size_t order;                               /* --order K */
+    const fe_dynamics_fit *dyn;                 /* the simulation's, when K > 0 */
+    /* User terms: the expression of each catalog term that is one (else
+       NULL), and the channel's unit for reading their coefficients. */
+    const char *expression[FE_DISCOVER_MAX_GROUPS];
+    char unit[64];
 } fe__outcome;
+
+/* The coefficient of catalog term j in words: the catalog's reading of a
+   built-in term; for a user term, what it adds to the channel per unit of
+   its expression. */
+static void fe__explain(const fe__outcome *o, size_t j, double coef, double se, char *words,
+                        size_t len)
+{
+    if (o->expression[j] != NULL && o->order > 0)
+        snprintf(words, len, "%s gains %.4g +/- %.2g times %s", o->order == 2 ? "d2x/dt2" : "dT/dt",
+                 coef, se, o->expression[j]);
+    else if (o->expression[j] != NULL)
+        snprintf(words, len, "the recording exceeds the simulation by %.4g +/- %.2g%s%s per "
+                 "unit of %s", coef, se, o->unit[0] != '\0' ? " " : "", o->unit,
+                 o->expression[j]);
+    else
+        fe_dynamics_explain(o->c->terms[j].name, o->order, coef, se, words, len);
+}
 
 static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
 {
@@ -603,6 +1095,7 @@ static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
     fe__json_pair(f, "bic", fit->bic);
     fe__json_pair(f, "heldout_rms", fit->heldout_rms);
     fe__json_pair(f, "lag1", fit->lag1);
+    fe__json_pair(f, "floor", fit->floor);
     fprintf(f, ", \"params\": %zu}", fit->params);
 }
 
@@ -670,7 +1163,14 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
             o->fit, o->heldout, o->outside[FE__BEFORE_START], o->outside[FE__AFTER_END],
             o->outside[FE__IN_GAP]);
     fe_cli_json_bad_rows(f);
-    fprintf(f, ", ");
+    fprintf(f, ", \"order\": %zu, ", o->order);
+    if (o->dyn != NULL) {
+        fprintf(f, "\"simulation_dynamics\": {\"basis\": %zu, \"rows\": %.0f, \"r2\": ",
+                o->dyn->nused, o->dyn->n);
+        fe__json_number(f, o->dyn->r2);
+        fe__json_pair(f, "rms", o->dyn->rms);
+        fprintf(f, "}, ");
+    }
     fprintf(f, "\"base\": [");
     for (size_t i = 0; i < o->nbase; i++) {
         fprintf(f, "%s", i ? ", " : "");
@@ -697,9 +1197,13 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         const fe_term *t = &o->c->terms[r->added[s]];
         double se, coef = fe__coef_of(r, r->added[s], &se);
         char words[512];
-        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fe__explain(o, r->added[s], coef, se, words, sizeof words);
         fprintf(f, "%s{\"name\": \"%s\", \"description\": ", s ? ", " : "", t->name);
         fe_cli_json_string(f, t->description);
+        if (o->expression[r->added[s]] != NULL) {
+            fprintf(f, ", \"expression\": ");
+            fe_cli_json_string(f, o->expression[r->added[s]]);
+        }
         fe__json_pair(f, "coefficient", coef);
         fe__json_pair(f, "stderr", se);
         fprintf(f, ", \"interval95\": [");
@@ -841,6 +1345,14 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     if (o->heldout > 0)
         fprintf(f, ", held-out RMS %.5g", r->baseline.heldout_rms);
     fprintf(f, ", lag-1 autocorrelation %.2f\n", r->baseline.lag1);
+    if (o->dyn != NULL) {
+        fprintf(f, "order %zu: the missing effect enters the %s derivative of the channel; the "
+                   "simulation's own dynamics fitted on %zu functions of its state, R^2 = %.6f\n",
+                o->order, o->order == 2 ? "second" : "first", o->dyn->nused, o->dyn->r2);
+        if (o->dyn->r2 < 0.99)
+            fprintf(f, "  warning: the simulation is not well described by those functions "
+                       "(R^2 below 0.99): the terms' signatures are approximate\n");
+    }
     fprintf(f, "\nwhere they differ:\n");
     if (o->nlocated == 0)
         fprintf(f, "  nowhere in particular (no time window or state region stands out)\n");
@@ -879,7 +1391,7 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         const fe_term *t = &o->c->terms[r->added[s]];
         double se, coef = fe__coef_of(r, r->added[s], &se);
         char words[512];
-        fe_catalog_explain(t->name, coef, se, words, sizeof words);
+        fe__explain(o, r->added[s], coef, se, words, sizeof words);
         fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
                    "statistic %.2f, p = %.2g\n     %s\n",
                 s + 1, t->name, t->description, coef, se, coef - r->t_critical * se,
@@ -911,9 +1423,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     if (r->steps > 0 && o->map->nregions > 0)
         fe__story_regions(f, o->map);
     rel = r->baseline.rms > 0 ? 100.0 * (r->final.rms / r->baseline.rms - 1.0) : 0.0;
-    fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f\n",
+    fprintf(f, "\nfit: RMS %.5g -> %.5g (%+.2f%%), BIC %.6g -> %.6g, lag-1 %.2f -> %.2f; "
+               "high-frequency floor %.3g (RMS %.3g times it)\n",
             r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
-            r->baseline.lag1, r->final.lag1);
+            r->baseline.lag1, r->final.lag1, r->final.floor,
+            r->final.floor > 0 ? r->final.rms / r->final.floor : 0.0);
     if (o->heldout > 0)
         fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
                 r->baseline.heldout_rms, r->final.heldout_rms,
@@ -1025,7 +1539,7 @@ static void fe__report_pending(const char *dir, int made)
 {
     static const char *const names[] = {"residuals.dat", "blocks.dat", "bins.dat",
                                         "report.md", "plots.gp", "residual_time.png",
-                                        "residual_state.png"};
+                                        "residual_state.png", "trajectory.png"};
     char path[4200];
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
@@ -1083,7 +1597,9 @@ static void fe__report_data(FILE *f, const fe__plot_info *pi)
                 pi->state_name, pi->state_name);
     fprintf(f, "- `residuals.dat`, every few rows: 1 time (the recording's own clock), "
                "2 residual before, 3 after, 4 position, 5 velocity, 6 temperature "
-               "(0 where the role is not given).\n"
+               "(0 where the role is not given; with --order, the states corrected by the "
+               "discovered terms), 7 the recording, 8 the simulation (column 7 minus column 3 "
+               "is the simulation corrected by the discovered terms).\n"
                "- `plots.gp`, the gnuplot script: `gnuplot plots.gp` in this folder "
                "draws the plots again.\n");
 }
@@ -1158,6 +1674,16 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
         fprintf(f, "Mean residual in 40 equal bins of `%s` (the %s), all rows, with %s1 "
                    "standard error.\n\n", pi->state_name, pi->state_var, pm);
     }
+    if (o->order > 0) {
+        fprintf(f, "## Recording, simulation and corrected simulation\n\n");
+        if (plots)
+            fprintf(f, "![recording, simulation and corrected simulation](trajectory.png)\n\n");
+        fprintf(f, "`%s` as recorded, as simulated, and as simulated with the discovered terms "
+                   "in its dynamics (to first order: the simulation plus each term's signature "
+                   "times its coefficient, plus the sensor's offset)%s.\n\n", pi->channel,
+                pi->held ? "; the grey band is held out, never seen by selection or fitting"
+                         : "");
+    }
     fe__report_data(f, pi);
     if ((rc = fe_cli_output_commit(&out, err, errlen)) != FE_CLI_OK)
         return rc;
@@ -1196,6 +1722,33 @@ static int fe__write_report(const char *dir, const fe__outcome *o, const fe__plo
                    "set xlabel '%s'\n", qchan, qstate, pm, qstate);
         fe__plot_series(f, "bins.dat", NULL, terms, 0);
     }
+    if (o->order > 0)
+        {
+            fprintf(f, "unset object 1\nunset label 1\nunset arrow\n"
+                       "set output 'trajectory.png'\n"
+                       "set title '%s: recording, simulation and corrected simulation'\n"
+                       "set xlabel '%s'\nset ylabel '%s%s%s%s'\n",
+                    qchan, qtime, qchan, unit[0] ? " [" : "", qunit, unit[0] ? "]" : "");
+            if (pi->held && pi->njoins == 0)
+                fprintf(f, "set object 1 rect from first %.15g, graph 0 to first %.15g, graph 1 behind "
+                           "fillcolor rgb '#e6e6e6' fillstyle solid 1.0 noborder\n",
+                        pi->held0, pi->held1);
+            fprintf(f, "set terminal pngcairo size 1000,900 noenhanced\n"
+                       "set output 'trajectory.png'\nset multiplot layout 2,1\n"
+                       "plot 'residuals.dat' using 1:7 with points pt 7 ps 0.3 lc rgb '#808080' "
+                       "title 'recording', \\\n"
+                       "     '' using 1:8 with lines lw 2 lc rgb '#c0504d' title 'simulation', \\\n"
+                       "     '' using 1:($7-$3) with lines lw 2 lc rgb '#1f4e79' "
+                       "title 'corrected simulation'\n"
+                       "set title 'the same, less the simulation: how the trajectories part'\n"
+                       "set ylabel 'against the simulation%s%s%s'\n"
+                       "plot 'residuals.dat' using 1:2 with points pt 7 ps 0.3 lc rgb '#808080' "
+                       "title 'recording %s simulation (less the offset)', \\\n"
+                       "     '' using 1:($2-$3) with lines lw 2 lc rgb '#1f4e79' "
+                       "title 'corrected %s simulation'\n"
+                       "unset multiplot\n",
+                    unit[0] ? " [" : "", qunit, unit[0] ? "]" : "", minus, minus);
+        }
     if (fclose(f) != 0) {
         snprintf(err, errlen, "%.1000s: cannot write: %s", script, strerror(errno));
         return FE_CLI_IO;
@@ -1215,7 +1768,8 @@ static int fe__discover_sphere_main(int argc, char **argv);
 static const fe_cli_option fe__discover_options[] = {
     {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
     {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--lags", 1}, {"--blocks", 1},
-    {"--alpha", 1},
+    {"--alpha", 1}, {"--order", 1}, {"--term", 1}, {"--terms", 1}, {"--only", 1},
+    {"--exclude", 1},
     {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
 
 /* Everything one run of the command holds, from the arguments to the
@@ -1245,7 +1799,19 @@ typedef struct fe__run {
     fe_residual_cell *pblocks;
     size_t nplot, njoins;
     double joins[FE__MAX_PAIRS], held_x0, last_x, shift, step_x;
+    /* --order K: the span and fit of the simulation's dynamics, the
+       signatures, and the coefficients the states are corrected by
+       (zero until a first selection). */
+    fe_dynamics_span span;
+    fe_dynamics_fit dyn;
+    fe_dynamics_sens sens;
+    fe_dynamics_deviation dev;
+    int refine;                         /* Gauss-Newton: about x(theta) */
+    double theta[FE_DISCOVER_MAX_GROUPS];
+    double adj;                         /* the row's residual adjustment */
     fe__outcome out;
+    fe__user_terms terms;               /* --term, --terms */
+    double *term_work;                  /* fe_catalog_eval_rows's */
     char err[2048];
 } fe__run;
 
@@ -1270,6 +1836,8 @@ static void fe__run_free(fe__run *u)
     free(u->out.per_se);
     free(u->out.per_rows);
     free(u->out.per_held);
+    fe__terms_free(&u->terms);
+    free(u->term_work);
 }
 
 #define FE__OOM(u) (snprintf((u)->err, sizeof (u)->err, "out of memory or internal error"), \
@@ -1286,6 +1854,11 @@ static int fe__run_scan(fe__run *u)
     }
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         fe_catalog_scale_add(&u->scale, &s);
+        if (u->a.order > 0 && fe_dynamics_span_add(&u->span, &s) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "%.1000s:%zu: a state value is not finite at t = %g",
+                     u->a.pairs[u->st.cur].sim.name, u->a.pairs[u->st.cur].sim.line, s.t);
+            return FE_CLI_INPUT;
+        }
         for (int v = 0; v < 3; v++) {
             double x = *fe__role(&s, v);    /* position, velocity, temperature */
             u->lo[v] = x < u->lo[v] ? x : u->lo[v];
@@ -1309,8 +1882,12 @@ static int fe__run_scan(fe__run *u)
     memcpy(u->out.outside, u->st.outside, sizeof u->out.outside);
     u->scale.temperature_kelvin = u->kelvin[2];
     u->scale.ambient_kelvin = u->kelvin[3];
-    if (fe_catalog_init(&u->cat, u->roles, &u->scale) != FE_OK)
+    if ((u->a.order == 0 ? fe_catalog_init(&u->cat, u->roles, &u->scale)
+                         : fe_dynamics_catalog_init(&u->cat, (size_t)u->a.order, u->roles,
+                                                    &u->scale)) != FE_OK)
         return FE__OOM(u);
+    if ((rc = fe__terms_catalog(&u->terms, &u->a, &u->cat, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
     u->out.heldout = (size_t)floor(u->a.holdout * (double)u->out.rows);
     u->out.fit = u->out.rows - u->out.heldout;
     if (u->out.fit < 2 * (size_t)u->a.blocks + 10) {
@@ -1326,6 +1903,8 @@ static int fe__run_base(fe__run *u)
 {
     char *list, *items[FE_DISCOVER_MAX_GROUPS];
     int n;
+    if (u->a.order > 0)                 /* the sensor's offset, always */
+        u->base[u->nbase++] = FE_DYNAMICS_OFFSET;
     if (u->a.base == NULL)
         return FE_CLI_OK;
     if ((list = malloc(strlen(u->a.base) + 1)) == NULL)
@@ -1340,15 +1919,177 @@ static int fe__run_base(fe__run *u)
             free(list);
             return FE_CLI_USAGE;
         }
+        if (u->a.order > 0 && j == FE_DYNAMICS_OFFSET)
+            continue;
         u->base[u->nbase++] = (size_t)j;
     }
     free(list);
     return FE_CLI_OK;
 }
 
+/* Row r of window w (0..2) of a simulation as a sample: its time,
+   channel and roles, the channel's three-point derivative as dsim (one
+   sided at a gap or an end), the state filled in as the stream does. */
+static fe_sample fe__sim_sample(const fe__pair *p, long order, const fe__simrow *w)
+{
+    fe_sample s;
+    const fe__simrow *a = fe__linked(p, &w[0], &w[1]) ? &w[0] : NULL;
+    const fe__simrow *b = fe__linked(p, &w[1], &w[2]) ? &w[2] : NULL;
+    memset(&s, 0, sizeof s);
+    s.t = w[1].t;
+    s.sim = w[1].s;
+    for (int r = 0; r < FE__ROLES; r++)
+        *fe__role(&s, r) = w[1].role[r];
+    if (a != NULL && b != NULL) {
+        double h0 = w[1].t - a->t, h1 = b->t - w[1].t;
+        s.dsim = (h0 * h0 * b->s - h1 * h1 * a->s + (h1 * h1 - h0 * h0) * w[1].s)
+                 / (h0 * h1 * (h0 + h1));
+    } else if (a != NULL || b != NULL) {
+        const fe__simrow *o = a != NULL ? a : b;
+        s.dsim = (w[1].s - o->s) / (w[1].t - o->t);
+    }
+    fe__fill_state(order, p, &s);
+    return s;
+}
+
+/* The pass that identifies the simulation's dynamics (--order K), from
+   the simulation's own rows: the recording's times may be uneven and the
+   simulation interpolated onto them, and the second difference of an
+   interpolated position is mostly the interpolation's kinks. */
+static int fe__run_ident(fe__run *u)
+{
+    fe_dynamics_ident id;
+    if (u->a.order == 0)
+        return FE_CLI_OK;
+    if (fe_dynamics_ident_init(&id, &u->span) != FE_OK
+        || fe_dynamics_sens_init(&u->sens, (size_t)u->a.order, u->cat.count - 1) != FE_OK
+        || fe_dynamics_deviation_init(&u->dev, (size_t)u->a.order) != FE_OK)
+        return FE__OOM(u);
+    for (size_t q = 0; q < u->a.npairs; q++) {
+        fe__pair *p = &u->a.pairs[q];
+        fe__simrow w[3];
+        double v[2 + FE__ROLES];
+        size_t k = 2, n = 0;
+        int rc;
+        for (int r = 0; r < FE__ROLES; r++)
+            if (p->role_col[r] >= 0 && (size_t)p->role_col[r] + 1 > k)
+                k = (size_t)p->role_col[r] + 1;
+        if ((rc = fe_cli_table_rewind(&p->sim, u->err, sizeof u->err)) != FE_CLI_OK)
+            return rc;
+        fe_dynamics_ident_break(&id);
+        memset(w, 0, sizeof w);
+        for (;;) {
+            rc = fe_cli_table_next(&p->sim, p->sim_cols, k, v, u->err, sizeof u->err);
+            if (rc != FE_OK && rc != FE_END)
+                return rc;
+            w[0] = w[1];
+            w[1] = w[2];
+            w[2].valid = rc == FE_OK;
+            if (rc == FE_OK) {
+                w[2].t = v[0];
+                w[2].s = v[1];
+                for (int r = 0; r < FE__ROLES; r++)
+                    w[2].role[r] = p->role_col[r] >= 0 ? v[p->role_col[r]] : 0.0;
+            }
+            if (w[1].valid) {
+                fe_sample s = fe__sim_sample(p, u->a.order, w);
+                int gap = w[0].valid && !fe__linked(p, &w[0], &w[1]);
+                if (gap)
+                    fe_dynamics_ident_break(&id);
+                rc = fe_dynamics_ident_add(&id, &s);
+                if (rc == FE_EINVAL) {
+                    snprintf(u->err, sizeof u->err, "%.1000s:%zu: simulation time does not "
+                             "increase", p->sim.name, p->sim.line);
+                    return FE_CLI_INPUT;
+                }
+                if (rc != FE_OK) {
+                    snprintf(u->err, sizeof u->err, "%.1000s:%zu: the simulation's state is not "
+                             "finite at t = %g", p->sim.name, p->sim.line, s.t);
+                    return FE_CLI_INPUT;
+                }
+                n++;
+            }
+            if (!w[2].valid && n > 0)
+                break;
+        }
+    }
+    if (fe_dynamics_ident_solve(&id, &u->dyn) != FE_OK) {
+        snprintf(u->err, sizeof u->err, "too few rows to identify the simulation's dynamics");
+        return FE_CLI_REFUSED;
+    }
+    return FE_CLI_OK;
+}
+
+/* Every term of the catalog at one row (the user's too: their other
+   columns are the current row's). */
+static int fe__run_terms(fe__run *u, const fe_sample *s, double *phi)
+{
+    double row[FE__MAX_VARS];
+    fe__terms_row(&u->terms, &u->a.pairs[u->st.cur], s, row);
+    return fe_catalog_eval_rows(&u->cat, row, FE__MAX_VARS, 1, phi, FE_DISCOVER_MAX_COLUMNS,
+                                u->term_work, NULL);
+}
+
+/* The discovered terms times their coefficients at a sample: the forcing
+   of the deviation (an fe_dynamics_fn).  Between rows there is only the
+   sample: --order refuses terms that read other columns. */
+static int fe__run_force(const fe_sample *s, double *g, void *user)
+{
+    const fe__run *u = user;
+    double phi[FE_DISCOVER_MAX_COLUMNS], sum = 0.0;
+    int rc = fe_catalog_eval(&u->cat, s, phi);
+    if (rc != FE_OK)
+        return rc;
+    for (size_t j = 1; j < u->cat.count; j++)
+        sum += u->theta[j] * phi[j];
+    *g = sum;
+    return FE_OK;
+}
+
+/* The columns of one row: the catalog's terms (--order 0), or each term's
+   signature through the simulation's dynamics, the offset as it is.  Once
+   refining (u->refine), about the corrected trajectory: the deviation
+   under u->theta moves the sample's states (the caller sees them moved),
+   the Jacobian and the terms are taken there, and u->adj receives the
+   residual's adjustment -delta + sum theta_j s_j. */
+static int fe__run_columns(fe__run *u, fe_sample *s, int new_pair, double *phi)
+{
+    size_t K = (size_t)u->a.order, m = u->cat.count;
+    double a[FE_DYNAMICS_MAX_ORDER], raw[FE_DISCOVER_MAX_COLUMNS], d[FE_DYNAMICS_MAX_ORDER] = {0};
+    int rc;
+    u->adj = 0.0;
+    if (K == 0)
+        return fe__run_terms(u, s, phi);
+    if (new_pair || !u->sens.started) {
+        fe_dynamics_sens_restart(&u->sens);
+        fe_dynamics_deviation_restart(&u->dev);
+    }
+    if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
+        return rc;
+    if (u->refine) {
+        if ((rc = fe_dynamics_deviation_step(&u->dev, s, a, fe_dynamics_fit_eval, &u->dyn,
+                                             fe__run_force, u, d)) != FE_OK)
+            return rc;
+        *(K == 2 ? &s->position : &s->temperature) += d[0];
+        if (K == 2)
+            s->velocity += d[1];
+        if ((rc = fe_dynamics_fit_jacobian(s, a, &u->dyn)) != FE_OK)
+            return rc;
+    }
+    if ((rc = fe__run_terms(u, s, raw)) != FE_OK
+        || (rc = fe_dynamics_sens_step(&u->sens, s->t, a, raw + 1, phi + 1, NULL)) != FE_OK)
+        return rc;
+    phi[0] = raw[FE_DYNAMICS_OFFSET];
+    u->adj = -d[0];
+    for (size_t j = 1; j < m; j++)
+        u->adj += u->theta[j] * phi[j];
+    return FE_OK;
+}
+
 /* Pass 2: every candidate term of every row into the engine's
-   accumulation, a panel at a time (fe_discover_add_rows: the lagged
-   products by matrix products), the panel flushed before a break. */
+   accumulation, a panel at a time (the terms by fe_catalog_eval_rows,
+   the lagged products by fe_discover_add_rows' matrix products), the
+   panel flushed before a break. */
 static int fe__run_fold(fe__run *u)
 {
     size_t nst = fe_discover_acc_doubles(u->cat.count, (size_t)u->a.blocks);
@@ -1356,10 +2097,15 @@ static int fe__run_fold(fe__run *u)
     fe_sample s;
     int rc, new_pair;
     u->nwork = fe_discover_workspace_doubles(u->cat.count, (size_t)u->a.blocks);
-    u->storage = malloc(nst * sizeof *u->storage);
-    u->work = malloc(u->nwork * sizeof *u->work);
-    u->panel = p = malloc(sizeof *u->panel);
-    if (u->storage == NULL || u->work == NULL || p == NULL)
+    if (u->storage == NULL) {           /* a second fold (--order) reuses them */
+        u->storage = malloc(nst * sizeof *u->storage);
+        u->work = malloc(u->nwork * sizeof *u->work);
+        u->panel = malloc(sizeof *u->panel);
+        u->term_work = malloc(fe_catalog_work_doubles(FE_DISCOVER_PANEL_ROWS)
+                              * sizeof *u->term_work);
+    }
+    p = u->panel;
+    if (u->storage == NULL || u->work == NULL || p == NULL || u->term_work == NULL)
         return FE__OOM(u);
     if (fe_discover_acc_init(&u->acc, u->cat.count, (size_t)u->a.blocks, u->out.fit, 0,
                              u->storage, nst) != FE_OK
@@ -1367,25 +2113,45 @@ static int fe__run_fold(fe__run *u)
         return FE__OOM(u);
     if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    fe_dynamics_sens_restart(&u->sens);
     p->n = 0;
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         size_t k = p->n;
-        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS) && fe__flush_panel(&u->acc, p) != FE_OK)
+        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS)
+            && fe__flush_panel(u->a.order == 0 ? &u->cat : NULL, &u->acc, p, u->term_work) != FE_OK)
             break;                              /* p->n: the refused row */
         if (new_pair)
             fe_discover_break(&u->acc);
         k = p->n;
-        p->r[k] = s.real - s.sim;
         p->line[k] = u->a.pairs[u->st.cur].real.line;
         p->file[k] = u->a.pairs[u->st.cur].real.name;
         p->t[k] = s.t;
-        if (fe_catalog_eval(&u->cat, &s, p->phi[k]) != FE_OK)
-            break;
+        if (u->a.order == 0) {          /* the terms, a panel at a time */
+            p->r[k] = s.real - s.sim;
+            fe__terms_row(&u->terms, &u->a.pairs[u->st.cur], &s, p->vars[k]);
+        } else {                        /* the signatures, row by row */
+            if (fe__run_columns(u, &s, new_pair, p->phi[k]) != FE_OK)
+                break;
+            p->r[k] = s.real - s.sim + u->adj;
+        }
         p->n++;
     }
-    if (rc == FE_OK || (rc == FE_END && fe__flush_panel(&u->acc, p) != FE_OK)) {
-        snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
-                 p->file[p->n], p->line[p->n], p->t[p->n]);
+    if (rc == FE_OK
+        || (rc == FE_END && fe__flush_panel(u->a.order == 0 ? &u->cat : NULL, &u->acc, p, u->term_work) != FE_OK)) {
+        const char *bad = NULL;
+        double x = 0.0;
+        for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
+            if (!isfinite(p->phi[p->n][j])) {
+                bad = u->cat.terms[j].name;
+                x = p->phi[p->n][j];
+            }
+        if (bad != NULL)
+            snprintf(u->err, sizeof u->err, "%.1000s:%zu: term '%s' is %s at t = %g: refused, "
+                     "nothing reported", p->file[p->n], p->line[p->n], bad,
+                     isnan(x) ? "NaN" : "infinite", p->t[p->n]);
+        else
+            snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
+                     p->file[p->n], p->line[p->n], p->t[p->n]);
         return FE_CLI_INPUT;
     }
     return rc == FE_END ? FE_CLI_OK : rc;
@@ -1397,7 +2163,7 @@ static int fe__run_select(fe__run *u)
     fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
     fe_discover_options opt = fe_discover_default_options();
     int rc;
-    if ((u->res = malloc(sizeof *u->res)) == NULL)
+    if (u->res == NULL && (u->res = malloc(sizeof *u->res)) == NULL)
         return FE__OOM(u);
     fe_catalog_groups(&u->cat, groups);
     opt.alpha = u->a.alpha;
@@ -1413,6 +2179,57 @@ static int fe__run_select(fe__run *u)
     }
     memcpy(u->out.baseline_coef, u->res->path[0].coef,
            u->nbase * sizeof *u->out.baseline_coef);
+    return FE_CLI_OK;
+}
+
+/* Gauss-Newton (--order K): fold and select again about the trajectory
+   corrected by the terms found, until the coefficients stop moving (a
+   fiftieth of a standard error) or FE__GN_ITERATIONS folds.  The baseline
+   (the simulation with its offset) stays the first fold's; the map pass
+   then integrates the deviation under the final coefficients. */
+enum { FE__GN_ITERATIONS = 4 };
+
+static void fe__run_theta(fe__run *u)
+{
+    const fe_discover_result *r = u->res;
+    memset(u->theta, 0, sizeof u->theta);
+    for (size_t j = 0; j < r->ncols; j++)
+        if (r->cols[j] != FE_DYNAMICS_OFFSET)
+            u->theta[r->cols[j]] = r->coef[j];
+}
+
+static int fe__run_refine(fe__run *u)
+{
+    fe_discover_step base0;
+    fe_discover_fit baseline0;
+    int rc;
+    if (u->a.order == 0 || u->res->steps == 0)
+        return FE_CLI_OK;
+    base0 = u->res->path[0];
+    baseline0 = u->res->baseline;
+    u->refine = 1;
+    for (int it = 0; it < FE__GN_ITERATIONS; it++) {
+        double before[FE_DISCOVER_MAX_GROUPS];
+        int moved = 0;
+        memcpy(before, u->theta, sizeof before);
+        fe__run_theta(u);
+        for (size_t j = 0; j < u->res->ncols; j++) {
+            size_t c = u->res->cols[j];
+            if (fabs(u->theta[c] - before[c]) > 0.02 * u->res->stderr_[j])
+                moved = 1;
+        }
+        for (size_t c = 1; c < u->cat.count; c++)
+            if (before[c] != 0.0 && u->theta[c] == 0.0)
+                moved = 1;                  /* a term left the model */
+        if (it > 0 && !moved)
+            break;
+        if ((rc = fe__run_fold(u)) != FE_CLI_OK || (rc = fe__run_select(u)) != FE_CLI_OK)
+            return rc;
+    }
+    fe__run_theta(u);
+    u->res->path[0] = base0;
+    u->res->baseline = baseline0;
+    memcpy(u->out.baseline_coef, base0.coef, u->nbase * sizeof *u->out.baseline_coef);
     return FE_CLI_OK;
 }
 
@@ -1481,6 +2298,7 @@ static int fe__run_map(fe__run *u)
     if ((rc = fe__run_open_report(u)) != FE_CLI_OK || (rc = fe__run_per_alloc(u)) != FE_CLI_OK
         || (rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    fe_dynamics_sens_restart(&u->sens);
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         double before = s.real - s.sim, after;
         for (; new_pair && pair < (int)u->st.cur; pair++)     /* a recording ends */
@@ -1489,10 +2307,13 @@ static int fe__run_map(fe__run *u)
         pair = (int)u->st.cur;
         if (i >= u->out.fit)
             u->out.per_held[pair] += 1.0;
-        fe_catalog_eval(&u->cat, &s, phi);
+        if (fe__run_columns(u, &s, new_pair, phi) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "a term is not finite at t = %g", s.t);
+            return FE_CLI_INPUT;
+        }
         for (size_t j = 0; j < u->nbase; j++)
             before -= u->out.baseline_coef[j] * phi[u->base[j]];
-        after = s.real - s.sim;
+        after = s.real - s.sim + u->adj;
         for (size_t j = 0; j < r->ncols; j++)
             after -= r->coef[j] * phi[r->cols[j]];
         if (fe_residual_map_add(u->map, &s, before, after) != FE_OK) {
@@ -1526,8 +2347,8 @@ static int fe__run_map(fe__run *u)
             fe_lsq_add(&u->per[pair], row, s.real - s.sim, 1.0);
         }
         if (u->pts != NULL && i % stride == 0)
-            fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g\n", s.t, before, after,
-                    s.position, s.velocity, s.temperature);
+            fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g %.10g %.10g\n", s.t, before, after,
+                    s.position, s.velocity, s.temperature, s.real, s.sim);
         i++;
     }
     return rc == FE_END ? FE_CLI_OK : rc;
@@ -1573,6 +2394,11 @@ static void fe__run_locate(fe__run *u)
     u->out.alpha = u->a.alpha;
     u->out.base = u->base;
     u->out.nbase = u->nbase;
+    u->out.order = (size_t)u->a.order;
+    u->out.dyn = u->a.order > 0 ? &u->dyn : NULL;
+    for (size_t j = 0; j < u->cat.count; j++)
+        u->out.expression[j] = fe__terms_text(&u->terms, &u->cat, j);
+    fe__unit_of(u->a.channel, u->out.unit, sizeof u->out.unit);
 }
 
 /* The report: the plot data, report.md and plots.gp, and the plots when
@@ -1629,15 +2455,24 @@ static int fe__run_report(fe__run *u)
     return FE_CLI_OK;
 }
 
-/* Open every pair and find its columns. */
+/* Open every pair and find its columns, those of the user's terms too. */
 static int fe__run_open(fe__run *u)
 {
+    int rc;
     for (size_t i = 0; i < u->a.npairs; i++) {
-        int rc = fe__pair_open(&u->a.pairs[i], &u->a, &u->roles, u->kelvin, u->err,
-                               sizeof u->err);
+        rc = fe__pair_open(&u->a.pairs[i], &u->a, &u->roles, u->kelvin, u->err, sizeof u->err);
         if (rc != FE_CLI_OK)
             return rc;
     }
+    if (u->a.order > 0) {               /* the state defaults to the channel */
+        u->roles |= u->a.order == 2 ? FE_ROLE_POSITION | FE_ROLE_VELOCITY : FE_ROLE_TEMPERATURE;
+        fe_dynamics_span_init(&u->span, (size_t)u->a.order);
+    }
+    if ((rc = fe__terms_compile(&u->terms, &u->a, u->roles, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
+    for (size_t i = 0; i < u->a.npairs; i++)
+        if ((rc = fe__terms_open(&u->terms, &u->a.pairs[i], u->err, sizeof u->err)) != FE_CLI_OK)
+            return rc;
     u->st.a = &u->a;
     return FE_CLI_OK;
 }
@@ -1666,8 +2501,9 @@ int fe_cli_discover(int argc, char **argv)
         rc = FE_CLI_OK;
     } else if (rc == FE_CLI_OK) {
         if ((rc = fe__run_open(u)) == FE_CLI_OK && (rc = fe__run_scan(u)) == FE_CLI_OK
-            && (rc = fe__run_base(u)) == FE_CLI_OK && (rc = fe__run_fold(u)) == FE_CLI_OK
-            && (rc = fe__run_select(u)) == FE_CLI_OK && (rc = fe__run_map(u)) == FE_CLI_OK) {
+            && (rc = fe__run_base(u)) == FE_CLI_OK && (rc = fe__run_ident(u)) == FE_CLI_OK
+            && (rc = fe__run_fold(u)) == FE_CLI_OK && (rc = fe__run_select(u)) == FE_CLI_OK
+            && (rc = fe__run_refine(u)) == FE_CLI_OK && (rc = fe__run_map(u)) == FE_CLI_OK) {
             fe__run_per_recording(u);
             fe__run_locate(u);
             if (u->a.json)

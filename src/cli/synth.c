@@ -8,13 +8,20 @@
 #include <unistd.h>
 
 static const char fe__synth_help[] =
-    "usage: foldest synth --effect NAME [--seed S] [--rows N] --real REAL.csv --sim SIM.csv\n"
+    "usage: foldest synth --effect NAME [--seed S] [--rows N] [--order K] --real REAL.csv\n"
+    "                     --sim SIM.csv\n"
     "\n"
     "Write a recording/simulation pair of a synthetic experiment in which the\n"
     "recording has one effect the simulation lacks, concealed (at most 0.3 noise\n"
     "standard deviations per sample, coloured noise).  NAME is a catalog term or\n"
     "'none' (mechanical rig) or 'none_thermal' (thermal rig).  The truth and the\n"
-    "command that analyses the pair are printed on standard error.\n";
+    "command that analyses the pair are printed on standard error.\n"
+    "\n"
+    "  --order K   0 (default): the effect is added to the channel.  2: it acts on\n"
+    "              the cart's acceleration and the channel is its position; 1: it\n"
+    "              acts on the heated stand's dT/dt and the channel is its\n"
+    "              temperature.  The trajectories part (by about 3 noise sds of\n"
+    "              static response); analyse with discover --order K.\n";
 
 /* `s` as one word of a POSIX shell (see above). */
 static void fe__shell_word(FILE *f, const char *s)
@@ -37,7 +44,7 @@ static void fe__shell_word(FILE *f, const char *s)
 int fe_cli_synth(int argc, char **argv)
 {
     const char *effect = NULL, *real = NULL, *sim = NULL;
-    long seed = 1, rows = 0;
+    long seed = 1, rows = 0, order = 0;
     char err[1024];
     fe_synth g;
     fe_synth_spec spec;
@@ -46,7 +53,8 @@ int fe_cli_synth(int argc, char **argv)
     int pending_real;
     int rc;
     static const fe_cli_option options[] = {
-        {"--effect", 1}, {"--real", 1}, {"--sim", 1}, {"--seed", 1}, {"--rows", 1}, {NULL, 0}};
+        {"--effect", 1}, {"--real", 1}, {"--sim", 1}, {"--seed", 1}, {"--rows", 1},
+        {"--order", 1}, {NULL, 0}};
     rc = fe_cli_options("synth", options, &argc, &argv);
     if (rc != FE_CLI_OK)
         return rc < 0 ? FE_CLI_OK : rc;
@@ -78,7 +86,13 @@ int fe_cli_synth(int argc, char **argv)
             rc = fe_cli_parse_long(o, v, &seed, err, sizeof err);
         else if (strcmp(o, "--rows") == 0)
             rc = fe_cli_parse_long(o, v, &rows, err, sizeof err);
-        else {
+        else if (strcmp(o, "--order") == 0) {
+            rc = fe_cli_parse_long(o, v, &order, err, sizeof err);
+            if (rc == FE_CLI_OK && (order < 0 || order > 2)) {
+                snprintf(err, sizeof err, "--order: %s is not 0, 1 or 2", v);
+                rc = FE_CLI_USAGE;
+            }
+        } else {
             snprintf(err, sizeof err, "unknown option '%s'", o);
             rc = FE_CLI_USAGE;
         }
@@ -94,10 +108,15 @@ int fe_cli_synth(int argc, char **argv)
     spec = fe_synth_default_spec(effect, (uint64_t)seed);
     if (rows > 0)
         spec.rows = (size_t)rows;
+    spec.order = (size_t)order;
     rc = fe_synth_init(&g, &spec);
     if (rc != FE_OK) {
-        fprintf(stderr, "foldest synth: --effect %s: %s\n", effect,
-                rc == FE_EINVAL ? "not an effect a rig can host ('foldest synth --help')"
+        fprintf(stderr, "foldest synth: --effect %s%s: %s\n", effect,
+                order == 2 ? " --order 2" : order == 1 ? " --order 1" : "",
+                rc == FE_EINVAL ? (order > 0 ? "not a forcing the rig can host (the mechanical "
+                                               "rig for --order 2, the thermal for --order 1; "
+                                               "gain and delay describe the measurement)"
+                                             : "not an effect a rig can host ('foldest synth --help')")
                                 : fe_strerror(rc));
         return FE_CLI_USAGE;
     }
@@ -110,7 +129,13 @@ int fe_cli_synth(int argc, char **argv)
         fprintf(stderr, "foldest synth: %s\n", err);
         return rc;
     }
-    if (g.thermal) {
+    if (order == 2) {
+        fprintf(ro.file, "time,position\n");
+        fprintf(so.file, "time,position,velocity,input\n");
+    } else if (order == 1) {
+        fprintf(ro.file, "time,temperature\n");
+        fprintf(so.file, "time,temperature,ambient,power\n");
+    } else if (g.thermal) {
         fprintf(ro.file, "time,load\n");
         fprintf(so.file, "time,load,temperature,ambient\n");
     } else {
@@ -119,7 +144,11 @@ int fe_cli_synth(int argc, char **argv)
     }
     while (fe_synth_next(&g, &s) == FE_OK) {
         fprintf(ro.file, "%.6f,%.10g\n", s.t, s.real);
-        if (g.thermal)
+        if (order == 2)
+            fprintf(so.file, "%.6f,%.10g,%.10g,%.10g\n", s.t, s.sim, s.velocity, s.input);
+        else if (order == 1)
+            fprintf(so.file, "%.6f,%.10g,%.10g,%.10g\n", s.t, s.sim, s.ambient, s.input);
+        else if (g.thermal)
             fprintf(so.file, "%.6f,%.10g,%.10g,%.10g\n", s.t, s.sim, s.temperature, s.ambient);
         else
             fprintf(so.file, "%.6f,%.10g,%.10g,%.10g,%.10g\n", s.t, s.sim, s.position,
@@ -142,11 +171,18 @@ int fe_cli_synth(int argc, char **argv)
     fe_cli_pending_drop(pending_real);
     fprintf(stderr, "synth: %zu rows; hidden effect %s, coefficient %.6g; noise sd %g, "
                     "lag-one correlation %g\n",
-            spec.rows, effect, g.coefficient, spec.noise_sd, spec.noise_rho);
+            spec.rows, effect, g.coefficient, g.sigma, spec.noise_rho);
     fprintf(stderr, "analyse with:\n  foldest discover --real ");
     fe__shell_word(stderr, real);
     fprintf(stderr, " --sim ");
     fe__shell_word(stderr, sim);
+    if (order > 0) {
+        fprintf(stderr, " --channel %s %s --order %ld --holdout 0.3\n",
+                order == 2 ? "position" : "temperature",
+                order == 2 ? "--role velocity=velocity --role input=input"
+                           : "--role ambient=ambient --role power=input", order);
+        return FE_CLI_OK;
+    }
     fprintf(stderr, " --channel %s %s --base %s --holdout 0.3\n",
             g.thermal ? "load" : "acceleration",
             g.thermal ? "--role temperature=temperature --role ambient=ambient"

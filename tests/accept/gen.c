@@ -28,6 +28,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "common.h"
+
 /* ------------------------------------------------------------------ macros */
 
 #define PI 3.14159265358979323846
@@ -136,40 +138,11 @@ typedef struct {
 
 /* ------------------------------------------------------------------ random numbers */
 
-static uint64_t rng_s[4];
 
-static uint64_t splitmix64(uint64_t *x)
-{
-    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
 
-static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 
-static uint64_t xoshiro(void)
-{
-    uint64_t r = rotl(rng_s[1] * 5, 7) * 9, t = rng_s[1] << 17;
-    rng_s[2] ^= rng_s[0];
-    rng_s[3] ^= rng_s[1];
-    rng_s[1] ^= rng_s[2];
-    rng_s[0] ^= rng_s[3];
-    rng_s[2] ^= t;
-    rng_s[3] = rotl(rng_s[3], 45);
-    return r;
-}
 
-static void rng_seed(uint64_t seed)
-{
-    for (int i = 0; i < 4; i++)
-        rng_s[i] = splitmix64(&seed);
-}
 
-static double unif(void) { return ((double)(xoshiro() >> 11) + 0.5) * 0x1.0p-53; }
-static double unif2(double a, double b) { return a + (b - a) * unif(); }
-static double logunif(double a, double b) { return exp(unif2(log(a), log(b))); }
-static double sgn_rand(void) { return unif() < 0.5 ? -1.0 : 1.0; }
 
 static double gauss(void)
 {
@@ -187,13 +160,6 @@ static double gauss(void)
     return sqrt(-2.0 * log(u)) * cos(2.0 * PI * v);
 }
 
-static uint64_t hash_str(const char *s)
-{
-    uint64_t h = 1469598103934665603ULL;
-    while (*s)
-        h = (h ^ (unsigned char)*s++) * 1099511628211ULL;
-    return h;
-}
 
 /* ------------------------------------------------------------------ small helpers */
 
@@ -207,39 +173,10 @@ static double *vec(long n)
     return p;
 }
 
-static double mean_of(const double *x, long n)
-{
-    double s = 0;
-    for (long i = 0; i < n; i++)
-        s += x[i];
-    return s / (double)n;
-}
 
-static double sd_of(const double *x, long n)
-{
-    double m = mean_of(x, n), s = 0;
-    for (long i = 0; i < n; i++)
-        s += (x[i] - m) * (x[i] - m);
-    return sqrt(s / (double)(n - 1));
-}
 
-static double rms_of(const double *x, long n)
-{
-    double s = 0;
-    for (long i = 0; i < n; i++)
-        s += x[i] * x[i];
-    return sqrt(s / (double)n);
-}
 
-static double maxabs_of(const double *x, long n)
-{
-    double m = 0;
-    for (long i = 0; i < n; i++)
-        m = fabs(x[i]) > m ? fabs(x[i]) : m;
-    return m;
-}
 
-static double clampd(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* ------------------------------------------------------------------ least squares */
 
@@ -421,41 +358,7 @@ static void noise_draw(int type, long n, double *x)
     }
 }
 
-/* Levinson-Durbin: AR(p) prediction coefficients a[1..p] from r[0..p]. */
-static void levinson(const double *r, int p, double *a)
-{
-    double e = r[0], tmp[64];
-    memset(a, 0, (size_t)(p + 1) * sizeof *a);
-    for (int k = 1; k <= p; k++) {
-        double acc = r[k], kap;
-        for (int j = 1; j < k; j++)
-            acc -= a[j] * r[k - j];
-        kap = e > 0 ? acc / e : 0;
-        for (int j = 1; j < k; j++)
-            tmp[j] = a[j] - kap * a[k - j];
-        for (int j = 1; j < k; j++)
-            a[j] = tmp[j];
-        a[k] = kap;
-        e *= 1 - kap * kap;
-    }
-}
 
-/* The innovations of x under the AR(p) filter a, for rows p .. n - 1 only,
-   into out[0 .. n - p): the conditional GLS.  The first p rows, filtered
-   with fewer than p lags, are not innovations (row 0 keeps the series'
-   whole variance, gamma_0, not sigma_eta^2); counted as if they were, they
-   overstate z for columns with a level at the start (gain, bias, slow
-   terms) under strongly coloured noise: for a gain under the resonant
-   AR(2), z = -10.9 instead of -1.0.  Dropping them loses p of n rows. */
-static void whiten(const double *a, int p, const double *x, double *out, long n)
-{
-    for (long i = p; i < n; i++) {
-        double v = x[i];
-        for (int k = 1; k <= p; k++)
-            v -= a[k] * x[i - k];
-        out[i - p] = v;
-    }
-}
 
 /* ------------------------------------------------------------------ time columns */
 
@@ -563,7 +466,6 @@ static void multisine_eval(const multisine *m, double t, double *x, double *v, d
 }
 
 /* Piecewise-constant levels with linear ramps (a heater, a switched input). */
-typedef struct { int k; double edge[32], level[33], ramp; } steps;
 
 static steps steps_draw(double D, double lo, double hi)
 {
@@ -577,13 +479,6 @@ static steps steps_draw(double D, double lo, double hi)
     return s;
 }
 
-static double steps_eval(const steps *s, double t)
-{
-    double v = s->level[0];
-    for (int i = 0; i < s->k; i++)
-        v += (s->level[i + 1] - s->level[i]) * clampd((t - s->edge[i]) / s->ramp + 0.5, 0, 1);
-    return v;
-}
 
 /* Thermal rig: a body A (the temperature column) heated by u (the input
    column) loses heat to the ambient: A' = (G u - (A - Ta)) / tau_th.  The
@@ -975,6 +870,11 @@ static void free_draw(draw *d)
         free(d->phi[k]);
 }
 
+/* The cogging effect as a term a user could write (foldest discover
+   --term): its period in position and its true coefficient, for the
+   user-term run of tests/accept/user_terms.py. */
+static double cogging_period, cogging_coefficient;
+
 /* An effect outside the catalog, added to (or, for clipping, applied to)
    the recording's channel.  Returns its RMS in noise sds. */
 static double outside_effect(draw *d, const char *what)
@@ -989,6 +889,7 @@ static double outside_effect(draw *d, const char *what)
             hi = fmax(hi, d->role_i[ROLE_POS][i]);
         }
         period = (hi - lo) / unif2(8, 20);
+        cogging_period = period;
         for (long i = 0; i < n; i++)
             e[i] = sin(2 * PI * d->role_i[ROLE_POS][i] / period);
     } else if (strcmp(what, "saturation") == 0) {
@@ -1075,6 +976,7 @@ static double outside_effect(draw *d, const char *what)
         double s = rms_of(e, n);
         for (long i = 0; i < n; i++)
             d->y[i] += e[i] * (s > 0 ? target / s : 0);
+        cogging_coefficient = s > 0 ? target / s : 0;
     }
     free(e);
     return target / d->sigma;
@@ -1332,7 +1234,11 @@ int main(int argc, char **argv)
         fprintf(f, "\"competitor\": null, \"competitor_delta\": null, ");
     if (cs->pair >= 0)
         fprintf(f, "\"rival\": \"%s\", ", term_name[cs->pair]);
-    if (cs->outside != NULL)
+    if (cs->outside != NULL && strcmp(cs->outside, "cogging") == 0)
+        fprintf(f, "\"outside\": \"%s\", \"outside_rms_sd\": %.4g, \"outside_term\": "
+                   "{\"expression\": \"sin(2*pi*position/%.17g)\", \"coefficient\": %.12g}}\n",
+                cs->outside, outside_rms, cogging_period, cogging_coefficient);
+    else if (cs->outside != NULL)
         fprintf(f, "\"outside\": \"%s\", \"outside_rms_sd\": %.4g}\n", cs->outside, outside_rms);
     else
         fprintf(f, "\"outside\": null}\n");

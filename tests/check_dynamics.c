@@ -1,0 +1,537 @@
+/* SPDX-License-Identifier: MIT */
+/* Output error: signatures against closed forms (a free mass, an
+   oscillator, a first-order lag), the simulation's dynamics identified
+   from its own rows (a linear plant exactly, a pendulum's cos theta, a
+   heated body), refusals that leave the state unchanged, merges, and the
+   whole recipe finding a viscous friction the simulation left out. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "foldest.h"
+#include "testutil.h"
+
+static const double PI = 3.14159265358979323846;
+
+START_TEST(a_free_mass_signature_is_exact)
+{
+    /* s'' = 1 from rest: s = tau^2 / 2, s' = tau, on an uneven clock. */
+    fe_dynamics_sens sn;
+    double a[2] = {0.0, 0.0}, phi = 1.0, y, rate, t = 3.0;
+    fe_rng rng = fe_rng_seed(1);
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, 1), FE_OK);
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, t, a, &phi, &y, &rate), FE_OK);
+    ck_assert_double_eq(y, 0.0);
+    for (int i = 0; i < 200; i++) {
+        t += 0.01 + 0.04 * fe_rng_uniform(&rng);
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, t, a, &phi, &y, &rate), FE_OK);
+        FE_ASSERT_REL(y, 0.5 * (t - 3.0) * (t - 3.0), 1e-12);
+        FE_ASSERT_REL(rate, t - 3.0, 1e-12);
+    }
+}
+END_TEST
+
+START_TEST(an_oscillator_signature_follows_its_closed_form)
+{
+    /* s'' = -w^2 s + 1: s = (1 - cos w t) / w^2, sampled 10 times a period
+       (the substeps carry the accuracy). */
+    const double w = 2.0 * PI * 1.5, h = 1.0 / 15.0;
+    fe_dynamics_sens sn;
+    double a[2] = {-w * w, 0.0}, phi = 1.0, y, worst = 0.0;
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, 1), FE_OK);
+    for (int i = 0; i <= 150; i++) {
+        double t = i * h, want = (1.0 - cos(w * t)) / (w * w);
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, t, a, &phi, &y, NULL), FE_OK);
+        worst = fmax(worst, fabs(y - want) * w * w);
+    }
+    ck_assert_msg(worst < 5e-3, "worst error %g of the amplitude", worst);
+}
+END_TEST
+
+START_TEST(a_first_order_lag_sampled_coarsely_does_not_ring)
+{
+    /* s' = -k s + 1: s = (1 - exp(-k t)) / k, three time constants a row. */
+    const double k = 3.0;
+    fe_dynamics_sens sn;
+    double a[1] = {-k}, phi = 1.0, y, rate;
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 1, 1), FE_OK);
+    for (int i = 0; i <= 10; i++) {
+        double t = i * 1.0, want = (1.0 - exp(-k * t)) / k;
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, t, a, &phi, &y, &rate), FE_OK);
+        ck_assert_msg(fabs(y - want) < 1e-3 / k, "t = %g: %g against %g", t, y, want);
+        FE_ASSERT_REL(rate + 1e-300, -k * y + 1.0 + 1e-300, 1e-12);
+    }
+}
+END_TEST
+
+/* A plant integrated by RK4 (20 substeps a row): x'' = f(x, v, u). */
+typedef struct plant {
+    int kind;                   /* 0 linear oscillator, 1 pendulum */
+    double w, zeta, b, extra;   /* extra: a coefficient of v for the real system */
+} plant;
+
+static double input_at(double t)
+{
+    return sin(2 * PI * 0.31 * t) + 0.6 * sin(2 * PI * 0.83 * t + 1.0) + 0.3 * sin(2 * PI * 2.1 * t);
+}
+
+static double accel(const plant *p, double x, double v, double t)
+{
+    double f = p->kind == 0 ? -p->w * p->w * x - 2 * p->zeta * p->w * v
+                            : -p->w * p->w * sin(x) - 2 * p->zeta * p->w * v;
+    return f + p->b * input_at(t) + p->extra * v;
+}
+
+static void rk4(const plant *p, double *x, double *v, double t, double h)
+{
+    double k1x = *v, k1v = accel(p, *x, *v, t);
+    double k2x = *v + h / 2 * k1v, k2v = accel(p, *x + h / 2 * k1x, *v + h / 2 * k1v, t + h / 2);
+    double k3x = *v + h / 2 * k2v, k3v = accel(p, *x + h / 2 * k2x, *v + h / 2 * k2v, t + h / 2);
+    double k4x = *v + h * k3v, k4v = accel(p, *x + h * k3x, *v + h * k3v, t + h);
+    *x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    *v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+}
+
+/* n rows at step h of plant p from (x0, 0): samples with t, position,
+   velocity, input (sim = position). */
+static void simulate(const plant *p, double x0, double h, size_t n, fe_sample *out)
+{
+    double x = x0, v = 0.0, t = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        memset(&out[i], 0, sizeof out[i]);
+        out[i].t = t;
+        out[i].sim = out[i].position = x;
+        out[i].velocity = v;
+        out[i].input = input_at(t);
+        for (int k = 0; k < 20; k++)
+            rk4(p, &x, &v, t + k * h / 20, h / 20);
+        t += h;
+    }
+}
+
+static void identify(const fe_sample *rows, size_t n, size_t order, fe_dynamics_fit *fit)
+{
+    fe_dynamics_span sp;
+    fe_dynamics_ident id;
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, order), FE_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(fe_dynamics_span_add(&sp, &rows[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(fe_dynamics_ident_add(&id, &rows[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, fit), FE_OK);
+}
+
+enum { NSIM = 3000 };
+static fe_sample rows[NSIM], rows2[NSIM];
+
+START_TEST(a_linear_plant_is_identified_exactly)
+{
+    plant p = {0, 2 * PI * 0.5, 0.1, 2.0, 0.0};
+    fe_dynamics_fit fit;
+    double a[2];
+    simulate(&p, 0.2, 0.01, NSIM, rows);
+    identify(rows, NSIM, 2, &fit);
+    ck_assert_msg(fit.r2 > 0.99999, "R^2 %.8f", fit.r2);
+    for (size_t i = 100; i < NSIM; i += 700) {
+        double f;
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], a, &fit), FE_OK);
+        FE_ASSERT_REL(a[0], -p.w * p.w, 1e-3);
+        FE_ASSERT_REL(a[1], -2 * p.zeta * p.w, 1e-2);
+        ck_assert_int_eq(fe_dynamics_fit_eval(&rows[i], &f, &fit), FE_OK);
+        ck_assert_msg(fabs(f - accel(&p, rows[i].position, rows[i].velocity, rows[i].t))
+                          < 1e-3 * p.w * p.w * 0.2, "f %g", f);
+    }
+}
+END_TEST
+
+START_TEST(a_pendulum_jacobian_is_its_cosine)
+{
+    /* Swings to about 1.4 rad: d f / d theta = -w^2 cos theta. */
+    plant p = {1, 2 * PI * 0.7, 0.02, 3.0, 0.0};
+    fe_dynamics_fit fit;
+    double a[2], top = 0.0;
+    simulate(&p, 1.0, 0.01, NSIM, rows);
+    for (size_t i = 0; i < NSIM; i++)
+        top = fmax(top, fabs(rows[i].position));
+    ck_assert_msg(top > 1.0, "swing %g", top);
+    identify(rows, NSIM, 2, &fit);
+    ck_assert_msg(fit.r2 > 0.9999, "R^2 %.8f", fit.r2);
+    for (size_t i = 50; i < NSIM; i += 97) {
+        double want = -p.w * p.w * cos(rows[i].position);
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], a, &fit), FE_OK);
+        ck_assert_msg(fabs(a[0] - want) < 0.03 * p.w * p.w, "theta %g: %g against %g",
+                      rows[i].position, a[0], want);
+    }
+}
+END_TEST
+
+static int heat_body(const fe_sample *s, double *d, void *user)
+{
+    (void)user;
+    *d = -0.01 * (s->temperature - s->ambient) + 0.002 * s->input;
+    return 0;
+}
+
+START_TEST(a_heated_body_is_identified)
+{
+    /* dT/dt = -0.01 (T - Ta) + 0.002 P, minutes, on an uneven clock; the
+       ambient swings.  Then R^2 against the three-point derivatives the
+       test takes itself. */
+    fe_dynamics_fit fit;
+    double T = 20.0, a[1], afd[1], t = 0.0, sum = 0.0, sq = 0.0, n = 0.0, var;
+    for (size_t i = 0; i < 1000; i++) {
+        fe_sample *s = &rows[i];
+        double d, h = 0.7 + 0.6 * (double)(i % 3) / 2.0;
+        memset(s, 0, sizeof *s);
+        s->t = t;
+        s->temperature = s->sim = T;
+        s->ambient = 18.0 + 3.0 * sin(2 * PI * t / 700.0);
+        s->input = (i / 150) % 2 ? 1500.0 : 0.0;
+        heat_body(s, &d, NULL);
+        T += h * d;             /* an Euler step: the identification sees its own rows */
+        t += h;
+    }
+    identify(rows, 1000, 1, &fit);
+    ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[500], a, &fit), FE_OK);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(heat_body, NULL, 1, &rows[500], afd), FE_OK);
+    FE_ASSERT_REL(afd[0], -0.01, 1e-6);
+    ck_assert_msg(fabs(a[0] + 0.01) < 1e-4, "a0 = %g", a[0]);
+    for (size_t i = 1; i + 1 < 1000; i++) {
+        double h0 = rows[i].t - rows[i - 1].t, h1 = rows[i + 1].t - rows[i].t;
+        double y = (h0 * h0 * rows[i + 1].temperature - h1 * h1 * rows[i - 1].temperature
+                    + (h1 * h1 - h0 * h0) * rows[i].temperature) / (h0 * h1 * (h0 + h1));
+        sum += y;
+        sq += y * y;
+        n += 1.0;
+    }
+    ck_assert(fit.n == n);
+    var = sq - sum * sum / n;
+    FE_ASSERT_REL(fit.r2, 1.0 - fit.rms * fit.rms * n / var, 1e-9);
+    ck_assert_msg(fit.r2 > 0.99 && fit.r2 < 1.0, "R^2 %.10f", fit.r2);
+}
+END_TEST
+
+/* A radiating body, dT/dt = -e (T_K^4 - Ta_K^4): the Jacobian
+   -4 e T_K^3 varies along the trajectory (the basis's higher powers). */
+static int radiating(const fe_sample *s, double *d, void *user)
+{
+    double T = s->temperature + 273.15, Ta = s->ambient + 273.15;
+    (void)user;
+    *d = -1e-10 * (T * T * T * T - Ta * Ta * Ta * Ta) + 0.01 * s->input;
+    return 0;
+}
+
+START_TEST(a_radiating_body_jacobian_follows_its_temperature)
+{
+    fe_dynamics_fit fit;
+    double T = 20.0, t = 0.0;
+    for (size_t i = 0; i < 2000; i++) {
+        fe_sample *s = &rows[i];
+        double d;
+        memset(s, 0, sizeof *s);
+        s->t = t;
+        s->temperature = s->sim = T;
+        s->ambient = 20.0;
+        s->input = (i / 400) % 2 ? 0.0 : 30.0;
+        for (int k = 0; k < 50; k++) {  /* a smooth trajectory: fine Euler substeps */
+            fe_sample m = *s;
+            m.temperature = T;
+            radiating(&m, &d, NULL);
+            T += 0.01 * d;
+        }
+        t += 0.5;
+    }
+    identify(rows, 2000, 1, &fit);
+    ck_assert_msg(fit.r2 > 0.999, "R^2 %.6f", fit.r2);
+    for (size_t i = 100; i < 2000; i += 150) {
+        double a[1], want, f, g;
+        double TK = rows[i].temperature + 273.15;
+        want = -4e-10 * TK * TK * TK;
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], a, &fit), FE_OK);
+        ck_assert_msg(fabs(a[0] - want) < 0.02 * fabs(want), "T %g: %g against %g",
+                      rows[i].temperature, a[0], want);
+        ck_assert_int_eq(fe_dynamics_fit_eval(&rows[i], &f, &fit), FE_OK);
+        radiating(&rows[i], &g, NULL);
+        ck_assert_msg(fabs(f - g) < 1e-3 * (fabs(g) + 1e-3), "dT/dt %g against %g", f, g);
+    }
+}
+END_TEST
+
+/* The deviation under a constant forcing c from rest, through linear
+   dynamics: K = 2, f = -w^2 x: c (1 - cos w t) / w^2; K = 1, f = -k T:
+   c (1 - exp(-k t)) / k.  Between rows the sample's fields are linear. */
+static int spring(const fe_sample *s, double *d, void *user)
+{
+    (void)user;
+    *d = -4.0 * s->position;
+    return 0;
+}
+
+static int lag(const fe_sample *s, double *d, void *user)
+{
+    (void)user;
+    *d = -0.5 * s->temperature;
+    return 0;
+}
+
+static int constant_force(const fe_sample *s, double *g, void *user)
+{
+    (void)s;
+    *g = *(const double *)user;
+    return 0;
+}
+
+START_TEST(a_deviation_follows_its_closed_form)
+{
+    fe_dynamics_deviation dv;
+    double c = 0.3, d[2], a2[2] = {-4.0, 0.0}, a1[1] = {-0.5};
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 3), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 2), FE_OK);
+    for (int i = 0; i <= 200; i++) {
+        fe_sample s;
+        double t = 0.05 * i;
+        memset(&s, 0, sizeof s);
+        s.t = t;
+        s.position = s.sim = 0.1 * sin(3.0 * t);     /* the simulated trajectory */
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a2, spring, NULL, constant_force,
+                                                    &c, d), FE_OK);
+        /* RK4 at h w = 0.1 over twenty radians: a few 1e-6 of the amplitude. */
+        ck_assert_msg(fabs(d[0] - c * (1.0 - cos(2.0 * t)) / 4.0) < 1e-5, "t %g: %g", t, d[0]);
+        ck_assert_msg(fabs(d[1] - c * sin(2.0 * t) / 2.0) < 1e-5, "t %g: rate %g", t, d[1]);
+    }
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 1), FE_OK);
+    for (int i = 0; i <= 60; i++) {
+        fe_sample s;
+        double t = 0.5 * i;
+        memset(&s, 0, sizeof s);
+        s.t = t;
+        s.temperature = s.sim = 20.0 + t;
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a1, lag, NULL, constant_force, &c,
+                                                    d), FE_OK);
+        ck_assert_msg(fabs(d[0] - c * (1.0 - exp(-0.5 * t)) / 0.5) < 1e-6, "t %g: %g", t, d[0]);
+    }
+}
+END_TEST
+
+START_TEST(spans_and_finite_differences_at_zero)
+{
+    fe_dynamics_span sp;
+    fe_sample s;
+    double a[2];
+    const double x[4] = {-1.2, 0.3, 2.5, 0.9};     /* the least first */
+    ck_assert_int_eq(fe_dynamics_span_init(NULL, 2), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 2), FE_OK);
+    for (int i = 0; i < 4; i++) {
+        memset(&s, 0, sizeof s);
+        s.position = x[i];
+        s.velocity = -x[i];
+        s.input = 10.0 + x[i];
+        s.ambient = 2.0 * x[i];
+        ck_assert_int_eq(fe_dynamics_span_add(&sp, &s), FE_OK);
+    }
+    ck_assert(sp.lo[0] == -1.2 && sp.hi[0] == 2.5 && sp.lo[1] == -2.5 && sp.hi[1] == 1.2);
+    ck_assert(sp.lo[2] == 8.8 && sp.hi[2] == 12.5 && sp.lo[3] == -2.4 && sp.hi[3] == 5.0);
+    /* The finite-difference step at a state of zero is 1e-6, not zero. */
+    memset(&s, 0, sizeof s);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 2, &s, a), FE_OK);
+    FE_ASSERT_REL(a[0], -4.0, 1e-9);
+    ck_assert(a[1] == 0.0);
+}
+END_TEST
+
+START_TEST(refusals_leave_the_state_unchanged)
+{
+    fe_dynamics_sens sn, copy;
+    fe_dynamics_ident id, icopy;
+    fe_dynamics_span sp;
+    fe_sample s;
+    double a[2] = {-1.0, 0.0}, phi[2] = {1.0, 2.0}, y[2];
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 3, 2), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, FE_DISCOVER_MAX_COLUMNS + 1), FE_ESIZE);
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, 2), FE_OK);
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.0, a, phi, y, NULL), FE_OK);
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.1, a, phi, y, NULL), FE_OK);
+    copy = sn;
+    phi[1] = NAN;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.2, a, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+    phi[1] = 2.0;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.1, a, phi, y, NULL), FE_EINVAL);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+    a[0] = INFINITY;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.2, a, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+
+    memset(&s, 0, sizeof s);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 2), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_ETOOFEW);
+    ck_assert_int_eq(fe_dynamics_span_add(&sp, &s), FE_OK);
+    s.velocity = NAN;
+    ck_assert_int_eq(fe_dynamics_span_add(&sp, &s), FE_ENONFINITE);
+    ck_assert(sp.n == 1.0);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_OK);
+    s.velocity = 0.0;
+    ck_assert_int_eq(fe_dynamics_ident_add(&id, &s), FE_OK);
+    icopy = id;
+    ck_assert_int_eq(fe_dynamics_ident_add(&id, &s), FE_EINVAL);    /* time stands still */
+    s.t = 1.0;
+    s.input = NAN;
+    ck_assert_int_eq(fe_dynamics_ident_add(&id, &s), FE_ENONFINITE);
+    ck_assert(memcmp(&id, &icopy, sizeof id) == 0);
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, &(fe_dynamics_fit){0}), FE_ETOOFEW);
+}
+END_TEST
+
+START_TEST(an_identification_split_at_a_break_merges_to_the_whole)
+{
+    plant p = {0, 2 * PI * 0.5, 0.1, 2.0, 0.0};
+    fe_dynamics_span sp;
+    fe_dynamics_ident whole, first, second;
+    fe_dynamics_fit fw, fm;
+    size_t half = NSIM / 2;
+    simulate(&p, 0.2, 0.01, NSIM, rows);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 2), FE_OK);
+    for (size_t i = 0; i < NSIM; i++)
+        ck_assert_int_eq(fe_dynamics_span_add(&sp, &rows[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_init(&whole, &sp), FE_OK);
+    first = second = whole;
+    for (size_t i = 0; i < NSIM; i++) {
+        if (i == half)
+            fe_dynamics_ident_break(&whole);
+        ck_assert_int_eq(fe_dynamics_ident_add(&whole, &rows[i]), FE_OK);
+        ck_assert_int_eq(fe_dynamics_ident_add(i < half ? &first : &second, &rows[i]), FE_OK);
+    }
+    ck_assert_int_eq(fe_dynamics_ident_merge(&first, &second), FE_OK);
+    ck_assert(first.n == whole.n);
+    /* The sums agree to rounding; the fits' coefficients of nearly
+       collinear functions (the input and its neighbours) amplify that, so
+       what is compared after the solve is what the fit is for: the
+       Jacobian along the trajectory. */
+    for (size_t i = 0; i < sizeof whole.gram / sizeof whole.gram[0]; i++)
+        ck_assert_msg(fabs(first.gram[i] - whole.gram[i]) <= 1e-12 * (fabs(whole.gram[i]) + 1.0),
+                      "gram[%zu]: %.17g against %.17g", i, first.gram[i], whole.gram[i]);
+    ck_assert_int_eq(fe_dynamics_ident_solve(&whole, &fw), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_solve(&first, &fm), FE_OK);
+    for (size_t i = 100; i < NSIM; i += 350) {
+        double aw[2], am[2];
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], aw, &fw), FE_OK);
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], am, &fm), FE_OK);
+        FE_ASSERT_REL(am[0], aw[0], 1e-9);
+        FE_ASSERT_REL(am[1], aw[1], 1e-7);
+    }
+    second.order = 1;
+    ck_assert_int_eq(fe_dynamics_ident_merge(&first, &second), FE_EMISMATCH);
+}
+END_TEST
+
+START_TEST(the_dynamics_catalog_and_its_words)
+{
+    fe_catalog c;
+    fe_catalog_scale sc;
+    char words[256];
+    memset(&sc, 0, sizeof sc);
+    sc.vmax = 1.0;
+    ck_assert_int_eq(fe_dynamics_catalog_init(&c, 2, FE_ROLE_POSITION | FE_ROLE_VELOCITY, &sc),
+                     FE_OK);
+    ck_assert_str_eq(c.terms[FE_DYNAMICS_OFFSET].name, "offset");
+    ck_assert_int_lt(fe_catalog_find(&c, "gain"), 0);
+    ck_assert_int_lt(fe_catalog_find(&c, "delay"), 0);
+    ck_assert_int_gt(fe_catalog_find(&c, "viscous_friction"), 0);
+    ck_assert_int_eq(fe_dynamics_catalog_init(&c, 0, 0, &sc), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_explain("viscous_friction", 2, -0.25, 0.01, words, sizeof words),
+                     FE_OK);
+    ck_assert_msg(strstr(words, "d2x/dt2 gains -c v with c = 0.25") != NULL, "%s", words);
+    ck_assert_int_eq(fe_dynamics_explain("newton_cooling", 1, -0.02, 0.001, words, sizeof words),
+                     FE_OK);
+    ck_assert_msg(strstr(words, "dT/dt") != NULL, "%s", words);
+}
+END_TEST
+
+/* The recipe: identify the simulation, carry every term through it, fold
+   the signatures with the offset, select.  The real cart has a viscous
+   friction the simulation lacks; trajectories part by a few noise sds. */
+START_TEST(a_missing_viscous_friction_is_named_with_its_coefficient)
+{
+    const double truth = -0.02, sd = 0.002, h = 0.01;
+    plant sim = {0, 2 * PI * 0.5, 0.1, 2.0, 0.0}, real = sim;
+    fe_dynamics_fit fit;
+    fe_dynamics_sens sn;
+    fe_catalog c;
+    fe_catalog_scale sc;
+    fe_discover_acc acc;
+    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
+    fe_discover_options opt = fe_discover_default_options();
+    static fe_discover_result res;
+    static double storage[200000], work[200000];
+    fe_rng rng = fe_rng_seed(11);
+    size_t base = FE_DYNAMICS_OFFSET, visc, fit_rows = NSIM * 4 / 5;
+    double e = 0.0, parting = 0.0;
+    int named = 0;
+    real.extra = truth;
+    simulate(&sim, 0.2, h, NSIM, rows);
+    simulate(&real, 0.2, h, NSIM, rows2);
+    memset(&sc, 0, sizeof sc);
+    for (size_t i = 0; i < NSIM; i++)
+        ck_assert_int_eq(fe_catalog_scale_add(&sc, &rows[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_catalog_init(&c, 2, FE_ROLE_POSITION | FE_ROLE_VELOCITY
+                                                         | FE_ROLE_INPUT, &sc), FE_OK);
+    visc = (size_t)fe_catalog_find(&c, "viscous_friction");
+    identify(rows, NSIM, 2, &fit);
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, c.count - 1), FE_OK);
+    ck_assert_uint_le(fe_discover_acc_doubles(c.count, 20), sizeof storage / sizeof storage[0]);
+    ck_assert_int_eq(fe_discover_acc_init(&acc, c.count, 20, fit_rows, 0, storage,
+                                          sizeof storage / sizeof storage[0]), FE_OK);
+    for (size_t i = 0; i < NSIM; i++) {
+        double phi[FE_DISCOVER_MAX_COLUMNS], col[FE_DISCOVER_MAX_COLUMNS], a[2];
+        e = 0.5 * e + sqrt(0.75) * sd * fe_rng_normal(&rng);
+        parting = fmax(parting, fabs(rows2[i].position - rows[i].position));
+        ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[i], a, &fit), FE_OK);
+        ck_assert_int_eq(fe_catalog_eval(&c, &rows[i], phi), FE_OK);
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, rows[i].t, a, phi + 1, col + 1, NULL), FE_OK);
+        col[0] = phi[0];
+        ck_assert_int_eq(fe_discover_add(&acc, col, rows2[i].position + e - rows[i].position),
+                         FE_OK);
+    }
+    ck_assert_msg(parting > 1 * sd && parting < 10 * sd, "parting %g sds", parting / sd);
+    fe_catalog_groups(&c, groups);
+    opt.base = &base;
+    opt.nbase = 1;
+    ck_assert_uint_le(fe_discover_workspace_doubles(c.count, 20), sizeof work / sizeof work[0]);
+    ck_assert_int_eq(fe_discover_select(&acc, groups, c.count, &opt, &res, work,
+                                        sizeof work / sizeof work[0]), FE_OK);
+    ck_assert_uint_ge(res.steps, 1);
+    ck_assert_uint_eq(res.added[0], visc);
+    for (size_t j = 0; j < res.ncols; j++)
+        if (res.cols[j] == visc) {
+            double lo = res.coef[j] - res.t_critical * res.stderr_[j];
+            double hi = res.coef[j] + res.t_critical * res.stderr_[j];
+            ck_assert_msg(lo <= truth && truth <= hi, "%g not in [%g, %g]", truth, lo, hi);
+            named = 1;
+        }
+    ck_assert(named);
+    ck_assert(res.final.heldout_rms < res.baseline.heldout_rms);
+}
+END_TEST
+
+Suite *fe_dynamics_suite(void)
+{
+    Suite *s = suite_create("dynamics");
+    TCase *t = tcase_create("dynamics");
+    tcase_add_test(t, a_free_mass_signature_is_exact);
+    tcase_add_test(t, an_oscillator_signature_follows_its_closed_form);
+    tcase_add_test(t, a_first_order_lag_sampled_coarsely_does_not_ring);
+    tcase_add_test(t, a_linear_plant_is_identified_exactly);
+    tcase_add_test(t, a_pendulum_jacobian_is_its_cosine);
+    tcase_add_test(t, a_heated_body_is_identified);
+    tcase_add_test(t, a_radiating_body_jacobian_follows_its_temperature);
+    tcase_add_test(t, a_deviation_follows_its_closed_form);
+    tcase_add_test(t, spans_and_finite_differences_at_zero);
+    tcase_add_test(t, refusals_leave_the_state_unchanged);
+    tcase_add_test(t, an_identification_split_at_a_break_merges_to_the_whole);
+    tcase_add_test(t, the_dynamics_catalog_and_its_words);
+    tcase_add_test(t, a_missing_viscous_friction_is_named_with_its_coefficient);
+    suite_add_tcase(s, t);
+    return s;
+}
