@@ -177,7 +177,7 @@ $(B)/tests/suites.h: $(TEST_SRC)
 
 TEST_DEFS = -DFE_TEST_CLI='"$(abspath $(CLI))"' -DFE_TEST_SRC='"$(abspath .)"'
 
-$(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(STATIC) $(CLI)
+$(B)/tests/check_foldest: $(TEST_SRC) tests/main.c tests/testutil.h tests/cli_run.h $(B)/tests/suites.h $(STATIC) $(CLI)
 	$(CC) $(WARN) -O2 -g $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(STATIC) $(CHECK_LIBS) $(EXT_LIBS) $(LDFLAGS)
 
@@ -185,7 +185,7 @@ $(B)/san/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(SAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
-$(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(SAN_OBJ) $(CLI)
+$(B)/tests/check_foldest_san: $(TEST_SRC) tests/main.c tests/testutil.h tests/cli_run.h $(B)/tests/suites.h $(SAN_OBJ) $(CLI)
 	$(CC) $(WARN) -O1 -g $(SAN) $(TEST_DEFS) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(SAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
@@ -194,7 +194,7 @@ $(B)/tsan/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
-$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h $(B)/tests/suites.h $(TSAN_OBJ)
+$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h tests/cli_run.h $(B)/tests/suites.h $(TSAN_OBJ)
 	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(TSAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 

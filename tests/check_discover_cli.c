@@ -10,26 +10,12 @@
 
 #include "foldest.h"
 #include "testutil.h"
+#include "cli_run.h"
 
 #ifndef FE_TEST_CLI
 #define FE_TEST_CLI "build/bin/foldest"
 #endif
 
-/* Run a shell command; capture at most `len` bytes of its stdout+stderr. */
-static int run(const char *cmd, char *out, size_t len)
-{
-    char full[16384];
-    FILE *p;
-    size_t got;
-    int status;
-    snprintf(full, sizeof full, "%s 2>&1", cmd);
-    p = popen(full, "r");
-    ck_assert_ptr_nonnull(p);
-    got = fread(out, 1, len - 1, p);
-    out[got] = '\0';
-    status = pclose(p);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 static char dir[64];
 
@@ -50,11 +36,11 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     make_dir();
     snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 7 --rows %d --real %s/r.csv --sim %s/s.csv",
              FE_TEST_CLI, fe_test_quick() ? 100000 : 200000, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "hidden effect quadratic_drag") != NULL, "%s", out);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s --json --report %s/rep",
              FE_TEST_CLI, dir, dir, roles, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"quadratic_drag\"") != NULL, "%s", out);
     {
@@ -64,10 +50,10 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     }
     snprintf(cmd, sizeof cmd, "%s synth --effect none --seed 7 --real %s/nr.csv --sim %s/ns.csv",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json",
              FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"verdict\": \"no significant mismatch\"") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"discovered\": []") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\"") != NULL, "%s", out);
@@ -75,16 +61,16 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     /* Batch means on request, and when no lagged products are kept. */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --noise batch",
              FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"batch\"") != NULL, "%s", out);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --lags 0",
              FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"batch\"") != NULL, "%s", out);
     /* Two lags: an autoregression of order at most 1. */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/nr.csv --sim %s/ns.csv %s --json --lags 2",
              FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 1") != NULL
                   || strstr(out, "\"noise\": {\"model\": \"ar\", \"order\": 0") != NULL, "%s", out);
     fe_test_remove_dir(dir);
@@ -109,7 +95,7 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     make_dir();
     snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --order 2 --seed 3 --rows 6000 "
              "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     p = strstr(out, "coefficient ");
     ck_assert_ptr_nonnull(p);
     truth = strtod(p + 12, NULL);
@@ -117,7 +103,7 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
              "--role velocity=velocity --role input=input --order 2 --holdout 0.3 --json",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"order\": 2, \"simulation_dynamics\": {") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"viscous_friction\"") != NULL, "%s",
                   out);
@@ -129,11 +115,11 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
 
     snprintf(cmd, sizeof cmd, "%s synth --effect newton_cooling --order 1 --seed 2 --rows 8000 "
              "--real %s/tr.csv --sim %s/ts.csv", FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/tr.csv --sim %s/ts.csv --channel temperature "
              "--role ambient=ambient --role power=input --order 1 --holdout 0.3",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "1. newton_cooling") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "dT/dt gains -h (T - T_ambient)") != NULL, "%s", out);
 
@@ -158,18 +144,18 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     fclose(fs);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/wr.csv --sim %s/ws.csv --channel position "
              "--role velocity=velocity --role input=input --holdout 0.3", FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "verdict: mismatch not explained by the catalog") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "trajectories diverge") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "--order 2") != NULL, "%s", out);
 
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel position "
              "--order 3", FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "--order: 3 is not 0, 1 or 2") != NULL, "%s", out);
     snprintf(cmd, sizeof cmd, "%s synth --effect gain --order 2 --real %s/x.csv --sim %s/y.csv",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "describe the measurement") != NULL, "%s", out);
     fe_test_remove_dir(dir);
 }
@@ -189,32 +175,32 @@ START_TEST(inputs_from_a_pipe_and_compressed)
     ck_assert_int_eq(mkdir(tmp, 0700), 0);
     snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 3 --rows 20000 --real %s/r.csv --sim %s/s.csv",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s", FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, want, sizeof want), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, want, sizeof want), 0);
     ck_assert_msg(strstr(want, "\"bad_rows\": {\"total\": 0,") != NULL, "%s", want);
     /* The recording from a pipe. */
     snprintf(cmd, sizeof cmd, "cat %s/r.csv | TMPDIR=%s %s discover --real - --sim %s/s.csv %s",
              dir, tmp, FE_TEST_CLI, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_str_eq(out, want);
     /* The simulation from standard input, compressed. */
     snprintf(cmd, sizeof cmd, "gzip -c %s/s.csv | TMPDIR=%s %s discover --real %s/r.csv --sim - %s",
              dir, tmp, FE_TEST_CLI, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_str_eq(out, want);
     /* A compressed file. */
     snprintf(cmd, sizeof cmd, "gzip -c %s/r.csv > %s/r.csv.gz && %s discover --real %s/r.csv.gz --sim %s/s.csv %s",
              dir, dir, FE_TEST_CLI, dir, dir, roles);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_str_eq(out, want);
     /* Nothing left in TMPDIR. */
     snprintf(cmd, sizeof cmd, "ls -A %s", tmp);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(out[0] == '\0', "left in TMPDIR: %s", out);
     /* Standard input once only. */
     snprintf(cmd, sizeof cmd, "%s discover --real - --sim - %s < %s/r.csv", FE_TEST_CLI, roles, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 2);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 2);
     ck_assert_msg(strstr(out, "standard input can be read only once") != NULL, "%s", out);
     fe_test_remove_dir(dir);
 }
@@ -278,14 +264,14 @@ START_TEST(bursty_clocks_keep_every_covered_row)
     /* The simulation's own times: every row compared. */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/own.csv --channel az --json",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(json_count(out, "\"compared\": ") == rows, "%s", out);
     ck_assert_msg(strstr(out, "\"outside_simulation\": 0,") != NULL, "%s", out);
     ck_assert_msg(strstr(out, "same unit of time") == NULL, "%s", out);
     /* A regular grid over the recording's span: every row compared. */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/grid.csv --channel az --json",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(json_count(out, "\"compared\": ") == rows, "%s", out);
     /* Late start, a 2 s hole, early end: counted by reason, counted here
        independently from the times. */
@@ -300,7 +286,7 @@ START_TEST(bursty_clocks_keep_every_covered_row)
     }
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/holes.csv --channel az --json",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(json_count(out, "\"before_start\": ") == before, "want %ld: %s", before, out);
     ck_assert_msg(json_count(out, "\"after_end\": ") == after, "want %ld: %s", after, out);
     ck_assert_msg(json_count(out, "\"in_gap\": ") == gap, "want %ld: %s", gap, out);
@@ -309,12 +295,12 @@ START_TEST(bursty_clocks_keep_every_covered_row)
     /* The story says it in words. */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/holes.csv --channel az",
              FE_TEST_CLI, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "before it starts") != NULL && strstr(out, "in its gaps") != NULL, "%s", out);
     /* Milliseconds against seconds: a warning (and nothing compared). */
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/ms.csv --channel az --json",
              FE_TEST_CLI, dir, dir);
-    run(cmd, out, sizeof out);
+    fe_test_run(cmd, 1, out, sizeof out);
     ck_assert_msg(strstr(out, "same unit of time") != NULL, "%s", out);
     fe_test_remove_dir(dir);
 }
@@ -368,7 +354,7 @@ START_TEST(bad_inputs)
     fe_test_write_file(dir, "sim.csv", c->sim);
     snprintf(cmd, sizeof cmd, "%s discover --real %s/real.csv --sim %s/sim.csv %s", FE_TEST_CLI,
              dir, dir, c->args);
-    status = run(cmd, out, sizeof out);
+    status = fe_test_run(cmd, 1, out, sizeof out);
     if (strcmp(c->what, "unknown base term") == 0) {
         /* Too few rows is found before the base terms are read: build a
            table long enough to reach them. */
@@ -386,7 +372,7 @@ START_TEST(bad_inputs)
         for (int i = 0; i < 200; i++)
             fprintf(f, "%d,0\n", i);
         fclose(f);
-        status = run(cmd, out, sizeof out);
+        status = fe_test_run(cmd, 1, out, sizeof out);
         ck_assert_msg(status == 2 && strstr(out, "--base: no term 'drag'") != NULL, "%s", out);
     } else {
         ck_assert_msg(status == c->status, "%s: status %d, want %d:\n%s", c->what, status,
@@ -430,7 +416,7 @@ static void named_pair(int rows, const char *channel, double *t0, double *t1)
     FILE *f;
     snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 5 --rows %d "
              "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, rows, dir, dir);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     snprintf(header, sizeof header, "t [s],%s", channel);
     rename_columns("r.csv", header);
     snprintf(header, sizeof header, "t [s],%s,position,v (m/s),input", channel);
@@ -455,13 +441,13 @@ static void report_of_named_pair(const char *channel)
              "--time 't [s]' --role position=position --role 'v (m/s)=velocity' --role input=input "
              "--base bias,gain --holdout 0.25 --blocks 10 --report %s/rep", FE_TEST_CLI, dir, dir,
              channel, dir);
-    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s\n%s", cmd, out);
+    ck_assert_msg(fe_test_run(cmd, 1, out, sizeof out) == 0, "%s\n%s", cmd, out);
 }
 
 static int have_gnuplot(void)
 {
     char out[256];
-    if (run("gnuplot --version", out, sizeof out) == 0)
+    if (fe_test_run("gnuplot --version", 1, out, sizeof out) == 0)
         return 1;
     fprintf(stderr, "SKIP report plots: gnuplot is not installed (the deps step installs gnuplot-nox)\n");
     return 0;
@@ -561,7 +547,7 @@ START_TEST(report_data_and_plots_a_physicist_keeps)
         unsigned char magic[8];
         snprintf(cmd, sizeof cmd, "cd %s/rep && rm residual_time.png residual_state.png && "
                  "gnuplot plots.gp", dir);
-        ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s:\n%s", cmd, out);
+        ck_assert_msg(fe_test_run(cmd, 1, out, sizeof out) == 0, "%s:\n%s", cmd, out);
         ck_assert_msg(out[0] == '\0', "gnuplot warned:\n%s", out);
         for (int k = 0; k < 2; k++) {
             snprintf(path, sizeof path, "%s/rep/%s", dir, k ? "residual_state.png" : "residual_time.png");
@@ -616,7 +602,7 @@ START_TEST(report_lays_recordings_end_to_end)
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --real %s/r.csv "
              "--sim %s/s.csv --channel a --time 't [s]' --role 'v (m/s)=velocity' --base bias "
              "--holdout 0 --blocks 8 --report %s/rep", FE_TEST_CLI, dir, dir, dir, dir, dir);
-    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(fe_test_run(cmd, 1, out, sizeof out) == 0, "%s", out);
     snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
     f = fopen(path, "r");
     ck_assert_ptr_nonnull(f);
@@ -684,7 +670,7 @@ START_TEST(report_keeps_an_epoch_clock)
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel a --time 't [s]' "
              "--role 'v (m/s)=velocity' --base bias --holdout 0.2 --blocks 4 --report %s/rep",
              FE_TEST_CLI, dir, dir, dir);
-    ck_assert_msg(run(cmd, out, sizeof out) == 0, "%s", out);
+    ck_assert_msg(fe_test_run(cmd, 1, out, sizeof out) == 0, "%s", out);
     snprintf(path, sizeof path, "%s/rep/blocks.dat", dir);
     f = fopen(path, "r");
     ck_assert_ptr_nonnull(f);
@@ -727,7 +713,7 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
                  "--sim %s/fall_%d_sim.csv --channel Absolute --time Time "
                  "--role velocity=velocity --base bias --holdout 0 --json",
                  FE_TEST_CLI, data, k, dir, k);
-        ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
         q = strstr(out, "\"discovered\": [{\"name\": \"quadratic_drag\"");
         if (q == NULL)
             continue;
@@ -759,7 +745,7 @@ START_TEST(magnetometers_show_axis_gain_and_cross_axis)
     for (int i = 0; i < 2; i++) {
         const char *b, *f;
         snprintf(cmd, sizeof cmd, "%s discover --sphere %s/%s --json", FE_TEST_CLI, data, files[i]);
-        ck_assert_int_eq(run(cmd, out, sizeof out), 0);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
         ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
         ck_assert_msg(strstr(out, "\"name\": \"axis_gain\"") != NULL, "%s", out);
         ck_assert_msg(strstr(out, "\"name\": \"cross_axis\"") != NULL, "%s", out);
@@ -772,7 +758,7 @@ START_TEST(magnetometers_show_axis_gain_and_cross_axis)
     }
     snprintf(cmd, sizeof cmd, "%s discover --sphere %s/ximu3_fusion/sensor_data.csv "
              "--columns 'Magnetometer X','Magnetometer Y','Magnetometer Z'", FE_TEST_CLI, data);
-    ck_assert_int_eq(run(cmd, out, sizeof out), 1);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 1);
     ck_assert_msg(strstr(out, "one side of the sphere") != NULL, "%s", out);
 }
 END_TEST

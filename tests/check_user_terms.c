@@ -11,6 +11,7 @@
 
 #include "foldest.h"
 #include "testutil.h"
+#include "cli_run.h"
 
 #ifndef FE_TEST_CLI
 #define FE_TEST_CLI "build/bin/foldest"
@@ -20,22 +21,6 @@ enum { ROWS = 3000, GATE_ROW = 1500 };
 static const double cog_amp = 0.03, cog_period = 0.01;
 static double ols_cog;          /* this draw's cogging by least squares (fe_lsq) */
 
-/* Run a shell command; its standard output (and standard error too when
-   `both`) into out[len]; the exit status. */
-static int run(const char *cmd, int both, char *out, size_t len)
-{
-    char full[8192];
-    FILE *p;
-    size_t got;
-    int status;
-    snprintf(full, sizeof full, "%s %s", cmd, both ? "2>&1" : "2>/dev/null");
-    p = popen(full, "r");
-    ck_assert_ptr_nonnull(p);
-    got = fread(out, 1, len - 1, p);
-    out[got] = '\0';
-    status = pclose(p);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 static char dir[64];
 static char base_args[1024];
@@ -143,10 +128,10 @@ START_TEST(errors_name_their_column)
     if (bad[_i].file != NULL)
         fe_test_write_file(dir, "terms.txt", bad[_i].file);
     snprintf(cmd, sizeof cmd, "%s %s", base_args, args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), bad[_i].status);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), bad[_i].status);
     ck_assert_msg(strstr(out, bad[_i].says) != NULL, "%s\nwant: %s\ngot: %s", args,
                   bad[_i].says, out);
-    ck_assert_int_eq(run(cmd, 0, out, sizeof out), bad[_i].status);
+    ck_assert_int_eq(fe_test_run(cmd, 0, out, sizeof out), bad[_i].status);
     ck_assert_str_eq(out, "");
     fe_test_remove_dir(dir);
 }
@@ -161,18 +146,18 @@ START_TEST(a_term_not_finite_is_refused_at_its_row)
     char cmd[4096], want[256];
     write_pair();
     snprintf(cmd, sizeof cmd, "%s --term 'inv=1/gate'", base_args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 3);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 3);
     snprintf(want, sizeof want, "%s/real.csv:%d: term 'inv' is infinite at t = 15", dir,
              GATE_ROW + 2);
     ck_assert_msg(strstr(out, want) != NULL, "want %s, got %s", want, out);
     snprintf(cmd, sizeof cmd, "%s --term 'inv=1/gate' --json", base_args);
-    ck_assert_int_eq(run(cmd, 0, out, sizeof out), 3);
+    ck_assert_int_eq(fe_test_run(cmd, 0, out, sizeof out), 3);
     ck_assert_str_eq(out, "");
     snprintf(cmd, sizeof cmd, "%s --term 'nan=sqrt(gate - 1)' --json", base_args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 3);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 3);
     ck_assert_msg(strstr(out, ":2: term 'nan' is NaN") == NULL, "%s", out);   /* 0: fine */
     snprintf(cmd, sizeof cmd, "%s --term 'nan=sqrt(gate - 1.5)' --json", base_args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 3);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 3);
     ck_assert_msg(strstr(out, "real.csv:2: term 'nan' is NaN at t = 0") != NULL, "%s", out);
     fe_test_remove_dir(dir);
 }
@@ -198,7 +183,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
                "heat = \"P_heater [W]\"^2 : heating: in the power's square\n"
                "r = ref * 2\n");
     snprintf(cmd, sizeof cmd, "%s --terms %s/terms.txt --json", base_args, dir);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
     d = strstr(out, "\"discovered\": [{\"name\": \"cogging\", \"description\": "
                     "\"periodic force of the motor poles\", \"expression\": "
@@ -220,7 +205,7 @@ START_TEST(hidden_cogging_is_named_with_its_description)
     ck_assert_msg(strstr(out, "{\"name\": \"heat\", \"description\"") == NULL, "%s", out);
     /* The story and the report. */
     snprintf(cmd, sizeof cmd, "%s --terms %s/terms.txt --report %s/rep", base_args, dir, dir);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "1. cogging (periodic force of the motor poles): coefficient")
                   != NULL, "%s", out);
     ck_assert_msg(strstr(out, "per unit of sin(2*pi*position/0.01)") != NULL, "%s", out);
@@ -249,7 +234,7 @@ START_TEST(only_and_exclude_choose_among_all_terms)
     write_pair();
     snprintf(cmd, sizeof cmd, "%s --term 'cogging=sin(2*pi*position/0.01)' "
              "--term 'decoy=cos(position)' --only cogging,viscous_friction --json", base_args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg((rank = strstr(out, "\"ranking\": [")) != NULL, "%s", out);
     ck_assert_msg(strstr(rank, "\"cogging\"") != NULL && strstr(rank, "\"viscous_friction\"")
                   != NULL, "%s", rank);
@@ -259,7 +244,7 @@ START_TEST(only_and_exclude_choose_among_all_terms)
     ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"cogging\"") != NULL, "%s", out);
     snprintf(cmd, sizeof cmd, "%s --term 'cogging=sin(2*pi*position/0.01)' "
              "--term 'decoy=cos(position)' --exclude cogging,gain --json", base_args);
-    ck_assert_int_eq(run(cmd, 1, out, sizeof out), 0);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
     ck_assert_msg(strstr(out, "\"cogging\"") == NULL, "%s", out);
     ck_assert_msg(strstr(out, "\"base\": [\"bias\", \"gain\"]") != NULL, "%s", out);
     ck_assert_msg(strstr(strstr(out, "\"ranking\""), "\"decoy\"") != NULL, "%s", out);

@@ -138,4 +138,94 @@ static double steps_eval(const steps *s, double t)
     return v;
 }
 
+/* The least squares of the generators' identifiability checks need
+   scratch vectors: each generator defines vec() (calloc, or exit 4 with
+   its own name). */
+static double *vec(long n);
+
+enum { ACCEPT_LSQ_MAXCOL = 20 };    /* columns of one regression, at most */
+
+/* Least squares of y on k columns (n rows) by modified Gram-Schmidt (twice)
+   on columns scaled to unit norm.  Writes coef and se (from the residual
+   variance rss/(n-k)); returns the residual sum of squares, -1 when a
+   column is numerically dependent on the others. */
+static double lsq(double *const *cols, int k, const double *y, long n, double *coef, double *se)
+{
+    static double *q[ACCEPT_LSQ_MAXCOL], *res;
+    static long qn;
+    double r[ACCEPT_LSQ_MAXCOL][ACCEPT_LSQ_MAXCOL] = {{0}};
+    double rinv[ACCEPT_LSQ_MAXCOL][ACCEPT_LSQ_MAXCOL] = {{0}};
+    double scale[ACCEPT_LSQ_MAXCOL], qty[ACCEPT_LSQ_MAXCOL];
+    double rss = 0;
+    if (qn < n) {
+        for (int j = 0; j < ACCEPT_LSQ_MAXCOL; j++) {
+            free(q[j]);
+            q[j] = vec(n);
+        }
+        free(res);
+        res = vec(n);
+        qn = n;
+    }
+    for (int j = 0; j < k; j++) {
+        double nn = 0;
+        for (long i = 0; i < n; i++)
+            nn += cols[j][i] * cols[j][i];
+        if (!(nn > 0) || !isfinite(nn))
+            return -1;
+        scale[j] = 1.0 / sqrt(nn);
+        for (long i = 0; i < n; i++)
+            q[j][i] = cols[j][i] * scale[j];
+    }
+    for (int j = 0; j < k; j++) {
+        double nn = 0;
+        for (int pass = 0; pass < 2; pass++)
+            for (int l = 0; l < j; l++) {
+                double d = 0;
+                for (long i = 0; i < n; i++)
+                    d += q[l][i] * q[j][i];
+                r[l][j] += d;
+                for (long i = 0; i < n; i++)
+                    q[j][i] -= d * q[l][i];
+            }
+        for (long i = 0; i < n; i++)
+            nn += q[j][i] * q[j][i];
+        nn = sqrt(nn);
+        if (nn < 1e-10)
+            return -1;
+        r[j][j] = nn;
+        for (long i = 0; i < n; i++)
+            q[j][i] /= nn;
+    }
+    memcpy(res, y, (size_t)n * sizeof *res);
+    for (int j = 0; j < k; j++) {
+        double d = 0;
+        for (long i = 0; i < n; i++)
+            d += q[j][i] * res[i];
+        qty[j] = d;
+        for (long i = 0; i < n; i++)
+            res[i] -= d * q[j][i];
+    }
+    for (long i = 0; i < n; i++)
+        rss += res[i] * res[i];
+    for (int j = k - 1; j >= 0; j--) {
+        rinv[j][j] = 1.0 / r[j][j];
+        for (int c = j + 1; c < k; c++) {
+            double s = 0;
+            for (int l = j + 1; l <= c; l++)
+                s += r[j][l] * rinv[l][c];
+            rinv[j][c] = -s / r[j][j];
+        }
+    }
+    for (int j = 0; j < k; j++) {
+        double c = 0, v = 0;
+        for (int l = j; l < k; l++) {
+            c += rinv[j][l] * qty[l];
+            v += rinv[j][l] * rinv[j][l];
+        }
+        coef[j] = c * scale[j];
+        se[j] = sqrt(v * rss / (double)(n - k)) * scale[j];
+    }
+    return rss;
+}
+
 #endif /* FOLDEST_ACCEPT_COMMON_H */

@@ -29,6 +29,8 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+from pairs import generate
+
 FOLDEST = os.environ.get("FOLDEST", "build/bin/foldest")
 GEN = os.environ.get("GEN", "build/accept/gen")
 GEN_DYN = os.environ.get("GEN_DYN", "build/accept/gen_dyn")
@@ -98,13 +100,7 @@ def score(truth, js, rc):
 
 def one_case(case, seed):
     d = os.path.join(OUT, "%s.%d" % (case, seed))
-    g = subprocess.run([GEN, "--case", case, "--seed", str(seed), "--out", d],
-                       capture_output=True, text=True)
-    if g.returncode != 0:
-        raise RuntimeError("gen %s %d: %s" % (case, seed, g.stderr))
-    args = shlex.split(g.stdout.strip())
-    with open(os.path.join(d, "truth.json")) as f:
-        truth = json.load(f)
+    args, truth, _ = generate(GEN, case, seed, d)
     res = {}
     for mode, extra in MODES:
         rc, js, sec = discover(args + extra)
@@ -322,15 +318,7 @@ def drop_order(args):
 
 def one_dyn_case(case, seed, modes):
     d = os.path.join(OUT, "dyn.%s.%d" % (case, seed))
-    t0 = time.time()
-    g = subprocess.run([GEN_DYN, "--case", case, "--seed", str(seed), "--out", d],
-                       capture_output=True, text=True)
-    gen_sec = time.time() - t0
-    if g.returncode != 0:
-        raise RuntimeError("gen_dyn %s %d: %s" % (case, seed, g.stderr))
-    args = shlex.split(g.stdout.strip())
-    with open(os.path.join(d, "truth.json")) as f:
-        truth = json.load(f)
+    args, truth, gen_sec = generate(GEN_DYN, case, seed, d)
     res = {}
     for mode, how in modes:
         a = drop_order(args) if how == "drop" else args

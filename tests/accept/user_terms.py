@@ -11,23 +11,18 @@ own, so that it stays apart from the generated cases' metrics);
 library only."""
 import json
 import os
-import shlex
 import shutil
 import subprocess
 import sys
+
+from pairs import generate
 
 CASE = "outside_cogging"
 
 
 def _one(foldest, gen, out, seed, keep, extra):
     d = os.path.join(out, "user_terms.%d" % seed)
-    g = subprocess.run([gen, "--case", CASE, "--seed", str(seed), "--out", d],
-                       capture_output=True, text=True)
-    if g.returncode != 0:
-        raise RuntimeError("gen %s %d: %s" % (CASE, seed, g.stderr))
-    args = shlex.split(g.stdout.strip())
-    with open(os.path.join(d, "truth.json")) as f:
-        truth = json.load(f)
+    args, truth, _ = generate(gen, CASE, seed, d)
     term = truth["outside_term"]
     res = {"seed": seed, "rows": truth["rows"], "noise": truth["noise"], "clock": truth["clock"]}
     for label, more in (("with", ["--term", "cogging=%s:periodic force of the motor poles"
