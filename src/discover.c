@@ -2195,9 +2195,11 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
         }
 }
 
-/* The long-range part of a variance factor: sum_t lambda_t V_t for the
-   shares lam (clamped to add up to at most 1; their sum in *share), with
-   the variance of its log in *lnvar. */
+/* The long-range part of a variance factor: sum_t lambda_t max(1, V_t)
+   for the shares lam (clamped to add up to at most 1; their sum in
+   *share), with the variance of its log in *lnvar.  A level the AR model
+   overpredicts is left at the model's own variance: the long range only
+   ever widens. */
 static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, double *share,
                              double *lnvar)
 {
@@ -2211,8 +2213,8 @@ static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, doubl
         total += lam_in[t];
     for (size_t t = 0; t <= J; t++) {
         lam[t] = total > 1.0 ? lam_in[t] / total : lam_in[t];
-        g[t] = lam[t] * exp(sf->lnv[t]);
-        F += g[t];
+        F += lam[t] * (sf->lnv[t] > 0.0 ? exp(sf->lnv[t]) : 1.0);
+        g[t] = sf->lnv[t] > 0.0 ? lam[t] * exp(sf->lnv[t]) : 0.0;  /* d F / d ln V_t */
     }
     *share = total > 1.0 ? 1.0 : total;
     if (!(F > 0.0))
