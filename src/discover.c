@@ -127,6 +127,51 @@ static void fe__discover_lags_panel(fe_discover_acc *a, const double *const *col
     a->nhist = a->nhist + q < P ? a->nhist + q : P;
 }
 
+/* The fine blocks: B = 2^J, the most (up to FE_DISCOVER_FINE_BLOCKS) of
+   at least FE_DISCOVER_FINE_ROWS fitted rows each; one for short records. */
+static size_t fe__discover_fine_count(uint64_t fit_rows)
+{
+    size_t b = 1;
+    while (2 * b <= FE_DISCOVER_FINE_BLOCKS
+           && (uint64_t)(2 * b) * FE_DISCOVER_FINE_ROWS <= fit_rows)
+        b *= 2;
+    return b;
+}
+
+/* The fine block of a fitted global row, and the first row of fine block
+   k (k = B: fit_rows). */
+static size_t fe__discover_fine(const fe_discover_acc *a, uint64_t row)
+{
+    return (size_t)(row * a->fine / a->fit_rows);
+}
+
+static uint64_t fe__discover_fine_cut(const fe_discover_acc *a, size_t k)
+{
+    return ((uint64_t)k * a->fit_rows + a->fine - 1) / a->fine;
+}
+
+/* Add q fitted rows, from global row `row` on, given by columns (value c
+   of row t at col[c][t * ts]), to their fine blocks' sums. */
+static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
+                                   size_t ts, size_t q, uint64_t row)
+{
+    size_t dim = a->m + 1, t = 0;
+    while (t < q) {
+        size_t k = fe__discover_fine(a, row + t), stop = q;
+        uint64_t end = fe__discover_fine_cut(a, k + 1);
+        if (end - (row + t) < (uint64_t)(q - t))
+            stop = t + (size_t)(end - (row + t));
+        for (size_t c = 0; c < dim; c++) {
+            double s = 0.0;
+            for (size_t i = t; i < stop; i++)
+                s += col[c][i * ts];
+            a->fsum[k * dim + c] += s;
+        }
+        a->fcount[k] += (double)(stop - t);
+        t = stop;
+    }
+}
+
 /* Fold q rows of block k given by columns (value c of row t at
    col[c][t * ts]): the block's sums, and the lagged products. */
 static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
@@ -140,6 +185,8 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
             s += col[c][t * ts];
         a->bsum[k * (a->m + 1) + c] += s;
     }
+    if (fitted)
+        fe__discover_fine_rows(a, col, ts, q, a->row0 + a->n);
     if (a->lags == 0 || !fitted)
         return;
     if (q >= 8) {
@@ -173,6 +220,10 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
     size_t dim = a->m + 1, P = a->lags;
     for (size_t i = 0; i < a->blocks * dim; i++)
         a->bsum[i] += b->bsum[i];
+    for (size_t i = 0; i < a->fine * dim; i++)
+        a->fsum[i] += b->fsum[i];
+    for (size_t i = 0; i < a->fine; i++)
+        a->fcount[i] += b->fcount[i];
     if (P == 0)
         return;
     for (size_t i = 0; i < P * dim * dim; i++)
@@ -290,7 +341,9 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->edge_start = a->bsum + a->blocks * dim;
     a->edge_end = a->edge_start + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
     a->shead = a->edge_end + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
-    a->work = a->shead + FE_DISCOVER_EDGE * dim;
+    a->fsum = a->shead + FE_DISCOVER_EDGE * dim;
+    a->fcount = a->fsum + FE_DISCOVER_FINE_BLOCKS * dim;
+    a->work = a->fcount + FE_DISCOVER_FINE_BLOCKS;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -331,7 +384,19 @@ int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
     a->head_open = 1;
     a->nshead = 0;
     a->shead_pending = 0;
+    a->fine = fe__discover_fine_count(fit_rows);
     fe__discover_layout(a, storage);
+    return FE_OK;
+}
+
+int fe_discover_set_fine(fe_discover_acc *a, size_t blocks)
+{
+    if (a == NULL || a->n > 0 || blocks == 0 || (blocks & (blocks - 1)) != 0)
+        return FE_EINVAL;
+    if (blocks > FE_DISCOVER_FINE_BLOCKS
+        || (blocks > 1 && (uint64_t)blocks * FE_DISCOVER_FINE_ROWS > a->fit_rows))
+        return FE_ESIZE;
+    a->fine = blocks;
     return FE_OK;
 }
 
@@ -457,6 +522,12 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     fe__discover_lags_row(a, z, k < a->blocks);
     for (size_t i = 0; i < dim && k < a->blocks; i++)
         a->bsum[k * dim + i] += z[i];
+    if (k < a->blocks) {
+        const double *zc[FE_DISCOVER_MAX_COLUMNS + 1];
+        for (size_t i = 0; i < dim; i++)
+            zc[i] = z + i;
+        fe__discover_fine_rows(a, zc, 0, 1, a->row0 + a->n);
+    }
     if (a->n == 0)
         memcpy(a->first, z, dim * sizeof *z);
     memcpy(a->last, z, dim * sizeof *z);
@@ -489,7 +560,7 @@ int fe_discover_merge(fe_discover_acc *a, const fe_discover_acc *b)
     if (a == NULL || b == NULL)
         return FE_EINVAL;
     if (a->m != b->m || a->blocks != b->blocks || a->fit_rows != b->fit_rows
-        || a->base_cols != b->base_cols || a->lags != b->lags)
+        || a->base_cols != b->base_cols || a->lags != b->lags || a->fine != b->fine)
         return FE_EMISMATCH;
     if (b->n == 0) {            /* the identity, carrying b's break if any */
         if (!b->first_linked)
@@ -1840,21 +1911,340 @@ static void fe__block_ratio(const fe_discover_acc *a, const double *u, fe_discov
     nz->long_range = nz->block_p < 0.05 && nz->block_ratio > 1.0;
 }
 
+/* psi(x) and psi'(x) for x > 0: the recurrence up to 6, then the
+   asymptotic series (errors below 1e-12 there). */
+static double fe__digamma(double x)
+{
+    double r = 0.0, f;
+    for (; x < 6.0; x += 1.0)
+        r -= 1.0 / x;
+    f = 1.0 / (x * x);
+    return r + log(x) - 0.5 / x - f * (1.0 / 12.0 - f * (1.0 / 120.0 - f / 252.0));
+}
+
+static double fe__trigamma(double x)
+{
+    double r = 0.0, f;
+    for (; x < 6.0; x += 1.0)
+        r += 1.0 / (x * x);
+    f = 1.0 / (x * x);
+    return r + 1.0 / x + 0.5 * f + f / x * (1.0 / 6.0 - f * (1.0 / 30.0 - f / 42.0));
+}
+
+/* The Haar energies of x[0 .. B-1], B = 2^J, overwriting x: e[j-1] for
+   j = 1 .. J the sum of squares of level j's B / 2^j detail coefficients
+   (each the difference of two sums of 2^(j-1) entries, over
+   sqrt(2^j)), e[J] the square of the scaling coefficient sum x / sqrt(B).
+   The transform is orthonormal: the energies add up to sum x^2. */
+static size_t fe__haar(double *x, size_t B, double *e)
+{
+    size_t J = 0;
+    for (size_t len = B; len > 1; len /= 2) {
+        double s = 0.0;
+        for (size_t i = 0; i < len / 2; i++) {
+            double d = (x[2 * i] - x[2 * i + 1]) * 0.70710678118654752440;
+            x[i] = (x[2 * i] + x[2 * i + 1]) * 0.70710678118654752440;
+            s += d * d;
+        }
+        e[J++] = s;
+    }
+    e[J] = x[0] * x[0];
+    return J;
+}
+
+/* The fine-block sums of the series u^T z_t, over sqrt(L), L = n / B. */
+static void fe__fine_series(const fe_discover_acc *a, const double *u, double *y)
+{
+    size_t dim = a->m + 1;
+    double root = sqrt(fe__fitted_rows(a) / (double)a->fine);
+    for (size_t k = 0; k < a->fine; k++) {
+        double s = 0.0;
+        for (size_t c = 0; c < dim; c++)
+            if (u[c] != 0.0)
+                s += u[c] * a->fsum[k * dim + c];
+        y[k] = s / root;
+    }
+}
+
+enum { FE__SCALE_TERMS = 1 << 22 };     /* most lags an AR sum follows */
+
+/* The AR model's autocovariances per unit innovation variance at lags
+   0 .. p, g_h = sum_i psi_i psi_{i+h}, from its impulse response psi. */
+static void fe__ar_acov(const fe_discover_noise *nz, double *g)
+{
+    size_t p = nz->order;
+    double psi[FE_DISCOVER_LAGS + 1] = {0};   /* psi_{t-i} at (t - i) mod (p + 1) */
+    for (size_t h = 0; h <= p; h++)
+        g[h] = 0.0;
+    for (size_t t = 0; t < FE__SCALE_TERMS; t++) {
+        double v = t == 0 ? 1.0 : 0.0, big = 0.0;
+        for (size_t i = 1; i <= p && i <= t; i++)
+            v += nz->phi[i - 1] * psi[(t - i) % (p + 1)];
+        psi[t % (p + 1)] = v;
+        for (size_t h = 0; h <= p && h <= t; h++)
+            g[h] += v * psi[(t - h) % (p + 1)];
+        for (size_t i = 0; i <= p; i++)
+            big = fmax(big, fabs(psi[i]));
+        if (t > p && big < 1e-12)
+            break;
+    }
+}
+
+/* v(m) = m g_0 + 2 sum_{h<m} (m - h) g_h, the variance of a sum of m
+   consecutive rows of the AR model nz per unit innovation variance, for
+   the `count` lengths m[] in increasing order, into v[]: a walk over the
+   lags with c0 = sum g_h and c1 = sum h g_h so far, v(m) = m (g_0 + 2 c0)
+   - 2 c1 at h = m; once g is negligible the sums stop changing and the
+   rest are read at once. */
+static void fe__ar_sum_variances(const fe_discover_noise *nz, const uint64_t *m,
+                                 size_t count, double *v)
+{
+    size_t p = nz->order, next = 0;
+    double g[FE_DISCOVER_LAGS + 1], hist[FE_DISCOVER_LAGS + 1], c0 = 0.0, c1 = 0.0;
+    fe__ar_acov(nz, g);
+    for (size_t i = 0; i <= p; i++)
+        hist[i] = g[i];
+    for (uint64_t h = 1; next < count; h++) {
+        double gh = 0.0;
+        while (next < count && m[next] <= h) {
+            v[next] = (double)m[next] * (g[0] + 2.0 * c0) - 2.0 * c1;
+            next++;
+        }
+        if (next == count)
+            break;
+        if (h <= p)
+            gh = g[h];
+        else
+            for (size_t i = 1; i <= p; i++)
+                gh += nz->phi[i - 1] * hist[(h - i) % (p + 1)];
+        hist[h % (p + 1)] = gh;
+        c0 += gh;
+        c1 += (double)h * gh;
+        if ((h > p && fabs(gh) < 1e-14 * g[0]) || h >= FE__SCALE_TERMS)
+            for (; next < count; next++)
+                v[next] = (double)m[next] * (g[0] + 2.0 * c0) - 2.0 * c1;
+    }
+}
+
+/* nz->scale_model: the variance of a Haar coefficient of the fine block
+   sums that the AR model nz predicts, per unit innovation variance, at
+   each level j = 1 .. J of the B = 2^J blocks (two halves of m_j rows,
+   m_j = n 2^(j-1) / B rounded): (4 v(m_j) - v(2 m_j)) / (2 m_j); and of
+   the scaling coefficient, v(n) / n. */
+static void fe__scale_model(const fe_discover_acc *a, fe_discover_noise *nz)
+{
+    size_t J = 0;
+    double n = fe__fitted_rows(a), v[2 * FE_DISCOVER_SCALES + 1];
+    uint64_t m[2 * FE_DISCOVER_SCALES + 1];
+    for (size_t b = a->fine; b > 1; b /= 2)
+        J++;
+    nz->scales = J;
+    if (J == 0)
+        return;
+    /* m_1, 2 m_1, m_2, 2 m_2, ..., n: increasing, as m_j >= 2 m_{j-1} - 1
+       is not guaranteed by rounding, sorted below. */
+    for (size_t j = 1; j <= J; j++) {
+        m[2 * j - 2] = (uint64_t)(n * (double)((size_t)1 << (j - 1)) / (double)a->fine + 0.5);
+        if (m[2 * j - 2] < 1)
+            m[2 * j - 2] = 1;
+        m[2 * j - 1] = 2 * m[2 * j - 2];
+    }
+    m[2 * J] = (uint64_t)n;
+    {
+        uint64_t sorted[2 * FE_DISCOVER_SCALES + 1];
+        double vs[2 * FE_DISCOVER_SCALES + 1];
+        size_t count = 2 * J + 1;
+        memcpy(sorted, m, count * sizeof *m);
+        for (size_t i = 1; i < count; i++)         /* insertion sort */
+            for (size_t k = i; k > 0 && sorted[k - 1] > sorted[k]; k--) {
+                uint64_t t = sorted[k];
+                sorted[k] = sorted[k - 1];
+                sorted[k - 1] = t;
+            }
+        fe__ar_sum_variances(nz, sorted, count, vs);
+        for (size_t i = 0; i < count; i++)
+            for (size_t k = 0; k < count; k++)
+                if (sorted[k] == m[i])
+                    v[i] = vs[k];
+    }
+    for (size_t j = 1; j <= J; j++)
+        nz->scale_model[j - 1] = (4.0 * v[2 * j - 2] - v[2 * j - 1]) / (2.0 * (double)m[2 * j - 2]);
+    nz->scale_model[J] = v[2 * J] / (double)m[2 * J];
+}
+
+/* |alpha(e^{i w})|^2, the whitening filter's power at w radians a row. */
+static double fe__filter_power(const fe_discover_noise *nz, double w)
+{
+    double re = 1.0, im = 0.0;
+    for (size_t i = 1; i <= nz->order; i++) {
+        re -= nz->phi[i - 1] * cos((double)i * w);
+        im += nz->phi[i - 1] * sin((double)i * w);
+    }
+    return re * re + im * im;
+}
+
+/* The shares lambda_t, t = 1 .. J + 1, of a series' whitened energy
+   `energy` in the Haar levels of its fine-block sums (level J + 1: the
+   scaling coefficient), each level's raw energy scaled by the whitening
+   filter's power at its frequency, pi / m_t radians a row for levels of
+   m_t rows a side (the filter's gain at zero for the scaling
+   coefficient).  Returns their sum (not clamped). */
+static double fe__scale_shares(const fe_discover_acc *a, const fe_discover_noise *nz,
+                               const double *u, double energy, double *lam)
+{
+    double y[FE_DISCOVER_FINE_BLOCKS], e[FE_DISCOVER_SCALES + 1];
+    double n = fe__fitted_rows(a), total = 0.0;
+    size_t J = nz->scales;
+    fe__fine_series(a, u, y);
+    fe__haar(y, a->fine, e);
+    for (size_t t = 1; t <= J + 1; t++) {
+        double mt = n * (double)((size_t)1 << (t - 1)) / (double)a->fine;
+        double w = t <= J ? 3.14159265358979323846 / mt : 0.0;
+        lam[t - 1] = energy > 0.0 ? fe__filter_power(nz, w) * e[t - 1] / energy : 0.0;
+        total += lam[t - 1];
+    }
+    return total;
+}
+
+/* nz->scale_used: the Haar coefficients of each level that the model's
+   columns take up, sum_c lambda_t(q_c) over a basis q_c of the columns
+   orthonormal in the whitened metric, read off the model's factor:
+   with D G~ D = U^T U, the columns of X~ D U^{-1}. */
+static void fe__scale_used(const fe_discover_acc *a, const fe__model *mo,
+                           fe_discover_noise *nz)
+{
+    size_t dim = a->m + 1, s = mo->n;
+    double u[FE_DISCOVER_MAX_COLUMNS + 1], v[FE_DISCOVER_MAX_COLUMNS];
+    double lam[FE_DISCOVER_SCALES + 1];
+    memset(nz->scale_used, 0, sizeof nz->scale_used);
+    for (size_t c = 0; c < s && nz->scales > 0; c++) {
+        for (size_t i = c + 1; i-- > 0;) {      /* U v = e_c, back substitution */
+            double t = i == c ? 1.0 : 0.0;
+            for (size_t k = i + 1; k <= c; k++)
+                t -= mo->chol[i * s + k] * v[k];
+            v[i] = t / mo->chol[i * s + i];
+        }
+        memset(u, 0, dim * sizeof *u);
+        for (size_t i = 0; i <= c; i++)
+            u[mo->cols[i]] = mo->scale[i] * v[i];
+        fe__scale_shares(a, nz, u, 1.0, lam);
+        for (size_t t = 0; t <= nz->scales; t++)
+            nz->scale_used[t] += lam[t];
+    }
+}
+
+/* The fit of the residual's level ratios V_t, t = 1 .. J + 1, to its
+   fine-block sums.  Level i's B / 2^i Haar coefficients, less the d_i
+   that the model takes up (`used`), give
+   y_i = ln(E_i / (k_i var h_i)) less the chi-square bias of a log,
+   psi(k_i/2) - ln(k_i/2), with k_i = B / 2^i - d_i, and variance
+   psi'(k_i/2) (h_i the AR prediction nz->scale_model, var the innovation
+   variance).  ln V_t is the line through the levels, weighted by
+   1 / psi'(k_i/2), with slope >= 0 (their weighted mean otherwise).
+   coef[t][i] holds the linear map ln V_t = sum_i coef y_i, which carries
+   the variances of the y_i to any combination. */
+typedef struct fe__scalefit {
+    size_t levels;                                      /* J (0: none) */
+    double lnv[FE_DISCOVER_SCALES + 1];
+    double coef[FE_DISCOVER_SCALES + 1][FE_DISCOVER_SCALES];
+    double var[FE_DISCOVER_SCALES];
+} fe__scalefit;
+
+static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
+                          const double *u, double var, const double *used, fe__scalefit *sf)
+{
+    double y[FE_DISCOVER_FINE_BLOCKS], e[FE_DISCOVER_SCALES + 1];
+    double ly[FE_DISCOVER_SCALES], wt[FE_DISCOVER_SCALES];
+    double sw = 0.0, sx = 0.0, sxx = 0.0, sy = 0.0, sxy = 0.0, det;
+    size_t J = nz->scales, usable = 0;
+    int line;
+    memset(sf, 0, sizeof *sf);
+    if (J < 1 || !(var > 0.0))
+        return;
+    fe__fine_series(a, u, y);
+    fe__haar(y, a->fine, e);
+    for (size_t i = 1; i <= J; i++) {
+        double k = (double)(a->fine >> i) - used[i - 1];
+        double pred = var * nz->scale_model[i - 1], x = (double)i;
+        wt[i - 1] = 0.0;
+        ly[i - 1] = 0.0;
+        if (!(k >= 0.5) || !(e[i - 1] > 0.0) || !(pred > 0.0))
+            continue;
+        ly[i - 1] = log(e[i - 1] / (k * pred)) - (fe__digamma(k / 2.0) - log(k / 2.0));
+        sf->var[i - 1] = fe__trigamma(k / 2.0);
+        wt[i - 1] = 1.0 / sf->var[i - 1];
+        sw += wt[i - 1];
+        sx += wt[i - 1] * x;
+        sxx += wt[i - 1] * x * x;
+        sy += wt[i - 1] * ly[i - 1];
+        sxy += wt[i - 1] * x * ly[i - 1];
+        usable++;
+    }
+    if (usable == 0)
+        return;
+    sf->levels = J;
+    det = sw * sxx - sx * sx;
+    line = usable >= 2 && det > 1e-12 * sw * sxx && sw * sxy - sx * sy > 0.0;
+    for (size_t t = 1; t <= J + 1; t++)
+        for (size_t i = 1; i <= J; i++) {
+            double x = (double)i, x0 = (double)t, c;
+            c = line ? wt[i - 1] * ((sxx - x0 * sx) + (x0 * sw - sx) * x) / det
+                     : wt[i - 1] / sw;
+            sf->coef[t - 1][i - 1] = c;
+            sf->lnv[t - 1] += c * ly[i - 1];
+        }
+}
+
+/* The long-range part of a variance factor: sum_t lambda_t max(1, V_t)
+   for the shares lam (clamped to add up to at most 1; their sum in
+   *share), with the variance of its log in *lnvar.  A level the AR model
+   overpredicts is left at the model's own variance: the long range only
+   ever widens. */
+static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, double *share,
+                             double *lnvar)
+{
+    double lam[FE_DISCOVER_SCALES + 1], total = 0.0, F = 0.0, g[FE_DISCOVER_SCALES + 1];
+    size_t J = sf->levels;
+    *share = 0.0;
+    *lnvar = 0.0;
+    if (J == 0)
+        return 0.0;
+    for (size_t t = 0; t <= J; t++)
+        total += lam_in[t];
+    for (size_t t = 0; t <= J; t++) {
+        lam[t] = total > 1.0 ? lam_in[t] / total : lam_in[t];
+        F += lam[t] * (sf->lnv[t] > 0.0 ? exp(sf->lnv[t]) : 1.0);
+        g[t] = sf->lnv[t] > 0.0 ? lam[t] * exp(sf->lnv[t]) : 0.0;  /* d F / d ln V_t */
+    }
+    *share = total > 1.0 ? 1.0 : total;
+    if (!(F > 0.0))
+        return 0.0;
+    for (size_t i = 0; i < J; i++) {
+        double d = 0.0;
+        for (size_t t = 0; t <= J; t++)
+            d += g[t] / F * sf->coef[t][i];
+        *lnvar += d * d * sf->var[i];
+    }
+    return F;
+}
+
 /* The factor by which the variance of sum_t x~_t e~_t exceeds the white
    noise value sigma^2 sum x~^2, for the series x_t = u^T z_t whitened by
    nz, and the degrees of freedom of that variance (nu for white noise):
    the short-lag factor f_s (Bartlett over the whitened residual's first H
-   autocorrelations, when whiteness was rejected), and the long-range
-   part for the share lambda of x~'s energy in its block means,
-   f = f_s (1 - lambda) + R lambda, with Satterthwaite's degrees of
-   freedom for the two parts.  Uses w->q and w->acov. */
+   autocorrelations, when whiteness was rejected) for the share of x~'s
+   energy within the fine blocks, and the scale fit sf for the shares
+   lambda_j in the Haar levels of the fine blocks,
+   f = f_s (1 - sum lambda_j) + sum lambda_j V_j, with Satterthwaite's
+   degrees of freedom for the two parts (the second's from the variance of
+   its log, 2 / Var ln).  Uses w->q and w->acov. */
 static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
                                   const fe_discover_noise *nz, const double *u, double nu,
-                                  double ratio, int long_range, double *dof)
+                                  const fe__scalefit *sf, double *dof)
 {
-    double fs = 1.0, lambda, f, parts;
+    double fs = 1.0, share, lnvar, F, f, parts, lam[FE_DISCOVER_SCALES + 1];
     *dof = nu;
-    if (!nz->long_run && !long_range)
+    if (!nz->long_run && sf->levels == 0)
         return 1.0;
     fe__lagged_sums(a, w->g, u, w->q);
     fe__white_acov(w->q, a->lags, nz, w->acov);
@@ -1870,13 +2260,10 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
         if (fs < 1.0)
             fs = 1.0;
     }
-    if (!long_range)
-        return fs;
-    lambda = fe__block_energy(a, u, nz) / w->acov[0];
-    lambda = lambda < 0.0 ? 0.0 : lambda > 1.0 ? 1.0 : lambda;
-    f = fs * (1.0 - lambda) + ratio * lambda;
-    parts = fs * (1.0 - lambda) * fs * (1.0 - lambda) / nu
-            + ratio * lambda * ratio * lambda / ((double)a->blocks - 1.0);
+    fe__scale_shares(a, nz, u, w->acov[0], lam);
+    F = fe__scale_part(sf, lam, &share, &lnvar);
+    f = fs * (1.0 - share) + F;
+    parts = fs * (1.0 - share) * fs * (1.0 - share) / nu + F * F * lnvar / 2.0;
     if (parts > 0.0)
         *dof = f * f / parts;
     if (*dof > nu)
@@ -1957,6 +2344,14 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
     fe__ljung_box(nz, w->acov_e, n);
     nz->long_run = nz->portmanteau_p < 0.05;
     fe__block_ratio(a, w->uv, nz);
+    fe__scale_model(a, nz);
+    fe__scale_used(a, &mo, nz);
+    {
+        fe__scalefit sf;
+        fe__scale_fit(a, nz, w->uv, nz->innovation_variance, nz->scale_used, &sf);
+        for (size_t t = 0; t <= nz->scales; t++)
+            nz->scale_ratio[t] = sf.levels > 0 ? exp(sf.lnv[t]) : 1.0;
+    }
     return FE_OK;
 }
 
@@ -1972,13 +2367,16 @@ static double fe__gls_dof(const fe_discover_fit *fit, const fe_discover_noise *n
    when nz->long_run, into w->inv (ncols x ncols), and the standard
    errors into se (if not NULL). */
 static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
-                        size_t ncols, const fe_discover_fit *fit,
+                        size_t ncols, const double *coef, const fe_discover_fit *fit,
                         const fe_discover_noise *nz, double *se, double *dof)
 {
     size_t dim = a->m + 1;
     fe__model mo = {ncols, cols, w->css, {0}};
     double nu = fe__gls_dof(fit, nz), s2 = nz->innovation_variance * fit->n / nu;
     double f[FE_DISCOVER_MAX_COLUMNS];
+    fe__scalefit sf;
+    fe__residual_weights(dim, cols, ncols, coef, w->uv);
+    fe__scale_fit(a, nz, w->uv, nz->innovation_variance, nz->scale_used, &sf);
     /* The factor of gt_SS is in w->css (scales recomputed). */
     for (size_t i = 0; i < ncols; i++)
         mo.scale[i] = 1.0 / sqrt(w->gt[cols[i] * dim + cols[i]]);
@@ -1994,7 +2392,7 @@ static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t 
         memset(w->uv, 0, dim * sizeof *w->uv);
         for (size_t k = 0; k < ncols; k++)
             w->uv[cols[k]] = w->inv[k * ncols + i];
-        f[i] = fe__variance_factor(a, w, nz, w->uv, nu, nz->block_ratio, nz->long_range, &di);
+        f[i] = fe__variance_factor(a, w, nz, w->uv, nu, &sf, &di);
         if (dof != NULL && di < *dof)
             *dof = di;
     }
@@ -2023,7 +2421,7 @@ int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
         return rc;
     rc = fe__gls(a, &w, cols, ncols, max_order, coef, fit, noise);
     if (rc == FE_OK && ncols > 0)
-        fe__gls_cov(a, &w, cols, ncols, fit, noise, stderr_, NULL);
+        fe__gls_cov(a, &w, cols, ncols, coef, fit, noise, stderr_, NULL);
     return rc;
 }
 
@@ -2058,22 +2456,25 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
     w->uv[gr->first] = 1.0;
     for (size_t i = 0; i < s; i++)
         w->uv[mo->cols[i]] -= w->aj[i * d];
-    /* The block ratio of the residual with the candidate in the model:
-       a slow effect that is missing inflates the block means of the
+    /* The scale fit of the residual with the candidate in the model: a
+       slow effect that is missing inflates the coarse levels of the
        residual without it, and must not hide itself. */
     {
-        double ures[FE_DISCOVER_MAX_COLUMNS + 1], ratio = nz->block_ratio, bp;
-        int long_range = nz->long_range;
-        if (d == 1 && w->sjj[0] > 0.0 && (double)cur->n / (double)a->blocks >= 20.0) {
-            double gamma = w->cj[0] / w->sjj[0], K = (double)a->blocks;
-            fe__residual_weights(dim, mo->cols, s, beta, ures);
+        double ures[FE_DISCOVER_MAX_COLUMNS + 1];
+        double used[FE_DISCOVER_SCALES + 1], lam[FE_DISCOVER_SCALES + 1];
+        fe__scalefit sf;
+        memcpy(used, nz->scale_used, sizeof used);
+        fe__residual_weights(dim, mo->cols, s, beta, ures);
+        if (d == 1 && w->sjj[0] > 0.0) {
+            double gamma = w->cj[0] / w->sjj[0];
             for (size_t c = 0; c < dim; c++)
                 ures[c] -= gamma * w->uv[c];
-            ratio = fe__block_energy(a, ures, nz) / (K - 1.0) / (s2 * nu / cur->n);
-            bp = fe_chi2_upper((K - 1.0) * ratio, K - 1.0);
-            long_range = bp < 0.05 && ratio > 1.0;
+            fe__scale_shares(a, nz, w->uv, w->sjj[0], lam);
+            for (size_t t = 0; t <= nz->scales; t++)
+                used[t] += lam[t];
         }
-        f = fe__variance_factor(a, w, nz, w->uv, nu, ratio, long_range, &nu);
+        fe__scale_fit(a, nz, ures, s2 * nu / cur->n, used, &sf);
+        f = fe__variance_factor(a, w, nz, w->uv, nu, &sf, &nu);
     }
     if (d == 1) {
         out->statistic = (w->cj[0] >= 0.0 ? 1.0 : -1.0) * sqrt(out->rss_drop / (s2 * f));
@@ -2155,7 +2556,7 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     if (ar) {
         rc = fe__gls(a, w, cols, ncols, maxp, beta, fit, &nz);
         if (rc == FE_OK && st != NULL && ncols > 0)
-            fe__gls_cov(a, w, cols, ncols, fit, &nz, st->stderr_, &st->dof);
+            fe__gls_cov(a, w, cols, ncols, beta, fit, &nz, st->stderr_, &st->dof);
     } else {
         rc = fe__fit(a, w, cols, ncols, beta, st != NULL ? st->stderr_ : NULL, fit);
         if (rc == FE_OK && st != NULL) {

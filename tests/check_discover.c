@@ -812,6 +812,25 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
             }
             ck_assert_int_eq(fe_discover_merge(&merged, &part), FE_OK);
         }
+        /* The fine blocks' sums and counts: B = 128 blocks of 18 or 19
+           fitted rows (at least FE_DISCOVER_FINE_ROWS), by global row. */
+        ck_assert_uint_eq(rows.fine, 128);
+        for (size_t k = 0; k < rows.fine; k++) {
+            long double want[NM + 1] = {0}, count = 0;
+            for (size_t t = 0; t < NFIT; t++)
+                if (t * rows.fine / NFIT == k) {
+                    for (size_t c = 0; c < NM; c++)
+                        want[c] += nphi[t][c];
+                    want[NM] += nr[t];
+                    count += 1;
+                }
+            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
+            for (int q = 0; q < 4; q++) {
+                ck_assert_double_eq(acc[q]->fcount[k], (double)count);
+                for (size_t c = 0; c <= NM; c++)
+                    FE_ASSERT_REL(acc[q]->fsum[k * dim + c] + 1.0, (double)want[c] + 1.0, 1e-11);
+            }
+        }
         for (size_t l = 1; l <= FE_DISCOVER_DEFAULT_LAGS; l++)
             for (size_t i = 0; i < dim; i++)
                 for (size_t j = 0; j < dim; j++) {
@@ -873,12 +892,15 @@ START_TEST(gls_matches_prewhitened_least_squares)
     fe_discover_acc a;
     noise_rows();
     ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, st, nst), FE_OK);
+    /* The long range off: the standard errors are the AR model's own. */
+    ck_assert_int_eq(fe_discover_set_fine(&a, 1), FE_OK);
     for (size_t t = 0; t < NN; t++) {
         if (t == NBREAK)
             fe_discover_break(&a);
         ck_assert_int_eq(fe_discover_add(&a, nphi[t], nr[t]), FE_OK);
     }
     ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 3, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_uint_eq(nz.scales, 0);
     ck_assert_int_eq(nz.kind, FE_DISCOVER_NOISE_AR);
     ck_assert_uint_ge(nz.order, 2);
     ck_assert_double_eq_tol(nz.phi[0], 1.2, 0.1);
@@ -966,6 +988,97 @@ START_TEST(gls_matches_prewhitened_least_squares)
 END_TEST
 
 
+/* v(m) = Var(sum of m consecutive values) of the AR model nz per unit
+   innovation variance, from its autocovariances: gamma_0 .. gamma_p by
+   solving the Yule-Walker equations gamma_k - sum_i phi_i gamma_|k-i| =
+   [k == 0], the rest by the recursion, summed directly. */
+static long double ar_sum_variance(const fe_discover_noise *nz, size_t m)
+{
+    size_t p = nz->order;
+    long double a[FE_DISCOVER_EDGE + 1][FE_DISCOVER_EDGE + 2] = {{0}}, g[4096] = {0}, v = 0;
+    ck_assert_uint_le(m, 4096);
+    for (size_t k = 0; k <= p; k++) {
+        a[k][k] += 1;
+        for (size_t i = 1; i <= p; i++)
+            a[k][k > i ? k - i : i - k] -= nz->phi[i - 1];
+        a[k][p + 1] = k == 0;
+    }
+    for (size_t c = 0; c <= p; c++)                 /* Gauss-Jordan */
+        for (size_t r = 0; r <= p; r++) {
+            long double f = a[r][c] / a[c][c];
+            if (r == c)
+                continue;
+            for (size_t d = c; d <= p + 1; d++)
+                a[r][d] -= f * a[c][d];
+        }
+    for (size_t k = 0; k <= p; k++)
+        g[k] = a[k][p + 1] / a[k][k];
+    for (size_t h = p + 1; h < m; h++)
+        for (size_t i = 1; i <= p; i++)
+            g[h] += nz->phi[i - 1] * g[h - i];
+    for (size_t h = 0; h < m; h++)
+        v += (h == 0 ? 1 : 2) * (long double)(m - h) * g[h];
+    return v;
+}
+
+START_TEST(long_range_model_of_the_fine_blocks)
+{
+    /* The noise model's prediction for the fine blocks' Haar levels
+       against the AR model's autocovariances summed directly; the fitted
+       ratios near 1 where the AR model is the truth, and far above it
+       for a random walk, which widens the standard error of a trend. */
+    size_t nst = fe_discover_acc_doubles(NM, NK), nw = fe_discover_workspace_doubles(NM, NK);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    size_t cols[3] = {0, 1, 2};
+    double coef[3], se[3], se_off[3];
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    fe_discover_acc a;
+    noise_rows();
+    ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < NN; t++)
+        ck_assert_int_eq(fe_discover_add(&a, nphi[t], nr[t]), FE_OK);
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 3, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_uint_eq(a.fine, 128);
+    ck_assert_uint_eq(nz.scales, 7);
+    for (size_t j = 1; j <= 7; j++) {
+        size_t m = (size_t)((double)NFIT * (double)(1u << (j - 1)) / 128.0 + 0.5);
+        long double want = (4 * ar_sum_variance(&nz, m) - ar_sum_variance(&nz, 2 * m)) / (2 * m);
+        FE_ASSERT_REL(nz.scale_model[j - 1], (double)want, 1e-9);
+    }
+    FE_ASSERT_REL(nz.scale_model[7], (double)(ar_sum_variance(&nz, NFIT) / NFIT), 1e-9);
+    for (size_t t = 0; t <= nz.scales; t++) {
+        ck_assert_double_gt(nz.scale_ratio[t], 0.5);
+        ck_assert_double_lt(nz.scale_ratio[t], 2.0);
+    }
+    /* A slow random walk under white noise, and a trend fitted to it. */
+    {
+        fe_rng g = fe_rng_seed(7);
+        double walk = 0.0;
+        fe_discover_acc b;
+        size_t two[2] = {0, 1};
+        for (int off = 0; off < 2; off++) {
+            ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, 0, st, nst), FE_OK);
+            if (off)
+                ck_assert_int_eq(fe_discover_set_fine(&b, 1), FE_OK);
+            g = fe_rng_seed(7);
+            walk = 0.0;
+            for (size_t t = 0; t < NN; t++) {
+                walk += 0.05 * fe_rng_normal(&g);
+                ck_assert_int_eq(fe_discover_add(&b, nphi[t], walk + fe_rng_normal(&g)), FE_OK);
+            }
+            ck_assert_int_eq(fe_discover_fit_noise(&b, two, 2, 4, coef, off ? se_off : se, &fit,
+                                                   &nz, w, nw), FE_OK);
+            if (!off)
+                ck_assert_double_gt(nz.scale_ratio[nz.scales], 10.0);
+        }
+        ck_assert_double_gt(se[1], 2.0 * se_off[1]);
+    }
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(merged_parts_fit_as_the_whole_near_breaks)
 {
     /* Parts cut anywhere, also within FE_DISCOVER_EDGE rows of the break
@@ -1036,16 +1149,34 @@ START_TEST(lags_are_an_option_of_an_empty_accumulation)
     ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, s1, nst), FE_OK);
     ck_assert_uint_eq(a.lags, FE_DISCOVER_DEFAULT_LAGS);
     ck_assert_int_eq(fe_discover_set_lags(&a, FE_DISCOVER_LAGS + 1), FE_ESIZE);
+    /* Fine blocks: a power of two, of at least FE_DISCOVER_FINE_ROWS rows. */
+    ck_assert_uint_eq(a.fine, 128);
+    ck_assert_int_eq(fe_discover_set_fine(NULL, 2), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 96), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 256), FE_ESIZE);    /* 256 x 16 > 2400 rows */
+    ck_assert_int_eq(fe_discover_set_fine(&a, 2 * FE_DISCOVER_FINE_BLOCKS), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 128), FE_OK);
     ck_assert_int_eq(fe_discover_set_lags(NULL, 2), FE_EINVAL);
     ck_assert_int_eq(fe_discover_set_lags(&a, 2), FE_OK);
     ck_assert_int_eq(fe_discover_add(&a, nphi[0], nr[0]), FE_OK);
     ck_assert_int_eq(fe_discover_set_lags(&a, 3), FE_EINVAL);      /* not empty */
+    ck_assert_int_eq(fe_discover_set_fine(&a, 64), FE_EINVAL);     /* not empty */
     for (size_t t = 1; t < NN; t++)
         ck_assert_int_eq(fe_discover_add(&a, nphi[t], nr[t]), FE_OK);
-    /* Parts with other lags do not merge. */
+    /* Parts with other lags, or other fine blocks, do not merge. */
     ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, NN, s2, nst), FE_OK);
     ck_assert_int_eq(fe_discover_add(&b, nphi[0], nr[0]), FE_OK);
     ck_assert_int_eq(fe_discover_merge(&a, &b), FE_EMISMATCH);
+    ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, NN, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&b, 2), FE_OK);
+    ck_assert_int_eq(fe_discover_set_fine(&b, 64), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&b, nphi[0], nr[0]), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_EMISMATCH);
+    ck_assert_int_eq(fe_discover_acc_init(&b, NM, NK, NFIT, NN, s2, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&b, 2), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&b, nphi[0], nr[0]), FE_OK);
+    ck_assert_int_eq(fe_discover_merge(&a, &b), FE_OK);            /* the same shape */
     /* Two lags: the AR order is at most 1 (a lag is left for the test). */
     o.base = base;
     o.nbase = 1;
@@ -1153,6 +1284,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
+    tcase_add_test(t, long_range_model_of_the_fine_blocks);
     tcase_add_test(t, merged_parts_fit_as_the_whole_near_breaks);
     tcase_add_test(t, lags_are_an_option_of_an_empty_accumulation);
     tcase_set_timeout(acc, 900);

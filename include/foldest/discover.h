@@ -22,9 +22,12 @@ enum {
     FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P a full
                                        accumulation can keep */
     FE_DISCOVER_DEFAULT_LAGS = 8,   /* ... and keeps unless told otherwise */
-    FE_DISCOVER_EDGE = 4            /* rows kept at each end of every
+    FE_DISCOVER_EDGE = 4,           /* rows kept at each end of every
                                        recording: the highest order of the
                                        noise model */
+    FE_DISCOVER_FINE_BLOCKS = 512,  /* most fine blocks (a power of two) */
+    FE_DISCOVER_FINE_ROWS = 16,     /* fewest fitted rows in a fine block */
+    FE_DISCOVER_SCALES = 9          /* log2 FE_DISCOVER_FINE_BLOCKS */
 };
 
 /* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
@@ -41,7 +44,8 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
      + FE_DISCOVER_LAGS * (((m) + 1) * ((m) + 1) + 2 * ((m) + 1))           \
      + (blocks) * ((m) + 1)                                                 \
      + 2 * (FE_DISCOVER_EDGE * ((m) + 1)) * (FE_DISCOVER_EDGE * ((m) + 1))    \
-     + FE_DISCOVER_EDGE * ((m) + 1))
+     + FE_DISCOVER_EDGE * ((m) + 1)                                         \
+     + FE_DISCOVER_FINE_BLOCKS * ((m) + 2))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
      + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1)                             \
@@ -92,6 +96,9 @@ typedef struct fe_discover_acc {
                                    fitted rows stacked (zeros past the end) */
     double *edge_end;           /* the same for the last E, newest first */
     double *shead;              /* E x M: the open recording's first rows */
+    size_t fine;                /* B: fine blocks, a power of two */
+    double *fsum;               /* B x M: each fine block's sum of rows */
+    double *fcount;             /* B: each fine block's fitted rows */
     double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
@@ -125,11 +132,21 @@ int fe_discover_screen_init(fe_discover_acc *a, size_t m, size_t base_cols,
                             double *storage, size_t storage_doubles);
 
 /* fe_discover_set_lags: keep lags Z_1 .. Z_P, P = lags <= FE_DISCOVER_LAGS
-   (16 by default; 0: no noise model, selection then uses batch means and
-   says so).  The cost of a row grows as P M^2.  Only on an empty full
-   accumulation (FE_EINVAL otherwise, or for lags > 0 on a screen; FE_ESIZE
-   for lags > FE_DISCOVER_LAGS).  Parts to be merged must agree. */
+   (FE_DISCOVER_DEFAULT_LAGS by default; 0: no noise model, selection then
+   uses batch means and says so).  The cost of a row grows as P M^2.  Only
+   on an empty full accumulation (FE_EINVAL otherwise, or for lags > 0 on a
+   screen; FE_ESIZE for lags > FE_DISCOVER_LAGS).  Parts to be merged must
+   agree. */
 int fe_discover_set_lags(fe_discover_acc *a, size_t lags);
+
+/* fe_discover_set_fine: the B fine blocks whose sums carry the noise
+   model's long range (see the noise model below): a power of two, at most
+   FE_DISCOVER_FINE_BLOCKS and at most fit_rows / FE_DISCOVER_FINE_ROWS; by
+   default the most that allows.  B = 1 turns the long range off, and
+   standard errors and tests are then those of the AR model alone.  Only
+   on an empty accumulation (FE_EINVAL otherwise, or for B not a power of
+   two; FE_ESIZE for B too large).  Parts to be merged must agree. */
+int fe_discover_set_fine(fe_discover_acc *a, size_t blocks);
 
 /* fe_discover_add: fold one row: m term values `phi` and the residual r =
    recording - simulation.  FE_ENONFINITE (accumulation unchanged) when any
@@ -267,8 +284,24 @@ typedef struct fe_discover_noise {
                                    block means over its variance per row
                                    (1 for white noise) */
     double block_p;             /* chi-square test of R = 1 (NaN: not made) */
-    int long_range;             /* 1 when R > 1 is significant (p < 0.05)
-                                   and variances of slow series carry it */
+    int long_range;             /* 1 when R > 1 is significant (p < 0.05):
+                                   the location tests carry it (slow terms'
+                                   variances carry the scale fit below) */
+    size_t scales;              /* J: Haar levels of the fine blocks (0:
+                                   too few rows to look) */
+    double scale_model[FE_DISCOVER_SCALES + 1];
+                                /* per level j = 1 .. J + 1, the variance of
+                                   a Haar coefficient of the block sums that
+                                   the AR model predicts, per unit of
+                                   innovation variance (J + 1: the sum of
+                                   all rows, over n) */
+    double scale_used[FE_DISCOVER_SCALES + 1];
+                                /* per level, the Haar coefficients the
+                                   model's columns take up */
+    double scale_ratio[FE_DISCOVER_SCALES + 1];
+                                /* per level, V_j: the residual's Haar
+                                   variance over the prediction, fitted
+                                   (1 for noise the AR model describes) */
 } fe_discover_noise;
 
 /* fe_discover_noise_fit: the AR noise model of a series from its lagged

@@ -1120,7 +1120,22 @@ static void fe__json_noise(FILE *f, const fe_discover_noise *nz)
             nz->long_run ? "true" : "false");
     fe__json_number(f, nz->block_ratio);
     fe__json_pair(f, "block_p_value", nz->block_p);
-    fprintf(f, ", \"long_range_correction\": %s}", nz->long_range ? "true" : "false");
+    fprintf(f, ", \"long_range_correction\": %s", nz->long_range ? "true" : "false");
+    if (nz->kind == FE_DISCOVER_NOISE_AR) {
+        fprintf(f, ", \"scales\": {\"levels\": %zu, \"fine_blocks\": %zu, \"prediction\": [",
+                nz->scales, (size_t)1 << nz->scales);
+        for (size_t t = 0; nz->scales > 0 && t <= nz->scales; t++) {
+            fprintf(f, "%s", t ? ", " : "");
+            fe__json_number(f, nz->scale_model[t]);
+        }
+        fprintf(f, "], \"ratio\": [");
+        for (size_t t = 0; nz->scales > 0 && t <= nz->scales; t++) {
+            fprintf(f, "%s", t ? ", " : "");
+            fe__json_number(f, nz->scale_ratio[t]);
+        }
+        fprintf(f, "]}");
+    }
+    fprintf(f, "}");
 }
 
 /* The selection path: each step's model refitted. */
@@ -1273,10 +1288,15 @@ static void fe__story_noise(FILE *f, const char *what, const fe_discover_noise *
                 nz->kind == FE_DISCOVER_NOISE_AR ? "whitened" : "the",
                 nz->portmanteau_p < 0.01 ? "not white" : "white", nz->lags_tested,
                 nz->portmanteau_p, nz->long_run ? ", variances widened by the long-run factor" : "");
+    if (nz->kind == FE_DISCOVER_NOISE_AR && nz->scales > 0
+        && (nz->scale_ratio[nz->scales] >= 1.5 || nz->scale_ratio[nz->scales] <= 1.0 / 1.5))
+        fprintf(f, "; slow variation beyond the AR model: at the record's scale the residual "
+                   "varies %.3g times as much as it predicts (%zu Haar levels of %zu blocks), "
+                   "and slow terms' variances carry that",
+                nz->scale_ratio[nz->scales], nz->scales, (size_t)1 << nz->scales);
     if (nz->long_range)
-        fprintf(f, "; slow variation beyond the model: block means vary %.3g times as much as "
-                   "white noise would (p = %.2g), variances of slow terms widened", nz->block_ratio,
-                nz->block_p);
+        fprintf(f, "; block means vary %.3g times as much as white noise would (p = %.2g), "
+                   "and the located windows are tested with that", nz->block_ratio, nz->block_p);
     fprintf(f, "\n");
 }
 
