@@ -167,7 +167,6 @@ static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
                 s += col[c][i * ts];
             a->fsum[k * dim + c] += s;
         }
-        a->fcount[k] += (double)(stop - t);
         t = stop;
     }
 }
@@ -222,8 +221,6 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         a->bsum[i] += b->bsum[i];
     for (size_t i = 0; i < a->fine * dim; i++)
         a->fsum[i] += b->fsum[i];
-    for (size_t i = 0; i < a->fine; i++)
-        a->fcount[i] += b->fcount[i];
     if (P == 0)
         return;
     for (size_t i = 0; i < P * dim * dim; i++)
@@ -342,8 +339,7 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->edge_end = a->edge_start + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
     a->shead = a->edge_end + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
     a->fsum = a->shead + FE_DISCOVER_EDGE * dim;
-    a->fcount = a->fsum + FE_DISCOVER_FINE_BLOCKS * dim;
-    a->work = a->fcount + FE_DISCOVER_FINE_BLOCKS;
+    a->work = a->fsum + FE_DISCOVER_FINE_BLOCKS * dim;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
