@@ -34,6 +34,13 @@ MathJax is read from Debian's local copy, so the pages render offline."
             (scale "100") (align "center") (font "TeX") (linebreaks "false")
             (autonumber "AMS") (indent "0em") (multlinewidth "85%")
             (tagindent ".8em") (tagside "right")))
+    ;; The root element says when MathJax has typeset the page (or that the
+    ;; page has no mathematics), so that make check-doc reads the page then.
+    (setq org-html-head-extra
+          (concat "<script>window.addEventListener('load', function () {\n"
+                  "  function done() { document.documentElement.setAttribute('data-mathjax', 'done'); }\n"
+                  "  if (window.MathJax && MathJax.Hub) MathJax.Hub.Register.StartupHook('End', done); else done();\n"
+                  "});</script>"))
     (dolist (file command-line-args-left)
       (with-current-buffer (find-file-noselect file)
         (let ((out (concat outdir (file-name-base file) ".html")))
