@@ -399,7 +399,9 @@ check-tangle: tangle-scratch
 
 doc: $(B)/.deps
 	@mkdir -p $(B)/doc
-	emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) 2>&1 | grep -E '^Wove|rror' || true
+	@emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) >$(B)/doc/weave.log 2>&1 \
+	  || { cat $(B)/doc/weave.log; echo "doc: weaving failed"; exit 1; }
+	@grep -E '^Wove|rror' $(B)/doc/weave.log || true
 	@echo "open $(B)/doc/index.html"
 
 # Every woven page opened in headless Chromium after MathJax has run: no raw
