@@ -11,6 +11,7 @@
 (require 'ox-html)
 (require 'seq)
 (require 'subr-x)
+(require 'xml)
 
 (defvar fe--literate-dir (file-name-directory (or load-file-name buffer-file-name))
   "The directory of this file, where book.css lives too.")
@@ -77,6 +78,111 @@
             (funcall link next "next" "&rarr;")
             "</nav>")))
 
+;; Fragments as pbrt shows them.  Every code block of the woven page
+;; starts with a line naming its fragment and the file it tangles into, and
+;; carries an anchor; a noweb reference <<name>> is a link to the fragment
+;; of that name; a fragment used by others says which ("Used in ...").
+;; Blocks tangled into include/ also feed the index of the public API.
+
+(defvar fe--uses nil "Fragment name -> list of (LABEL . ANCHOR) of the blocks using it, this page.")
+(defvar fe--anchors nil "Fragment name -> anchor, this page.")
+(defvar fe--block-count 0 "Code blocks exported so far, this page.")
+(defvar fe--page nil "The base name of the page being woven.")
+(defvar fe--api nil "List of (NAME KIND PAGE ANCHOR FRAGMENT) for the public API index.")
+
+(defun fe--slug (name)
+  (concat "frag-" (string-trim (replace-regexp-in-string "[^a-z0-9]+" "-" (downcase name)) "-" "-")))
+
+(defun fe--tangle-file (params)
+  "The file a block with header arguments PARAMS tangles into, relative to
+the project's root, or nil."
+  (let ((tangle (cdr (assq :tangle (org-babel-parse-header-arguments (or params ""))))))
+    (and tangle (not (member tangle '("no" "yes")))
+         (replace-regexp-in-string "\\`\\(\\.\\./\\)+" "" tangle))))
+
+(defun fe--collect-fragments ()
+  "Read the current buffer's code blocks: their anchors and who uses whom."
+  (setq fe--uses (make-hash-table :test 'equal)
+        fe--anchors (make-hash-table :test 'equal)
+        fe--block-count 0)
+  (let ((n 0))
+    (org-element-map (org-element-parse-buffer) 'src-block
+      (lambda (b)
+        (setq n (1+ n))
+        (let* ((name (org-element-property :name b))
+               (anchor (if name (fe--slug name) (format "block-%d" n)))
+               (label (or name (fe--tangle-file (org-element-property :parameters b))))
+               (body (org-element-property :value b))
+               (start 0))
+          (when (and name (not (gethash name fe--anchors)))
+            (puthash name anchor fe--anchors))
+          (while (string-match "<<\\([^<>\n]+?\\)>>" body start)
+            (let ((used (match-string 1 body))
+                  (user (cons (or label "an unnamed block") anchor)))
+              (unless (member user (gethash used fe--uses))
+                (puthash used (append (gethash used fe--uses) (list user)) fe--uses)))
+            (setq start (match-end 0))))))))
+
+(defun fe--api-names (body)
+  "The public names a header block BODY declares: (NAME . KIND)."
+  (let ((code (replace-regexp-in-string "/\\*\\(?:.\\|\n\\)*?\\*/" "" body))
+        (found nil))
+    (dolist (rule '(("^[ \t]*#[ \t]*define[ \t]+\\(FE_[A-Za-z0-9_]+\\)" . "macro")
+                    ("typedef[^;{]*?(\\*[ \t]*\\(fe_[a-z0-9_]+\\))" . "type")
+                    ("}[ \t]*\\(fe_[a-z0-9_]+\\)[ \t]*;" . "type")
+                    ("^typedef[^;{(]*[ \t*]\\(fe_[a-z0-9_]+\\)[ \t]*;" . "type")
+                    ("^[ \t]*\\(?:typedef[ \t]+\\)?\\(?:struct\\|enum\\|union\\)[ \t]+\\(fe_[a-z0-9_]+\\)[ \t]*{" . "type")
+                    ("^[ \t]*\\(FE_[A-Z0-9_]+\\)[ \t]*\\(?:=[^,\n]*\\)?,?[ \t]*$" . "constant")
+                    ("^\\(?:[A-Za-z_][A-Za-z0-9_]*[ \t*]+\\)+\\(fe_[a-z0-9_]+\\)[ \t]*(" . "function")))
+      (let ((start 0))
+        (while (string-match (car rule) code start)
+          (let ((name (match-string 1 code)))
+            (unless (or (assoc name found)
+                        (string-match-p "\\`return\\b" (match-string 0 code)))
+              (push (cons name (cdr rule)) found)))
+          (setq start (match-end 0)))))
+    (nreverse found)))
+
+(defun fe--src-block (src-block contents info)
+  "A code block as pbrt shows it: its fragment name, its file, its uses."
+  (setq fe--block-count (1+ fe--block-count))
+  (let* ((html (org-html-src-block src-block contents info))
+         (name (org-element-property :name src-block))
+         (file (fe--tangle-file (org-element-property :parameters src-block)))
+         (anchor (if name (fe--slug name) (format "block-%d" fe--block-count)))
+         (uses (and name (gethash name fe--uses))))
+    ;; Noweb references become links to their fragment.
+    (setq html (replace-regexp-in-string
+                "&lt;&lt;\\([^&<>\n]+?\\)&gt;&gt;"
+                (lambda (m)
+                  (let* ((ref (match-string 1 m))
+                         (target (gethash (xml-substitute-special ref) fe--anchors)))
+                    (if target
+                        (format "<a class=\"noweb-ref\" href=\"#%s\">&lt;&lt;%s&gt;&gt;</a>" target ref)
+                      m)))
+                html t t))
+    (when (and file (string-prefix-p "include/" file))
+      (dolist (n (fe--api-names (org-element-property :value src-block)))
+        (push (list (car n) (cdr n) fe--page anchor (or name file)) fe--api)))
+    (concat
+     (format "<div class=\"fragment-head\" id=\"%s\">" anchor)
+     (if name (format "<span class=\"fragment-name\">&lang;%s&rang;</span>"
+                      (org-html-encode-plain-text name)) "")
+     (if file (format "<span class=\"fragment-file\">&rarr; <code>%s</code></span>" file) "")
+     "</div>\n"
+     html
+     (if uses
+         (concat "<div class=\"fragment-uses\">Used in "
+                 (mapconcat (lambda (u)
+                              (format "<a href=\"#%s\">&lang;%s&rang;</a>" (cdr u)
+                                      (org-html-encode-plain-text (car u))))
+                            uses ", ")
+                 ".</div>\n")
+       ""))))
+
+(org-export-define-derived-backend 'fe-html 'html
+  :translate-alist '((src-block . fe--src-block)))
+
 (defun fe-weave ()
   "Weave the .org files named after the output directory into HTML there,
 as a book (see `fe--reading-order').  MathJax is read from Debian's local
@@ -113,8 +219,10 @@ copy and the stylesheet is copied beside the pages, so the book is offline."
                 org-html-preamble (lambda (_info) nav)
                 org-html-postamble (lambda (_info) nav))
           (with-current-buffer (find-file-noselect file)
+            (fe--collect-fragments)
+            (setq fe--page (file-name-base file))
             (let ((out (concat outdir (file-name-base file) ".html")))
-              (org-export-to-file 'html out)
+              (org-export-to-file 'fe-html out)
               (message "Wove %s -> %s" (file-relative-name file) out)))
           (setq prev page rest (cdr rest)))))
     (setq command-line-args-left nil)))
