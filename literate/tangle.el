@@ -132,15 +132,23 @@ the project's root, or nil."
                     ("}[ \t]*\\(fe_[a-z0-9_]+\\)[ \t]*;" . "type")
                     ("^typedef[^;{(]*[ \t*]\\(fe_[a-z0-9_]+\\)[ \t]*;" . "type")
                     ("^[ \t]*\\(?:typedef[ \t]+\\)?\\(?:struct\\|enum\\|union\\)[ \t]+\\(fe_[a-z0-9_]+\\)[ \t]*{" . "type")
-                    ("^[ \t]*\\(FE_[A-Z0-9_]+\\)[ \t]*\\(?:=[^,\n]*\\)?,?[ \t]*$" . "constant")
                     ("^\\(?:[A-Za-z_][A-Za-z0-9_]*[ \t*]+\\)+\\(fe_[a-z0-9_]+\\)[ \t]*(" . "function")))
       (let ((start 0))
         (while (string-match (car rule) code start)
           (let ((name (match-string 1 code)))
-            (unless (or (assoc name found)
+            (unless (or (assoc name found) (string-prefix-p "fe__" (downcase name))
                         (string-match-p "\\`return\\b" (match-string 0 code)))
               (push (cons name (cdr rule)) found)))
           (setq start (match-end 0)))))
+    ;; The constants of an enumeration: the name that starts each item.
+    (let ((start 0))
+      (while (string-match "enum[ \t\n]*[A-Za-z0-9_]*[ \t\n]*{\\([^}]*\\)}" code start)
+        (let ((body (match-string 1 code)))
+          (setq start (match-end 0))          ; before split-string moves the match data
+          (dolist (item (split-string body ","))
+            (when (string-match "\\`[ \t\n]*\\(FE_[A-Z0-9_]+\\)" item)
+              (let ((name (match-string 1 item)))
+                (unless (assoc name found) (push (cons name "constant") found))))))))
     (nreverse found)))
 
 (defun fe--src-block (src-block contents info)
@@ -183,6 +191,74 @@ the project's root, or nil."
 (org-export-define-derived-backend 'fe-html 'html
   :translate-alist '((src-block . fe--src-block)))
 
+;; The index of the public API: every fe_/FE_ name the headers in include/
+;; declare, linked to the block that declares it.  The names are read from
+;; the blocks as they are woven, then compared with the tangled headers
+;; themselves; a name found in a header but in no block is listed apart
+;; (class api-missing), and make check-doc fails on it.
+
+(defconst fe--api-page '("api" . "Index of the public API")
+  "The page the index of the public API is written to, and its title.")
+
+(defun fe--header-names ()
+  "Every public name in include/foldest.h and include/foldest/*.h: each
+fe_ or FE_ word outside comments, less the private ones (fe__... and FE__..., and a
+macro's locals, which end in _)."
+  (let* ((root (expand-file-name ".." fe--literate-dir))
+         (headers (cons (expand-file-name "include/foldest.h" root)
+                        (directory-files (expand-file-name "include/foldest" root) t "\\.h\\'")))
+         (names nil))
+    (dolist (h headers)
+      (when (file-exists-p h)
+        (let ((code (replace-regexp-in-string
+                     "/\\*\\(?:.\\|\n\\)*?\\*/" ""
+                     (with-temp-buffer (insert-file-contents h) (buffer-string))))
+              (start 0))
+          (while (string-match "\\_<\\(?:fe_[a-z0-9_]+\\|FE_[A-Z0-9_]+\\)\\_>" code start)
+            (let ((name (match-string 0 code)))
+              (unless (or (member name names) (string-prefix-p "fe__" (downcase name))
+                          (string-suffix-p "_" name))
+                (push name names)))
+            (setq start (match-end 0))))))
+    names))
+
+(defun fe--write-api-page (outdir head nav titles)
+  "Write the index of the public API to OUTDIR, with HEAD and NAV.
+TITLES maps a page's base name to its title."
+  (let ((entries nil) (missing nil))
+    (dolist (e (reverse fe--api))
+      (unless (assoc (car e) entries) (push e entries)))
+    (setq entries (sort entries (lambda (a b) (string< (downcase (car a)) (downcase (car b))))))
+    (dolist (n (fe--header-names))
+      (unless (assoc n entries) (push n missing)))
+    (with-temp-file (concat outdir (car fe--api-page) ".html")
+      (insert "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+              "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+              "<title>" (cdr fe--api-page) "</title>\n" head "\n</head>\n<body>\n"
+              "<div id=\"preamble\" class=\"status\">" nav "</div>\n"
+              "<div id=\"content\" class=\"content\">\n<h1 class=\"title\">" (cdr fe--api-page) "</h1>\n"
+              (format "<p>The %d public names of <code>include/foldest.h</code> and "
+                      (length entries))
+              "<code>include/foldest/*.h</code>: functions, types, macros and the "
+              "constants of their enumerations, each linked to the block of the chapter "
+              "that declares it; the paragraphs before that block explain it.</p>\n")
+      (when missing
+        (insert "<p class=\"api-missing\">Declared in a header but found in no block: "
+                (mapconcat (lambda (n) (format "<code>%s</code>" n)) (sort missing #'string<) ", ")
+                ".</p>\n")
+        (message "Weave: the API index misses %s" (mapconcat #'identity missing " ")))
+      (insert "<table class=\"api-index\">\n<thead><tr><th>Name</th><th>Kind</th>"
+              "<th>Chapter</th><th>Fragment</th></tr></thead>\n<tbody>\n")
+      (dolist (e entries)
+        (let ((name (nth 0 e)) (kind (nth 1 e)) (page (nth 2 e)) (anchor (nth 3 e)) (frag (nth 4 e)))
+          (insert (format "<tr id=\"%s\"><td><a href=\"%s.html#%s\"><code>%s</code></a></td><td>%s</td><td><a href=\"%s.html\">%s</a></td><td>%s</td></tr>\n"
+                          name page anchor name kind page
+                          (org-html-encode-plain-text (or (cdr (assoc page titles)) page))
+                          (org-html-encode-plain-text frag)))))
+      (insert "</tbody>\n</table>\n</div>\n<div id=\"postamble\" class=\"status\">" nav
+              "</div>\n</body>\n</html>\n"))
+    (message "Wove the API index (%d names) -> %s%s.html" (length entries) outdir (car fe--api-page))))
+
 (defun fe-weave ()
   "Weave the .org files named after the output directory into HTML there,
 as a book (see `fe--reading-order').  MathJax is read from Debian's local
@@ -190,8 +266,11 @@ copy and the stylesheet is copied beside the pages, so the book is offline."
   (let* ((outdir (file-name-as-directory (expand-file-name (pop command-line-args-left))))
          (files (mapcar #'expand-file-name command-line-args-left))
          (order (fe--reading-order files))
-         (pages (mapcar (lambda (f) (cons f (fe--org-title f))) order))
-         (css (expand-file-name "book.css" fe--literate-dir)))
+         (pages (append (mapcar (lambda (f) (cons f (fe--org-title f))) order)
+                        (list fe--api-page)))
+         (titles (mapcar (lambda (p) (cons (file-name-base (car p)) (cdr p))) pages))
+         (css (expand-file-name "book.css" fe--literate-dir))
+         (cwd default-directory))
     (copy-file css (concat outdir "book.css") t)
     (setq org-html-mathjax-options
           '((path "file:///usr/share/javascript/mathjax/MathJax.js?config=TeX-AMS_HTML")
@@ -202,6 +281,7 @@ copy and the stylesheet is copied beside the pages, so the book is offline."
           org-html-html5-fancy t
           org-html-head-include-default-style nil
           org-html-head "<link rel=\"stylesheet\" href=\"book.css\">")
+    (setq fe--api nil)
     (let ((prev nil) (rest pages))
       (while rest
         (let* ((page (car rest)) (next (cadr rest)) (file (car page))
@@ -218,11 +298,13 @@ copy and the stylesheet is copied beside the pages, so the book is offline."
                         "\n<link rel=\"contents\" href=\"index.html#chapters\">")
                 org-html-preamble (lambda (_info) nav)
                 org-html-postamble (lambda (_info) nav))
-          (with-current-buffer (find-file-noselect file)
-            (fe--collect-fragments)
-            (setq fe--page (file-name-base file))
-            (let ((out (concat outdir (file-name-base file) ".html")))
-              (org-export-to-file 'fe-html out)
-              (message "Wove %s -> %s" (file-relative-name file) out)))
+          (if (eq page fe--api-page)
+              (fe--write-api-page outdir (concat org-html-head "\n" org-html-head-extra) nav titles)
+            (with-current-buffer (find-file-noselect file)
+              (fe--collect-fragments)
+              (setq fe--page (file-name-base file))
+              (let ((out (concat outdir (file-name-base file) ".html")))
+                (org-export-to-file 'fe-html out)
+                (message "Wove %s -> %s" (file-relative-name file cwd) out))))
           (setq prev page rest (cdr rest)))))
     (setq command-line-args-left nil)))

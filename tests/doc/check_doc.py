@@ -14,7 +14,8 @@ to the end instead of guessing a delay.  In the rendered document, outside
 text must hold no raw TeX: no \\begin, \\end, \\mathsf, \\frac, \\[, \\], \\(,
 \\) nor any other backslash command; and no MathJax error may be shown
 (merror, noError, "Math Processing Error", or an undefined macro, which
-MathJax typesets as its name in red).  One line per failing page,
+MathJax typesets as its name in red).  The index of the public API
+(api.html) must list every public name of the headers (no "api-missing").  One line per failing page,
 then "N passed, N failed".  Standard library only.
 """
 import html
@@ -150,6 +151,8 @@ def check(dom):
     r = Rendered()
     r.feed(dom)
     problems = []
+    if 'class="api-missing"' in dom:
+        problems.append("the API index misses names the headers declare (see the page)")
     if not r.done:
         problems.append("MathJax did not finish typesetting")
     for e in r.errors:
