@@ -58,7 +58,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc demo run-examples bench size install uninstall clean \
+        check-install check-tangle tangle doc check-doc demo run-examples bench size install uninstall clean \
         check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
 
 all: lib cli examples
@@ -399,8 +399,15 @@ check-tangle: tangle-scratch
 
 doc: $(B)/.deps
 	@mkdir -p $(B)/doc
-	emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) 2>&1 | grep -E '^Wove|rror' || true
+	@emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) >$(B)/doc/weave.log 2>&1 \
+	  || { cat $(B)/doc/weave.log; echo "doc: weaving failed"; exit 1; }
+	@grep -E '^Wove|rror' $(B)/doc/weave.log || true
 	@echo "open $(B)/doc/index.html"
+
+# Every woven page opened in headless Chromium after MathJax has run: no raw
+# TeX may survive in the text a reader sees, and no MathJax error be shown.
+check-doc: doc
+	@python3 tests/doc/check_doc.py $(B)/doc
 
 # ---------------------------------------------------------------- demo
 demo: all

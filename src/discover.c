@@ -167,7 +167,6 @@ static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
                 s += col[c][i * ts];
             a->fsum[k * dim + c] += s;
         }
-        a->fcount[k] += (double)(stop - t);
         t = stop;
     }
 }
@@ -222,8 +221,6 @@ static void fe__discover_lags_merge(fe_discover_acc *a, const fe_discover_acc *b
         a->bsum[i] += b->bsum[i];
     for (size_t i = 0; i < a->fine * dim; i++)
         a->fsum[i] += b->fsum[i];
-    for (size_t i = 0; i < a->fine; i++)
-        a->fcount[i] += b->fcount[i];
     if (P == 0)
         return;
     for (size_t i = 0; i < P * dim * dim; i++)
@@ -342,8 +339,7 @@ static void fe__discover_layout(fe_discover_acc *a, double *storage)
     a->edge_end = a->edge_start + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
     a->shead = a->edge_end + FE_DISCOVER_EDGE * dim * FE_DISCOVER_EDGE * dim;
     a->fsum = a->shead + FE_DISCOVER_EDGE * dim;
-    a->fcount = a->fsum + FE_DISCOVER_FINE_BLOCKS * dim;
-    a->work = a->fcount + FE_DISCOVER_FINE_BLOCKS;
+    a->work = a->fsum + FE_DISCOVER_FINE_BLOCKS * dim;
 }
 
 int fe_discover_acc_init(fe_discover_acc *a, size_t m, size_t blocks,
@@ -1916,8 +1912,10 @@ static void fe__block_ratio(const fe_discover_acc *a, const double *u, fe_discov
 static double fe__digamma(double x)
 {
     double r = 0.0, f;
-    for (; x < 6.0; x += 1.0)
+    while (x < 6.0) {
         r -= 1.0 / x;
+        x += 1.0;
+    }
     f = 1.0 / (x * x);
     return r + log(x) - 0.5 / x - f * (1.0 / 12.0 - f * (1.0 / 120.0 - f / 252.0));
 }
@@ -1925,8 +1923,10 @@ static double fe__digamma(double x)
 static double fe__trigamma(double x)
 {
     double r = 0.0, f;
-    for (; x < 6.0; x += 1.0)
+    while (x < 6.0) {
         r += 1.0 / (x * x);
+        x += 1.0;
+    }
     f = 1.0 / (x * x);
     return r + 1.0 / x + 0.5 * f + f / x * (1.0 / 6.0 - f * (1.0 / 30.0 - f / 42.0));
 }
@@ -1948,7 +1948,7 @@ static size_t fe__haar(double *x, size_t B, double *e)
         }
         e[J++] = s;
     }
-    e[J] = x[0] * x[0];
+    e[J] = B > 0 ? x[0] * x[0] : 0.0;
     return J;
 }
 
@@ -2092,7 +2092,7 @@ static double fe__filter_power(const fe_discover_noise *nz, double w)
 static double fe__scale_shares(const fe_discover_acc *a, const fe_discover_noise *nz,
                                const double *u, double energy, double *lam)
 {
-    double y[FE_DISCOVER_FINE_BLOCKS], e[FE_DISCOVER_SCALES + 1];
+    double y[FE_DISCOVER_FINE_BLOCKS] = {0}, e[FE_DISCOVER_SCALES + 1] = {0};
     double n = fe__fitted_rows(a), total = 0.0;
     size_t J = nz->scales;
     fe__fine_series(a, u, y);
@@ -2115,7 +2115,7 @@ static void fe__scale_used(const fe_discover_acc *a, const fe__model *mo,
 {
     size_t dim = a->m + 1, s = mo->n;
     double u[FE_DISCOVER_MAX_COLUMNS + 1], v[FE_DISCOVER_MAX_COLUMNS];
-    double lam[FE_DISCOVER_SCALES + 1];
+    double lam[FE_DISCOVER_SCALES + 1] = {0};
     memset(nz->scale_used, 0, sizeof nz->scale_used);
     for (size_t c = 0; c < s && nz->scales > 0; c++) {
         for (size_t i = c + 1; i-- > 0;) {      /* U v = e_c, back substitution */
@@ -2153,8 +2153,8 @@ typedef struct fe__scalefit {
 static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
                           const double *u, double var, const double *used, fe__scalefit *sf)
 {
-    double y[FE_DISCOVER_FINE_BLOCKS], e[FE_DISCOVER_SCALES + 1];
-    double ly[FE_DISCOVER_SCALES], wt[FE_DISCOVER_SCALES];
+    double y[FE_DISCOVER_FINE_BLOCKS] = {0}, e[FE_DISCOVER_SCALES + 1] = {0};
+    double ly[FE_DISCOVER_SCALES] = {0}, wt[FE_DISCOVER_SCALES] = {0};
     double sw = 0.0, sx = 0.0, sxx = 0.0, sy = 0.0, sxy = 0.0, det;
     size_t J = nz->scales, usable = 0;
     int line;
@@ -2203,7 +2203,7 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
 static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, double *share,
                              double *lnvar)
 {
-    double lam[FE_DISCOVER_SCALES + 1], total = 0.0, F = 0.0, g[FE_DISCOVER_SCALES + 1];
+    double lam[FE_DISCOVER_SCALES + 1] = {0}, total = 0.0, F = 0.0, g[FE_DISCOVER_SCALES + 1] = {0};
     size_t J = sf->levels;
     *share = 0.0;
     *lnvar = 0.0;
@@ -2242,7 +2242,7 @@ static double fe__variance_factor(const fe_discover_acc *a, const fe__ws *w,
                                   const fe_discover_noise *nz, const double *u, double nu,
                                   const fe__scalefit *sf, double *dof)
 {
-    double fs = 1.0, share, lnvar, F, f, parts, lam[FE_DISCOVER_SCALES + 1];
+    double fs = 1.0, share, lnvar, F, f, parts, lam[FE_DISCOVER_SCALES + 1] = {0};
     *dof = nu;
     if (!nz->long_run && sf->levels == 0)
         return 1.0;
@@ -2461,7 +2461,7 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
        residual without it, and must not hide itself. */
     {
         double ures[FE_DISCOVER_MAX_COLUMNS + 1];
-        double used[FE_DISCOVER_SCALES + 1], lam[FE_DISCOVER_SCALES + 1];
+        double used[FE_DISCOVER_SCALES + 1], lam[FE_DISCOVER_SCALES + 1] = {0};
         fe__scalefit sf;
         memcpy(used, nz->scale_used, sizeof used);
         fe__residual_weights(dim, mo->cols, s, beta, ures);

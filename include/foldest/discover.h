@@ -45,7 +45,7 @@ enum { FE_DISCOVER_PANEL_ROWS = 128 };
      + (blocks) * ((m) + 1)                                                 \
      + 2 * (FE_DISCOVER_EDGE * ((m) + 1)) * (FE_DISCOVER_EDGE * ((m) + 1))    \
      + FE_DISCOVER_EDGE * ((m) + 1)                                         \
-     + FE_DISCOVER_FINE_BLOCKS * ((m) + 2))
+     + FE_DISCOVER_FINE_BLOCKS * ((m) + 1))
 #define FE_DISCOVER_ACC_DOUBLES(m, blocks)                                  \
     (FE_DISCOVER_ACC_VALUES(m, blocks) + ((m) + 1) * ((m) + 1)              \
      + (FE_DISCOVER_PANEL_ROWS + 1) * ((m) + 1)                             \
@@ -98,7 +98,6 @@ typedef struct fe_discover_acc {
     double *shead;              /* E x M: the open recording's first rows */
     size_t fine;                /* B: fine blocks, a power of two */
     double *fsum;               /* B x M: each fine block's sum of rows */
-    double *fcount;             /* B: each fine block's fitted rows */
     double *work;               /* scratch of fe_discover_add_rows */
 } fe_discover_acc;
 
