@@ -1907,30 +1907,6 @@ static void fe__block_ratio(const fe_discover_acc *a, const double *u, fe_discov
     nz->long_range = nz->block_p < 0.05 && nz->block_ratio > 1.0;
 }
 
-/* psi(x) and psi'(x) for x > 0: the recurrence up to 6, then the
-   asymptotic series (errors below 1e-12 there). */
-static double fe__digamma(double x)
-{
-    double r = 0.0, f;
-    while (x < 6.0) {
-        r -= 1.0 / x;
-        x += 1.0;
-    }
-    f = 1.0 / (x * x);
-    return r + log(x) - 0.5 / x - f * (1.0 / 12.0 - f * (1.0 / 120.0 - f / 252.0));
-}
-
-static double fe__trigamma(double x)
-{
-    double r = 0.0, f;
-    while (x < 6.0) {
-        r += 1.0 / (x * x);
-        x += 1.0;
-    }
-    f = 1.0 / (x * x);
-    return r + 1.0 / x + 0.5 * f + f / x * (1.0 / 6.0 - f * (1.0 / 30.0 - f / 42.0));
-}
-
 /* The Haar energies of x[0 .. B-1], B = 2^J, overwriting x: e[j-1] for
    j = 1 .. J the sum of squares of level j's B / 2^j detail coefficients
    (each the difference of two sums of 2^(j-1) entries, over
@@ -2170,8 +2146,8 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
         ly[i - 1] = 0.0;
         if (!(k >= 0.5) || !(e[i - 1] > 0.0) || !(pred > 0.0))
             continue;
-        ly[i - 1] = log(e[i - 1] / (k * pred)) - (fe__digamma(k / 2.0) - log(k / 2.0));
-        sf->var[i - 1] = fe__trigamma(k / 2.0);
+        ly[i - 1] = log(e[i - 1] / (k * pred)) - (fe_digamma(k / 2.0) - log(k / 2.0));
+        sf->var[i - 1] = fe_trigamma(k / 2.0);
         wt[i - 1] = 1.0 / sf->var[i - 1];
         sw += wt[i - 1];
         sx += wt[i - 1] * x;

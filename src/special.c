@@ -73,7 +73,37 @@ double fe_log_gamma(double x)
     t = x + 7.5;
     return 0.9189385332046728 + (x + 0.5) * log(t) - t + log(s);
 }
+/* Evaluate the incomplete gamma function ends here */
+/* [[file:../literate/special.org::Evaluate the digamma and trigamma functions][Evaluate the digamma and trigamma functions]] */
+double fe_digamma(double x)
+{
+    double r = 0.0, f;
+    if (!(x > 0.0) || !isfinite(x))
+        return NAN;
+    while (x < 10.0) {
+        r -= 1.0 / x;
+        x += 1.0;
+    }
+    f = 1.0 / (x * x);
+    return r + log(x) - 0.5 / x
+           - f * (1.0 / 12.0 - f * (1.0 / 120.0 - f * (1.0 / 252.0 - f * (1.0 / 240.0
+                                                                          - f / 132.0))));
+}
 
+double fe_trigamma(double x)
+{
+    double r = 0.0, f;
+    if (!(x > 0.0) || !isfinite(x))
+        return NAN;
+    while (x < 10.0) {
+        r += 1.0 / (x * x);
+        x += 1.0;
+    }
+    f = 1.0 / (x * x);
+    return r + 1.0 / x + 0.5 * f
+           + f / x * (1.0 / 6.0 - f * (1.0 / 30.0 - f * (1.0 / 42.0 - f * (1.0 / 30.0
+                                                                          - f * 5.0 / 66.0))));
+}
 
 /* log(x^a e^-x / Gamma(a)), the factor in front of the series and the
    fraction.  For a >= 10, Stirling's series for log Gamma(a) with the
@@ -149,7 +179,7 @@ double fe_gamma_q(double a, double x)
     fe__gamma_pq(a, x, &p, &q);
     return q;
 }
-/* Evaluate the incomplete gamma function ends here */
+/* Evaluate the digamma and trigamma functions ends here */
 /* [[file:../literate/special.org::Tails of t, F and chi-square][Tails of t, F and chi-square]] */
 double fe_student_t_two_sided(double t, double nu)
 {

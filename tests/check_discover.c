@@ -1147,8 +1147,17 @@ START_TEST(lags_are_an_option_of_an_empty_accumulation)
     ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, s1, nst), FE_OK);
     ck_assert_uint_eq(a.lags, FE_DISCOVER_DEFAULT_LAGS);
     ck_assert_int_eq(fe_discover_set_lags(&a, FE_DISCOVER_LAGS + 1), FE_ESIZE);
-    /* Fine blocks: a power of two, of at least FE_DISCOVER_FINE_ROWS rows. */
+    /* Fine blocks: a power of two, of at least FE_DISCOVER_FINE_ROWS rows
+       (the most that allows, FE_DISCOVER_FINE_BLOCKS at most). */
     ck_assert_uint_eq(a.fine, 128);
+    {
+        const uint64_t rows[5] = {31, 32, 4095, 4096, 1u << 20};
+        const size_t want[5] = {1, 2, 128, 256, FE_DISCOVER_FINE_BLOCKS};
+        for (int i = 0; i < 5; i++) {
+            ck_assert_int_eq(fe_discover_acc_init(&b, NM, 2, rows[i], 0, s2, nst), FE_OK);
+            ck_assert_uint_eq(b.fine, want[i]);
+        }
+    }
     ck_assert_int_eq(fe_discover_set_fine(NULL, 2), FE_EINVAL);
     ck_assert_int_eq(fe_discover_set_fine(&a, 0), FE_EINVAL);
     ck_assert_int_eq(fe_discover_set_fine(&a, 96), FE_EINVAL);

@@ -66,6 +66,33 @@ START_TEST(normal_quantile_within_its_promised_error)
 }
 END_TEST
 
+START_TEST(digamma_and_trigamma_closed_forms)
+{
+    /* psi and psi' at points where they have closed forms (gamma is
+       Euler's constant), on both sides of the switch to the asymptotic
+       series at 6, and their recurrences across it. */
+    const double gamma = 0.57721566490153286061, pi2 = 9.8696044010893586188;
+    FE_ASSERT_REL(fe_digamma(1.0), -gamma, 1e-13);
+    FE_ASSERT_REL(fe_digamma(0.5), -gamma - 2.0 * log(2.0), 1e-13);
+    FE_ASSERT_REL(fe_digamma(2.0), 1.0 - gamma, 1e-13);
+    FE_ASSERT_REL(fe_digamma(10.0), 2.8289682539682539683 - gamma, 1e-13);   /* H_9 - gamma */
+    FE_ASSERT_REL(fe_digamma(100.0), 4.6001618527380874002, 1e-13);
+    FE_ASSERT_REL(fe_trigamma(1.0), pi2 / 6.0, 1e-13);
+    FE_ASSERT_REL(fe_trigamma(0.5), pi2 / 2.0, 1e-13);
+    FE_ASSERT_REL(fe_trigamma(2.0), pi2 / 6.0 - 1.0, 1e-13);
+    FE_ASSERT_REL(fe_trigamma(10.0), pi2 / 6.0 - 1.5397677311665406904, 1e-12);
+    FE_ASSERT_REL(fe_trigamma(100.0), 0.010050166663333571395, 1e-12);
+    for (double x = 0.25; x < 12.0; x += 0.75) {
+        FE_ASSERT_REL(fe_digamma(x + 1.0) - fe_digamma(x), 1.0 / x, 1e-12);
+        FE_ASSERT_REL(fe_trigamma(x) - fe_trigamma(x + 1.0), 1.0 / (x * x), 1e-11);
+    }
+    ck_assert(isnan(fe_digamma(0.0)));
+    ck_assert(isnan(fe_trigamma(-1.0)));
+    ck_assert(isnan(fe_digamma(NAN)));
+    ck_assert(isnan(fe_trigamma(INFINITY)));
+}
+END_TEST
+
 START_TEST(bad_arguments_give_nan)
 {
     ck_assert(isnan(fe_beta_inc(-1, 1, 0.5)));
@@ -137,6 +164,7 @@ Suite *fe_special_suite(void)
     tcase_add_test(t, f_and_chi_square);
     tcase_add_test(t, normal_quantile_within_its_promised_error);
     tcase_add_test(t, bad_arguments_give_nan);
+    tcase_add_test(t, digamma_and_trigamma_closed_forms);
     tcase_add_loop_test(t, chi2_upper_large_degrees_of_freedom, 0,
                         (int)(sizeof chi2_reference / sizeof chi2_reference[0]));
     suite_add_tcase(s, t);

@@ -16,6 +16,15 @@ double fe_beta_inc(double a, double b, double x);
    lgamma). */
 double fe_log_gamma(double x);
 
+/* fe_digamma, fe_trigamma: psi(x) = d ln Gamma(x) / dx and its derivative
+   psi'(x) for x > 0, to about 1e-13 relative (near psi's zero at 1.4616,
+   to about 1e-15 absolute); NaN for other arguments.
+   They are the mean and variance of the log of a chi-square: for k degrees
+   of freedom, E ln(chi2_k / k) = psi(k/2) - ln(k/2) and Var ln chi2_k =
+   psi'(k/2). */
+double fe_digamma(double x);
+double fe_trigamma(double x);
+
 /* fe_gamma_p, fe_gamma_q: the regularised lower and upper incomplete gamma
    functions P(a, x) and Q(a, x) = 1 - P(a, x) for a > 0, x >= 0; NaN for
    other arguments. */
