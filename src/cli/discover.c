@@ -1288,8 +1288,7 @@ static void fe__story_noise(FILE *f, const char *what, const fe_discover_noise *
                 nz->kind == FE_DISCOVER_NOISE_AR ? "whitened" : "the",
                 nz->portmanteau_p < 0.01 ? "not white" : "white", nz->lags_tested,
                 nz->portmanteau_p, nz->long_run ? ", variances widened by the long-run factor" : "");
-    if (nz->kind == FE_DISCOVER_NOISE_AR && nz->scales > 0
-        && (nz->scale_ratio[nz->scales] >= 1.5 || nz->scale_ratio[nz->scales] <= 1.0 / 1.5))
+    if (nz->kind == FE_DISCOVER_NOISE_AR && nz->scales > 0 && nz->scale_ratio[nz->scales] >= 1.5)
         fprintf(f, "; slow variation beyond the AR model: at the record's scale the residual "
                    "varies %.3g times as much as it predicts (%zu Haar levels of %zu blocks), "
                    "and slow terms' variances carry that",
