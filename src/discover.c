@@ -184,7 +184,7 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
             s += col[c][t * ts];
         a->bsum[k * (a->m + 1) + c] += s;
     }
-    if (fitted)
+    if (fitted && a->lags > 0)  /* the long range is the AR model's: none in a screen */
         fe__discover_fine_rows(a, col, ts, q, a->row0 + a->n);
     if (a->lags == 0 || !fitted)
         return;
@@ -518,7 +518,7 @@ int fe_discover_add(fe_discover_acc *a, const double *phi, double r)
     fe__discover_lags_row(a, z, k < a->blocks);
     for (size_t i = 0; i < dim && k < a->blocks; i++)
         a->bsum[k * dim + i] += z[i];
-    if (k < a->blocks) {
+    if (k < a->blocks && a->lags > 0) {
         const double *zc[FE_DISCOVER_MAX_COLUMNS + 1];
         for (size_t i = 0; i < dim; i++)
             zc[i] = z + i;

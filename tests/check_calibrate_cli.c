@@ -4,11 +4,11 @@
    built binary (FE_TEST_CLI) on recordings written here. */
 #define _POSIX_C_SOURCE 200809L
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "foldest.h"
 #include "testutil.h"
+#include "cli_run.h"
 
 #ifndef FE_TEST_CLI
 #define FE_TEST_CLI "build/bin/foldest"
@@ -52,16 +52,8 @@ static void write_recording(const char *path, size_t n, enum shape shape,
 static int run(const char *fmt, const char *path, char *out, size_t outlen)
 {
     char cmd[2048];
-    FILE *p;
-    size_t got;
-    int status;
     snprintf(cmd, sizeof cmd, fmt, FE_TEST_CLI, path, path, path);
-    p = popen(cmd, "r");
-    ck_assert_ptr_nonnull(p);
-    got = fread(out, 1, outlen - 1, p);
-    out[got] = '\0';
-    status = pclose(p);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return fe_test_run(cmd, FE_TEST_AS_GIVEN, out, outlen);
 }
 
 static double json_number(const char *json, const char *key, int index)
