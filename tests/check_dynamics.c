@@ -384,6 +384,139 @@ START_TEST(refusals_leave_the_state_unchanged)
 }
 END_TEST
 
+/* A step of height c at a state of zero: the central difference over
+   +-1e-6 is 2 c / 2e-6 = 1e6 c.  It is a double for c = 1e302 (1e308,
+   under DBL_MAX = 1.8e308) and not for c = 1e303 (1e309), nor when f
+   itself is NaN or the difference of its values overflows. */
+static int step_of(const fe_sample *s, double *d, void *user)
+{
+    double c = *(const double *)user, x = s->position + s->velocity + s->temperature;
+    *d = x > 0.0 ? c : x < 0.0 ? -c : 0.0;
+    return 0;
+}
+
+START_TEST(refusals_at_their_edges)
+{
+    fe_dynamics_ident id;
+    fe_dynamics_fit fit;
+    fe_dynamics_sens sn, copy;
+    fe_dynamics_deviation dv, dcopy;
+    fe_sample s;
+    double a[2], c, d[2], ak[2] = {-1.0, 0.0}, phi[2] = {1.0, 2.0}, y[2], spr[2] = {-4.0, 0.0};
+    double force = 0.3;
+
+    /* The finite-difference Jacobian: a quotient of 1e308 is returned, one
+       of 1e309 refused with a[] untouched. */
+    memset(&s, 0, sizeof s);
+    c = 1e302;
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(step_of, &c, 1, &s, a), FE_OK);
+    FE_ASSERT_REL(a[0], 1e308, 1e-12);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(step_of, &c, 2, &s, a), FE_OK);
+    FE_ASSERT_REL(a[0], 1e308, 1e-12);
+    FE_ASSERT_REL(a[1], 1e308, 1e-12);
+    const double bad[3] = {1e303, 1e308, NAN};
+    for (int k = 0; k < 3; k++)
+        for (size_t order = 1; order <= 2; order++) {
+            c = bad[k];
+            a[0] = a[1] = 7.0;
+            ck_assert_int_eq(fe_dynamics_jacobian_fd(step_of, &c, order, &s, a), FE_ENONFINITE);
+            ck_assert(a[0] == 7.0 && a[1] == 7.0);
+        }
+
+    /* The identification's solve refuses each bad argument alone. */
+    memset(&id, 0, sizeof id);
+    id.order = 2;
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_ident_solve(NULL, &fit), FE_EINVAL);
+    id.order = 3;
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, &fit), FE_EINVAL);
+    id.order = 2;
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, &fit), FE_ETOOFEW);
+
+    /* The signatures: the first forcing not finite is refused as the
+       second is, the state unchanged. */
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, 2), FE_OK);
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.0, ak, phi, y, NULL), FE_OK);
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.1, ak, phi, y, NULL), FE_OK);
+    copy = sn;
+    phi[0] = NAN;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.2, ak, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+    phi[0] = INFINITY;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.2, ak, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+
+    /* The first row of a recording takes no forcing that is not finite
+       either (it has nothing to integrate, but keeps phi for the next). */
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 1, 2), FE_OK);
+    copy = sn;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.0, ak, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+    phi[0] = 1.0;
+    phi[1] = NAN;
+    ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.0, ak, phi, y, NULL), FE_ENONFINITE);
+    ck_assert(memcmp(&sn, &copy, sizeof sn) == 0);
+    phi[1] = 2.0;
+
+    /* The deviation refuses each missing argument alone, the state
+       unchanged (after two rows, so that a step would call f and force). */
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 1), FE_OK);
+    memset(&s, 0, sizeof s);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_OK);
+    s.t = 0.5;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_OK);
+    s.t = 1.0;
+    dcopy = dv;
+    ck_assert_int_eq(fe_dynamics_deviation_step(NULL, &s, ak, lag, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, NULL, ak, lag, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, NULL, lag, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, NULL, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, NULL, &force, d),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force,
+                                                &force, NULL), FE_EINVAL);
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) == 0);
+    dv.order = 3;
+    dcopy = dv;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) == 0);
+
+    /* The deviation: a row at the last row's time, or before it, is
+       refused with the state unchanged; the next row after it continues
+       the closed form of a_deviation_follows_its_closed_form. */
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 2), FE_OK);
+    for (int i = 0; i <= 2; i++) {
+        memset(&s, 0, sizeof s);
+        s.t = 0.05 * i;
+        s.position = s.sim = 0.1 * sin(3.0 * s.t);
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, spr, spring, NULL, constant_force,
+                                                    &force, d), FE_OK);
+    }
+    dcopy = dv;
+    d[0] = d[1] = 7.0;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, spr, spring, NULL, constant_force,
+                                                &force, d), FE_EINVAL);     /* t = 0.1 again */
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) == 0 && d[0] == 7.0 && d[1] == 7.0);
+    s.t = 0.05;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, spr, spring, NULL, constant_force,
+                                                &force, d), FE_EINVAL);
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) == 0 && d[0] == 7.0 && d[1] == 7.0);
+    s.t = 0.15;
+    s.position = s.sim = 0.1 * sin(3.0 * s.t);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, spr, spring, NULL, constant_force,
+                                                &force, d), FE_OK);
+    ck_assert_msg(fabs(d[0] - force * (1.0 - cos(2.0 * s.t)) / 4.0) < 1e-5, "%g", d[0]);
+    ck_assert_msg(fabs(d[1] - force * sin(2.0 * s.t) / 2.0) < 1e-5, "rate %g", d[1]);
+}
+END_TEST
+
 START_TEST(an_identification_split_at_a_break_merges_to_the_whole)
 {
     plant p = {0, 2 * PI * 0.5, 0.1, 2.0, 0.0};
@@ -529,6 +662,7 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, a_deviation_follows_its_closed_form);
     tcase_add_test(t, spans_and_finite_differences_at_zero);
     tcase_add_test(t, refusals_leave_the_state_unchanged);
+    tcase_add_test(t, refusals_at_their_edges);
     tcase_add_test(t, an_identification_split_at_a_break_merges_to_the_whole);
     tcase_add_test(t, the_dynamics_catalog_and_its_words);
     tcase_add_test(t, a_missing_viscous_friction_is_named_with_its_coefficient);

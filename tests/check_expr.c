@@ -126,6 +126,21 @@ START_TEST(errors_name_their_column)
         ck_assert_int_eq(fe_expr_compile(&e, "1", NULL, 1, NULL, NULL, 0), FE_EINVAL);
         ck_assert_int_eq(fe_expr_compile(&e, "pi", NULL, 0, NULL, NULL, 0), FE_OK);
     }
+    {
+        /* The message buffer holds a string after any call, down to one
+           byte: on success the empty one, whatever the byte held.  A
+           buffer of no bytes is not written. */
+        fe_expr e;
+        char one[1] = {'x'}, none[1] = {'x'};
+        ck_assert_int_eq(fe_expr_compile(&e, "1", names, NV, NULL, one, 1), FE_OK);
+        ck_assert_int_eq(one[0], '\0');
+        one[0] = 'x';
+        ck_assert_int_eq(fe_expr_compile(&e, "1 +", names, NV, NULL, one, 1), FE_EPARSE);
+        ck_assert_int_eq(one[0], '\0');
+        ck_assert_int_eq(fe_expr_compile(&e, "1", names, NV, NULL, none, 0), FE_OK);
+        ck_assert_int_eq(fe_expr_compile(&e, "1 +", names, NV, NULL, none, 0), FE_EPARSE);
+        ck_assert_int_eq(none[0], 'x');
+    }
 }
 END_TEST
 

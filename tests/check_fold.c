@@ -73,6 +73,24 @@ START_TEST(argument_errors)
     ck_assert_int_eq(fe_scan(&f, &a, z, 1, NULL, NULL), FE_EINVAL);
     ck_assert_int_eq(fe_scan_visit(&f, &a, z, 1, NULL, NULL, NULL), FE_EINVAL);
     ck_assert_int_eq(a.count, 0);
+    /* A merge and a copy refuse each bad argument alone, the accumulation
+       untouched: no accumulator, one without a step, no accumulation, no
+       other. */
+    {
+        toy_acc b = {3, 4.0}, c = {5, 6.0};
+        ck_assert_int_eq(fe_merge(NULL, &a, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_merge(&broken, &a, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_merge(&f, NULL, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_merge(&f, &a, NULL), FE_EINVAL);
+        ck_assert(a.count == 0 && a.sum == 0.0);
+        ck_assert_int_eq(fe_copy(NULL, &c, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_copy(&broken, &c, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_copy(&f, NULL, &b), FE_EINVAL);
+        ck_assert_int_eq(fe_copy(&f, &c, NULL), FE_EINVAL);
+        ck_assert(c.count == 5 && c.sum == 6.0);
+        ck_assert_int_eq(fe_merge(&f, &c, &b), FE_OK);
+        ck_assert(c.count == 8 && c.sum == 10.0);
+    }
     /* A refused fold reports that it folded nothing, whatever *done held. */
     {
         size_t done = 99;

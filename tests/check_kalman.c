@@ -722,6 +722,38 @@ START_TEST(edges_of_the_sizes_models_and_sums)
         free(a.mem);
         free(b.mem);
     }
+    {   /* The scaled information prior: P0 = 2 I, x0 = (1, -4) gives
+           Lambda = I / 2 and eta = x0 / 2; p0 = INFINITY zero information.
+           A NaN p0 or an x0 not finite is a value not finite
+           (FE_ENONFINITE, each alone, whatever the other is), p0 = 0 and
+           below a prior that is not positive definite; each refusal leaves
+           the prior as it was. */
+        kinfo a;
+        const double x0[2] = {1.0, -4.0}, want[4] = {0.5, 0.0, 0.0, 0.5};
+        double bad[2] = {1.0, -4.0};
+        kinfo_make(&a, 2, 1);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, x0, 2.0), FE_OK);
+        for (int i = 0; i < 4; i++)
+            ck_assert_double_eq(a.s.Lambda[i], want[i]);
+        ck_assert(a.s.eta[0] == 0.5 && a.s.eta[1] == -2.0);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, NULL, NAN), FE_ENONFINITE);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, x0, NAN), FE_ENONFINITE);
+        for (int k = 0; k < 2; k++) {
+            bad[1] = k == 0 ? NAN : -INFINITY;
+            ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, bad, 1.0), FE_ENONFINITE);
+            ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, bad, 0.0), FE_ENONFINITE);
+        }
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, x0, 0.0), FE_ENOTPD);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, x0, -1.0), FE_ENOTPD);
+        for (int i = 0; i < 4; i++)
+            ck_assert_double_eq(a.s.Lambda[i], want[i]);
+        ck_assert(a.s.eta[0] == 0.5 && a.s.eta[1] == -2.0);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, x0, INFINITY), FE_OK);
+        for (int i = 0; i < 4; i++)
+            ck_assert_double_eq(a.s.Lambda[i], 0.0);
+        ck_assert(a.s.eta[0] == 0.0 && a.s.eta[1] == 0.0);
+        free(a.mem);
+    }
 }
 END_TEST
 

@@ -447,18 +447,40 @@ static int bad_block_model(const double *x, fe_lm_sink *s, void *ctx)
     return FE_OK;
 }
 
+/* The rows of a report, as given. */
+struct all_rows { int n; fe_lm_iteration row[64]; };
+
+static int keep_all_rows(const fe_lm_iteration *it, void *ctx)
+{
+    struct all_rows *t = ctx;
+    if (t->n < 64)
+        t->row[t->n] = *it;
+    t->n++;
+    return 0;
+}
+
 START_TEST(model_failures_are_handled)
 {
     fe_lm_problem p = {1, 0, 0, sqrt_model, NULL};
     double w[64], x[3] = {100.0, 0, 0};
     fe_lm_params par = fe_lm_default_params();
     fe_lm_result r;
+    static struct all_rows t;
 
     par.lambda0 = 1e-9;                      /* take the bold step first */
     ck_assert_uint_le(fe_lm_work(&p, FE_LM_DENSE), 64);
-    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, keep_all_rows, &t, &r), FE_OK);
     ck_assert_double_eq_tol(x[0], 2.0, 1e-9);
     ck_assert_int_gt(r.iterations, r.accepted);  /* at least one rejection */
+    /* The first step, h = -(10 - sqrt 2) / (1/20) = -171.7 from 100, lands
+       where the model fails: rejected, and its row shows no gain (a
+       positive ratio is a step taken, lm.org).  No rejected row has one. */
+    ck_assert_int_eq(t.n, r.iterations);
+    ck_assert_int_eq(t.row[0].accepted, 0);
+    ck_assert_double_le(t.row[0].ratio, 0.0);
+    for (int i = 0; i < t.n && i < 64; i++)
+        ck_assert_msg(t.row[i].accepted || t.row[i].ratio <= 0.0, "row %d: ratio %g rejected",
+                      i + 1, t.row[i].ratio);
     /* Failure at the start is returned. */
     x[0] = -1.0;
     ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_ENONFINITE);
@@ -478,6 +500,48 @@ START_TEST(model_failures_are_handled)
     par.lambda0 = 0.0;
     p = (fe_lm_problem){1, 0, 0, sqrt_model, NULL};
     ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+}
+END_TEST
+
+/* A quantised measurement, f = floor(x) - 1/2 with the gradient of x: from
+   x = 1/4 every step h = (1/2) / (1 + lambda) stays in [0, 1), where the
+   cost is exactly 1/8, so every gain ratio is exactly 0 and no step is
+   taken.  The damping grows as lambda <- nu lambda, nu <- 2 nu: row k is
+   solved with 1e-3 2^(k(k-1)/2).  The step falls under xtol (|h| <=
+   1e-12 (1/4 + 1e-12)) first at lambda = 1e-3 2^55 = 3.6e13, the 11th
+   step, so the iteration ends there after 10 rows, at x = 1/4.  A
+   relative tolerance of 1e-6, met by the predicted reduction 0.125 (1 + 2
+   lambda) / (1 + lambda)^2 from the 9th row on (lambda = 6.9e7), does not
+   end it: rtol counts only a step taken (lm.h). */
+static int quantised(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double j = 1.0;
+    (void)ctx;
+    return fe_lm_emit(s, floor(x[0]) - 0.5, 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
+START_TEST(a_flat_cost_is_not_a_relative_convergence)
+{
+    fe_lm_problem p = {1, 0, 0, quantised, NULL};
+    double w[64], x[1] = {0.25};
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_result r;
+    static struct all_rows t;
+
+    par.rtol = 1e-6;
+    ck_assert_uint_le(fe_lm_work(&p, FE_LM_DENSE), 64);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, keep_all_rows, &t, &r), FE_OK);
+    ck_assert_int_eq(r.stop, FE_LM_XTOL);
+    ck_assert_int_eq(r.iterations, 10);
+    ck_assert_int_eq(r.accepted, 0);
+    ck_assert_double_eq(x[0], 0.25);
+    ck_assert_double_eq(r.cost, 0.125);
+    ck_assert_int_eq(t.n, 10);
+    for (int k = 1; k <= 10; k++) {
+        ck_assert_double_eq(t.row[k - 1].lambda, ldexp(1e-3, k * (k - 1) / 2));
+        ck_assert_double_eq(t.row[k - 1].ratio, 0.0);
+        ck_assert_int_eq(t.row[k - 1].accepted, 0);
+    }
 }
 END_TEST
 
@@ -938,6 +1002,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, bundle_adjustment_noisy_ends_at_the_optimum);
     tcase_add_test(t, report_table_and_stop);
     tcase_add_test(t, model_failures_are_handled);
+    tcase_add_test(t, a_flat_cost_is_not_a_relative_convergence);
     tcase_add_test(t, sessions_count_their_parameters);
     tcase_add_test(t, sessions_start_at_the_centroids);
     tcase_add_test(t, first_step_is_extended_along_its_line);

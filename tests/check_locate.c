@@ -366,6 +366,39 @@ START_TEST(huge_values_are_refused_and_nothing_infinite_escapes)
 }
 END_TEST
 
+START_TEST(a_lag_one_sum_that_overflows_is_refused)
+{
+    /* Four scalar reports in two blocks (rows 0, 1 | 2, 3), whitened
+       0, a = 1.3e154 | x1 = 1.1e154, x2.  Block 1's squares, 1.21e308 +
+       x2^2, and every single product are doubles; its lag-one sum a x1 +
+       x1 x2 = 1.43e308 + 1.1e154 x2 is one for x2 = -6e153 (7.7e307) and
+       not for x2 = +6e153 (2.09e308 > DBL_MAX = 1.80e308): that report is
+       refused, the accumulation unchanged. */
+    for (int sign = -1; sign <= 1; sign += 2) {
+        fe_innovations inn, before;
+        const double w[4] = {0.0, 1.3e154, 1.1e154, sign * 6e153};
+        double one[1];
+        fe_kalman_report r = {1, 1.0, 0, NULL, one, NULL};
+        ck_assert_int_eq(fe_innovations_init(&inn, 2, 4, 0), FE_OK);
+        for (int i = 0; i < 3; i++) {
+            one[0] = w[i];
+            ck_assert_int_eq(fe_innovations_add(&inn, (double)i, &r), FE_OK);
+        }
+        ck_assert(inn.block[1].acf == 1.3e154 * 1.1e154);
+        memcpy(&before, &inn, sizeof inn);
+        one[0] = w[3];
+        if (sign < 0) {
+            ck_assert_int_eq(fe_innovations_add(&inn, 3.0, &r), FE_OK);
+            ck_assert(inn.block[1].acf == 1.3e154 * 1.1e154 + 1.1e154 * -6e153);
+            ck_assert(inn.block[1].sq == 1.1e154 * 1.1e154 + 6e153 * 6e153);
+        } else {
+            ck_assert_int_eq(fe_innovations_add(&inn, 3.0, &r), FE_ENONFINITE);
+            ck_assert_mem_eq(&inn, &before, sizeof inn);
+        }
+    }
+}
+END_TEST
+
 START_TEST(arguments_merges_that_do_not_fit_and_json)
 {
     fe_innovations a, b, before;
@@ -595,6 +628,26 @@ START_TEST(residual_map_merge_of_parts_equals_whole)
         ck_assert_int_eq(fe_residual_map_init(&b, MAP_BLOCKS, MAP_FIT, 100, map_roles, lo2,
                                               map_hi), FE_OK);
         ck_assert_int_eq(fe_residual_map_merge(&a, &b), FE_EMISMATCH);
+        ck_assert_mem_eq(&a, &keep, sizeof a);
+        /* Each end of each range alone: a part cut from other ranges. */
+        for (int v = 0; v < 3; v++)
+            for (int end = 0; end < 2; end++) {
+                double l[3], h[3];
+                memcpy(l, map_lo, sizeof l);
+                memcpy(h, map_hi, sizeof h);
+                if (end == 0)
+                    l[v] -= 0.5;
+                else
+                    h[v] += 0.5;
+                ck_assert_int_eq(fe_residual_map_init(&b, MAP_BLOCKS, MAP_FIT, 100, map_roles,
+                                                      l, h), FE_OK);
+                ck_assert_msg(fe_residual_map_merge(&a, &b) == FE_EMISMATCH, "v %d end %d", v,
+                              end);
+                ck_assert_mem_eq(&a, &keep, sizeof a);
+            }
+        ck_assert_int_eq(fe_residual_map_init(&b, MAP_BLOCKS, MAP_FIT, 100, map_roles, map_lo,
+                                              map_hi), FE_OK);
+        ck_assert_int_eq(fe_residual_map_merge(&a, &b), FE_OK);     /* the same: an empty part */
         ck_assert_mem_eq(&a, &keep, sizeof a);
         ck_assert_int_eq(fe_residual_map_merge(NULL, &b), FE_EINVAL);
     }
@@ -892,6 +945,17 @@ START_TEST(located_regions_in_json_and_words)
     ck_assert_int_eq(fe_region_describe(&l, words, sizeof words), FE_OK);
     ck_assert_str_eq(words, "|v| 0.5 to 1");
     ck_assert_int_eq(fe_region_describe(&l, words, 5), FE_ESIZE);
+    /* A buffer of one byte holds only the empty string: too small, and
+       terminated; one of none is not written. */
+    words[0] = 'x';
+    ck_assert_int_eq(fe_region_describe(&l, words, 1), FE_ESIZE);
+    ck_assert_int_eq(words[0], '\0');
+    words[0] = 'x';
+    ck_assert_int_ne(fe_region_describe(&l, words, 0), FE_OK);
+    ck_assert_int_eq(words[0], 'x');
+    ck_assert_int_eq(fe_region_describe(&l, words, 13), FE_OK);   /* 12 characters and NUL */
+    ck_assert_str_eq(words, "|v| 0.5 to 1");
+    ck_assert_int_eq(fe_region_describe(&l, words, 12), FE_ESIZE);
     ck_assert_int_eq(fe_located_json(&l, json, sizeof json), FE_OK);
     ck_assert_ptr_nonnull(strstr(json, "{\"kind\": \"state\", \"variable\": \"speed\", "
                                        "\"region\": \"|v| 0.5 to 1\", \"rows\": 120, "
@@ -918,6 +982,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
+    tcase_add_test(t, a_lag_one_sum_that_overflows_is_refused);
     tcase_add_test(t, arguments_merges_that_do_not_fit_and_json);
     tcase_add_test(t, merge_into_an_empty_part_is_the_other_part);
     tcase_add_test(t, json_of_every_length_is_whole_or_refused);

@@ -492,6 +492,61 @@ START_TEST(empty_single_and_bad_arguments)
 }
 END_TEST
 
+/* Rows (1, 0 | 1), (1, 1 | 2), (1, 2 | 4): J'J = [3 3; 3 5], J'r = (7,
+   10), r'r = 21, each exact.  Folded twice and merged, every sum doubles.
+   A fold of m rows reads r[0 .. m) only, and an accumulation its own
+   fe_lsq_storage(p) doubles only: the value after the rows is 1000 (its
+   square would show in r'r), the doubles after each storage are NaN, and
+   nothing changes. */
+START_TEST(only_the_rows_and_storage_given_are_read)
+{
+    enum { TAIL = 8 };
+    const double J[6] = {1, 0, 1, 1, 1, 2}, r[4] = {1, 2, 4, 1000};
+    const double want[3][3] = {{6, 6, 14}, {6, 10, 20}, {14, 20, 42}};
+    double ga[9 + TAIL], gb[9 + TAIL], x[2], rss, score, schur, rssb, work[16];
+    const size_t base[1] = {0}, cand[1] = {1}, three[3] = {0, 1, 0};
+    size_t done;
+    fe_lsq a, b;
+    for (int i = 0; i < 9 + TAIL; i++)
+        ga[i] = gb[i] = NAN;
+    ck_assert_uint_eq(fe_lsq_storage(2), 9);
+    ck_assert_int_eq(fe_lsq_init(&a, 2, ga), FE_OK);
+    ck_assert_int_eq(fe_lsq_init(&b, 2, gb), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, 2, r, NULL, 3, &done), FE_OK);
+    ck_assert_uint_eq(done, 3);
+    ck_assert_int_eq(fe_lsq_add_rows(&b, J, 2, r, NULL, 3, &done), FE_OK);
+    ck_assert(fe_lsq_gram(&b, 2, 2) == 21.0 && fe_lsq_gram(&b, 0, 2) == 7.0
+              && fe_lsq_gram(&b, 1, 1) == 5.0);
+    ck_assert_int_eq(fe_lsq_merge(&a, &b), FE_OK);
+    for (size_t k = 0; k < 3; k++)
+        for (size_t l = 0; l < 3; l++)
+            ck_assert_double_eq(fe_lsq_gram(&a, k, l), want[k][l]);
+    ck_assert_uint_eq(a.n, 6);
+    for (int i = 9; i < 9 + TAIL; i++)
+        ck_assert(isnan(ga[i]) && isnan(gb[i]));
+    /* [3 3; 3 5] x = (7, 10): x = (5/6, 3/2); rss = 2 (21 - 7 x1 - 10 x2) = 1/3. */
+    ck_assert_int_eq(fe_lsq_solve(&a, NULL, 2, x, &rss, NULL, work), FE_OK);
+    FE_ASSERT_REL(x[0], 5.0 / 6.0, 1e-14);
+    FE_ASSERT_REL(x[1], 1.5, 1e-14);
+    FE_ASSERT_REL(rss, 1.0 / 3.0, 1e-12);
+    /* Column 1 added to column 0: s = 10 - 6 6 / 6 = 4, c = 20 - 6 14 / 6
+       = 6, score c^2 / s = 9; the base's rss 42 - 14^2 / 6 = 28 / 3. */
+    ck_assert_int_eq(fe_lsq_scores(&a, base, 1, cand, 1, &score, &schur, &rssb, work), FE_OK);
+    FE_ASSERT_REL(score, 9.0, 1e-13);
+    FE_ASSERT_REL(schur, 4.0, 1e-13);
+    FE_ASSERT_REL(rssb, 28.0 / 3.0, 1e-13);
+    FE_ASSERT_REL(rssb - score, rss, 1e-12);
+    /* Candidates without a list or without scores, each alone; a base
+       longer than p. */
+    ck_assert_int_eq(fe_lsq_scores(&a, base, 1, NULL, 1, &score, NULL, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, base, 1, cand, 1, NULL, NULL, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, NULL, 0, NULL, 1, &score, NULL, NULL, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, three, 3, cand, 1, &score, NULL, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, NULL, 0, cand, 1, &score, NULL, NULL, NULL), FE_OK);
+    ck_assert_double_eq(score, 20.0 * 20.0 / 10.0);     /* no base: G_jr^2 / G_jj */
+}
+END_TEST
+
 START_TEST(exact_fit_has_zero_rss)
 {
     enum { N = 30, Q = 3 };
@@ -607,6 +662,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, bad_rows_are_refused_and_nothing_changes);
     tcase_add_test(t, sparse_rows_are_refused_like_dense_rows);
     tcase_add_test(t, empty_single_and_bad_arguments);
+    tcase_add_test(t, only_the_rows_and_storage_given_are_read);
     tcase_add_test(t, exact_fit_has_zero_rss);
     tcase_add_test(t, sparse_rows_equal_dense_rows);
     tcase_add_test(t, blocked_rows_stop_exactly_at_the_bad_row);

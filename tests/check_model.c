@@ -436,6 +436,48 @@ START_TEST(arguments_and_failing_callbacks)
         ck_assert_int_eq(fe_model_theta(&a, r, NULL, se), FE_EINVAL);
         free(w);
     }
+    /* The parameters read from a result written here: columns 0 and 2
+       (parameters) and 3 (a catalog term) chosen, column 1 set aside.
+       theta = theta0 + coef for 0 and 2, theta0 with se 0 for 1. */
+    memset(r, 0, sizeof *r);
+    r->ncols = 3;
+    r->cols[0] = 2;
+    r->cols[1] = 0;
+    r->cols[2] = 3;
+    r->coef[0] = -0.25;
+    r->coef[1] = 0.5;
+    r->coef[2] = 7.0;
+    r->stderr_[0] = 0.2;
+    r->stderr_[1] = 0.1;
+    r->stderr_[2] = 3.0;
+    se[0] = se[1] = se[2] = -1.0;
+    ck_assert_int_eq(fe_model_theta(&a, r, th, se), FE_EUNDETERMINED);
+    ck_assert(th[0] == theta0[0] + 0.5 && th[1] == theta0[1] && th[2] == theta0[2] - 0.25);
+    ck_assert(se[0] == 0.1 && se[1] == 0.0 && se[2] == 0.2);
+    r->cols[2] = 1;                     /* all three: determined */
+    ck_assert_int_eq(fe_model_theta(&a, r, th, NULL), FE_OK);
+    ck_assert(th[0] == theta0[0] + 0.5 && th[1] == theta0[1] + 7.0 && th[2] == theta0[2] - 0.25);
+    /* p at its largest, FE_MODEL_MAX_PARAMS, is a model; one more is not. */
+    {
+        double th16[FE_MODEL_MAX_PARAMS] = {0}, *st16;
+        size_t n16 = fe_model_acc_doubles(FE_MODEL_MAX_PARAMS, c.count, 4);
+        ck_assert_uint_le(FE_MODEL_MAX_PARAMS + c.count, FE_DISCOVER_MAX_COLUMNS);
+        ck_assert_uint_gt(n16, 0);
+        ck_assert_uint_eq(fe_model_acc_doubles(FE_MODEL_MAX_PARAMS + 1, c.count, 4), 0);
+        st16 = malloc(n16 * sizeof *st16);
+        ck_assert_ptr_nonnull(st16);
+        bad = m;
+        bad.p = FE_MODEL_MAX_PARAMS;
+        bad.theta0 = th16;
+        bad.names = NULL;
+        bad.jacobian = NULL;
+        ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st16, n16), FE_OK);
+        ck_assert_uint_eq(a.ngroups, FE_MODEL_MAX_PARAMS + c.count);
+        ck_assert_str_eq(fe_model_group_name(&a, FE_MODEL_MAX_PARAMS - 1), "theta16");
+        bad.p = FE_MODEL_MAX_PARAMS + 1;
+        ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st16, n16), FE_EINVAL);
+        free(st16);
+    }
     free(st);
     free(copy);
     free(r);

@@ -1004,24 +1004,38 @@ START_TEST(sources_fold_their_concatenation)
     ck_assert_mem_eq(&a, &serial, sizeof a);
 
     /* A source with the wrong observation size, or twice the same source,
-       folds nothing. */
+       folds nothing and reads nothing, from sources rewound to their
+       start (the sources before the bad one have 1200 observations). */
+#define NOTHING_READ()                                          \
+    do {                                                        \
+        ck_assert_uint_eq(a.n, 0);                              \
+        ck_assert_uint_eq(done, 0);                             \
+        for (int t = 0; t < 5; t++)                             \
+            ck_assert_uint_eq(st[t].pos, 0);                    \
+    } while (0)
+    for (int t = 0; t < 5; t++)
+        fe_source_rewind(&src[t]);
     hash_init(&a, NULL);
     sp[1] = &src[0];
     ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    NOTHING_READ();
     sp[1] = &src[1];
-    src[2].obs_size = 4;
+    src[3].obs_size = 4;
     ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
-    ck_assert_uint_eq(a.n, 0);
+    NOTHING_READ();
     /* Nor does a missing source, or one without a next function. */
-    src[2].obs_size = src[1].obs_size;
+    src[3].obs_size = src[1].obs_size;
     sp[3] = NULL;
     ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+    NOTHING_READ();
     {
         fe_source nonext = src[3];
         nonext.next = NULL;
         sp[3] = &nonext;
         ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, pp, &done), FE_EINVAL);
+        NOTHING_READ();
     }
+#undef NOTHING_READ
     sp[3] = &src[3];
     ck_assert_uint_eq(a.n, 0);
     /* The accumulator's and the count's refusals, each with its own code,
@@ -1037,6 +1051,8 @@ START_TEST(sources_fold_their_concatenation)
         ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 0, pp, &done), FE_EINVAL);
         ck_assert_int_eq(fe_parallel_fold_sources(&f, NULL, sp, 5, pp, &done), FE_EINVAL);
         ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 5, NULL, &done), FE_EINVAL);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, NULL, 5, pp, &done), FE_EINVAL);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, NULL, 1, pp, &done), FE_EINVAL);
         ck_assert_uint_eq(a.n, 0);
     }
 }
@@ -1336,7 +1352,17 @@ START_TEST(pipeline_bad_arguments_read_nothing)
         wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
         ring[1].acc = &a;
         wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].acc = NULL;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
         ring[1].acc = keep;
+    }
+    {
+        void *keep = ring[1].obs;
+        ring[1].obs = NULL;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].obs = ring[0].obs;
+        wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
+        ring[1].obs = keep;
     }
     src.obs_size = sizeof x[0] / 2;             /* a source of other observations */
     wrong |= fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, 2, &done) != FE_EINVAL;
