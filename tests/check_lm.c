@@ -786,6 +786,102 @@ START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
 }
 END_TEST
 
+/* The session residual rho - 1, rho = |S (m - o)|, computed here. */
+static double session_residual(const double *x, const double *m)
+{
+    double S[3][3], d[3] = {m[0] - x[6], m[1] - x[7], m[2] - x[8]}, r = 0.0;
+    fe_sessions_matrix(x, S);
+    for (int k = 0; k < 3; k++) {
+        double h = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
+        r += h * h;
+    }
+    return sqrt(r) - 1.0;
+}
+
+START_TEST(sessions_first_step_from_a_numerical_jacobian)
+{
+    /* One session of 40 readings on the ellipsoid |S (m - o)| = 1, and a
+       start 1e-3 off in every parameter.  The first damped Gauss-Newton
+       step, (A + lambda0 diag A) h = -J'f with J by central differences of
+       the residual computed here, is the step the solver reports in its
+       first row: the model's analytic gradients are those of its
+       residuals (an error in one of them moves |h| by far more than the
+       differences' 1e-8). */
+    enum { N = 40, P = 9 };
+    static double m[3 * N];
+    const double truth[P] = {1.1, 0.05, -0.02, 0.9, 0.03, 1.0, 0.3, -0.2, 0.5};
+    double x[P], A[P][P + 1] = {{0}}, J[N][P], f[N], h[P], hn = 0.0, w[4096];
+    fe_rng g = fe_rng_seed(8);
+    fe_sessions c;
+    fe_lm_problem prob;
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_result r;
+    static struct all_rows t;
+    for (int i = 0; i < N; i++) {
+        double S[3][3], d[3], len = 0.0;
+        fe_sessions_matrix(truth, S);
+        fe_rng_unit_vector(&g, d);
+        for (int k = 0; k < 3; k++) {
+            double hk = S[k][0] * d[0] + S[k][1] * d[1] + S[k][2] * d[2];
+            len += hk * hk;
+        }
+        for (int k = 0; k < 3; k++)
+            m[3 * i + k] = truth[6 + k] + d[k] / sqrt(len);
+    }
+    memset(&c, 0, sizeof c);
+    c.count = 1;
+    c.m[0] = m;
+    c.n[0] = N;
+    for (int k = 0; k < P; k++)
+        x[k] = truth[k] + (k % 2 ? 1e-3 : -1e-3);
+    for (int i = 0; i < N; i++) {
+        f[i] = session_residual(x, m + 3 * i);
+        for (int k = 0; k < P; k++) {
+            double xp[P], xm[P], e = 1e-6;
+            memcpy(xp, x, sizeof xp);
+            memcpy(xm, x, sizeof xm);
+            xp[k] += e;
+            xm[k] -= e;
+            J[i][k] = (session_residual(xp, m + 3 * i) - session_residual(xm, m + 3 * i))
+                      / (xp[k] - xm[k]);
+        }
+    }
+    for (int k = 0; k < P; k++) {
+        for (int l = 0; l < P; l++)
+            for (int i = 0; i < N; i++)
+                A[k][l] += J[i][k] * J[i][l];
+        for (int i = 0; i < N; i++)
+            A[k][P] -= J[i][k] * f[i];
+    }
+    for (int k = 0; k < P; k++)
+        A[k][k] *= 1.0 + par.lambda0;
+    for (int k = 0; k < P; k++)                 /* Gauss-Jordan, pivots on the diagonal */
+        for (int i = 0; i < P; i++)
+            if (i != k) {
+                double q = A[i][k] / A[k][k];
+                for (int l = k; l <= P; l++)
+                    A[i][l] -= q * A[k][l];
+            }
+    for (int k = 0; k < P; k++) {
+        h[k] = A[k][P] / A[k][k];
+        hn += h[k] * h[k];
+    }
+    hn = sqrt(hn);
+    prob = fe_sessions_problem(&c);
+    ck_assert_uint_le(fe_lm_work(&prob, FE_LM_DENSE), sizeof w / sizeof w[0]);
+    t.n = 0;
+    ck_assert_int_eq(fe_lm_solve(&prob, FE_LM_DENSE, &par, x, w, keep_all_rows, &t, &r), FE_OK);
+    ck_assert_int_ge(t.n, 1);
+    ck_assert_int_eq(t.row[0].accepted, 1);
+    ck_assert_double_le(fabs(t.row[0].ratio - 1.0), 0.25);     /* not extended */
+    ck_assert_double_eq(t.row[0].lambda, par.lambda0);
+    ck_assert_msg(fabs(t.row[0].step - hn) <= 1e-6 * hn, "step %.10g, want %.10g",
+                  t.row[0].step, hn);
+    for (int k = 0; k < P; k++)
+        ck_assert_double_eq_tol(x[k], truth[k], 1e-9);
+}
+END_TEST
+
 START_TEST(sessions_start_at_the_centroids)
 {
     /* Two sessions of four points (different counts would weight the mean
@@ -1004,6 +1100,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, model_failures_are_handled);
     tcase_add_test(t, a_flat_cost_is_not_a_relative_convergence);
     tcase_add_test(t, sessions_count_their_parameters);
+    tcase_add_test(t, sessions_first_step_from_a_numerical_jacobian);
     tcase_add_test(t, sessions_start_at_the_centroids);
     tcase_add_test(t, first_step_is_extended_along_its_line);
     tcase_add_test(t, second_step_searches_along_the_last_two);

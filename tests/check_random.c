@@ -70,6 +70,19 @@ START_TEST(unit_vectors_are_unit_and_uniform)
             fe_meanvar_add(&c[j], u[j]);
     }
     ck_assert_double_le(worst, 1e-15);
+    {
+        /* u[0..2] and nothing past them: three normal deviates of the same
+           stream, divided by their length. */
+        fe_rng a = fe_rng_seed(5), b = fe_rng_seed(5);
+        double u[4] = {0, 0, 0, 7.0}, z[3], len;
+        fe_rng_unit_vector(&a, u);
+        for (int j = 0; j < 3; j++)
+            z[j] = fe_rng_normal(&b);
+        len = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+        for (int j = 0; j < 3; j++)
+            ck_assert_double_eq_tol(u[j], z[j] / len, 1e-15);
+        ck_assert_double_eq(u[3], 7.0);
+    }
     for (int j = 0; j < 3; j++) {
         ck_assert_double_eq_tol(c[j].mean, 0.0, 5 * sqrt(1.0 / 3 / N));
         /* Var(u^2) = E u^4 - 1/9 = 1/5 - 1/9 for a uniform direction. */

@@ -35,6 +35,29 @@ START_TEST(f_and_chi_square)
 }
 END_TEST
 
+START_TEST(chi_square_quantile_against_closed_forms)
+{
+    /* Two degrees of freedom: P(X <= x) = 1 - exp(-x/2), so the quantile
+       is -2 log(1 - q), down to q = 1e-300.  One degree of freedom, small
+       q: P(X <= x) = erf(sqrt(x/2)) = q gives x = (pi/2) q^2 (1 + x/3 +
+       O(x^2)), to 1e-24 for q <= 1e-6.  The promise is about 1e-13
+       relative. */
+    static const double q2[] = {1e-300, 1e-100, 1e-30, 1e-12, 1e-6, 0.05, 0.5, 0.95, 0.999};
+    static const double q1[] = {1e-30, 1e-12, 1e-6};
+    for (size_t i = 0; i < sizeof q2 / sizeof q2[0]; i++) {
+        double want = -2.0 * log1p(-q2[i]), got = fe_chi2_quantile(q2[i], 2.0);
+        ck_assert_msg(fabs(got - want) <= 1e-13 * want, "dof 2, q %g: %.17g, want %.17g", q2[i],
+                      got, want);
+    }
+    for (size_t i = 0; i < sizeof q1 / sizeof q1[0]; i++) {
+        double x0 = M_PI / 2.0 * q1[i] * q1[i], want = x0 * (1.0 + x0 / 3.0);
+        double got = fe_chi2_quantile(q1[i], 1.0);
+        ck_assert_msg(fabs(got - want) <= 1e-13 * want, "dof 1, q %g: %.17g, want %.17g", q1[i],
+                      got, want);
+    }
+}
+END_TEST
+
 START_TEST(normal_quantile_within_its_promised_error)
 {
     /* References: Python's statistics.NormalDist().inv_cdf (Wichura's
@@ -162,6 +185,7 @@ Suite *fe_special_suite(void)
     TCase *t = tcase_create("core");
     tcase_add_test(t, student_t_table_values);
     tcase_add_test(t, f_and_chi_square);
+    tcase_add_test(t, chi_square_quantile_against_closed_forms);
     tcase_add_test(t, normal_quantile_within_its_promised_error);
     tcase_add_test(t, bad_arguments_give_nan);
     tcase_add_test(t, digamma_and_trigamma_closed_forms);

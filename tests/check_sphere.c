@@ -333,6 +333,137 @@ START_TEST(algebraic_sphere_on_its_own)
 }
 END_TEST
 
+/* The algebraic sphere is the least-squares fit of t = |x - m|^2 on
+   (1, x - m) (m the samples' mean): t ~ k + beta . (x - m), b = m +
+   beta / 2, s = sqrt(k + |beta|^2 / 4).  Redone here over the samples in
+   long double: the covariance s2 N^-1 of (k, beta), s2 = rss / (n - 4)
+   from the residuals themselves, carried to (b, s) by the derivatives
+   db_j/dbeta_j = 1/2, ds/dk = 1/(2s), ds/dbeta_j = beta_j/(4s).  The
+   fit's params, cov (all 16 entries) and se must be those, whatever its
+   own frame. */
+static void algebraic_against_the_samples(const double *x, size_t n)
+{
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_fit f;
+    long double m[3] = {0, 0, 0}, G[4][9] = {{0}}, coef[4], rss = 0, s2, D[4][4] = {{0}};
+    long double cov[4][4], rad;
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, n, NULL), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_algebraic(&q, NULL, &f), FE_OK);
+    ck_assert_int_eq(f.nparams, 4);
+    for (size_t i = 0; i < n; i++)
+        for (int j = 0; j < 3; j++)
+            m[j] += x[3 * i + j] / (long double)n;
+    for (size_t i = 0; i < n; i++) {           /* [N | I | X't] */
+        long double u[4] = {1, x[3 * i] - m[0], x[3 * i + 1] - m[1], x[3 * i + 2] - m[2]};
+        long double t = u[1] * u[1] + u[2] * u[2] + u[3] * u[3];
+        for (int r = 0; r < 4; r++) {
+            for (int c = 0; c < 4; c++)
+                G[r][c] += u[r] * u[c];
+            G[r][8] += u[r] * t;
+        }
+    }
+    for (int r = 0; r < 4; r++)
+        G[r][4 + r] = 1;
+    for (int k = 0; k < 4; k++)                 /* Gauss-Jordan */
+        for (int r = 0; r < 4; r++)
+            if (r != k) {
+                long double fct = G[r][k] / G[k][k];
+                for (int c = 0; c < 9; c++)
+                    G[r][c] -= fct * G[k][c];
+            }
+    for (int r = 0; r < 4; r++) {
+        long double piv = G[r][r];
+        for (int c = 0; c < 9; c++)
+            G[r][c] /= piv;
+        coef[r] = G[r][8];
+    }
+    for (size_t i = 0; i < n; i++) {
+        long double u[3] = {x[3 * i] - m[0], x[3 * i + 1] - m[1], x[3 * i + 2] - m[2]};
+        long double e = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
+                        - (coef[0] + coef[1] * u[0] + coef[2] * u[1] + coef[3] * u[2]);
+        rss += e * e;
+    }
+    s2 = rss / (long double)(n - 4);
+    rad = sqrtl(coef[0] + (coef[1] * coef[1] + coef[2] * coef[2] + coef[3] * coef[3]) / 4);
+    for (int j = 0; j < 3; j++) {
+        FE_ASSERT_REL(f.params[j], (double)(m[j] + coef[1 + j] / 2), 1e-12);
+        D[j][1 + j] = 0.5L;
+        D[3][1 + j] = coef[1 + j] / (4 * rad);
+    }
+    D[3][0] = 1 / (2 * rad);
+    FE_ASSERT_REL(f.params[3], (double)rad, 1e-12);
+    FE_ASSERT_REL(f.radius, (double)rad, 1e-12);
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++) {
+            cov[a][b] = 0;
+            for (int k = 0; k < 4; k++)
+                for (int l = 0; l < 4; l++)
+                    cov[a][b] += D[a][k] * s2 * G[k][4 + l] * D[b][l];
+        }
+    for (int a = 0; a < 4; a++) {
+        FE_ASSERT_REL(f.se[a], (double)sqrtl(cov[a][a]), 1e-8);
+        for (int b = 0; b < 4; b++)
+            ck_assert_msg(fabsl(f.cov[a * 4 + b] - cov[a][b]) <= 1e-8L * sqrtl(cov[a][a] * cov[b][b]),
+                          "cov[%d][%d] %.10g, want %.10Lg", a, b, f.cov[a * 4 + b], cov[a][b]);
+    }
+}
+
+START_TEST(algebraic_covariance_is_the_linear_estimators)
+{
+    /* On an ellipsoid all round, and on a noisy sphere seen only where
+       x > -R/2 and y > -R/2: there the samples' mean is far from the
+       centre, and the linear estimator's covariance differs from the
+       Gauss-Newton one of Schmidt's cost at the same sphere. */
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_rng g = fe_rng_seed(79);
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 77);
+    algebraic_against_the_samples(x, N);
+    for (size_t i = 0; i < N; i++) {
+        double u[3], r = 400.0 + 20.0 * fe_rng_normal(&g);
+        do
+            fe_rng_unit_vector(&g, u);
+        while (u[0] < -0.5 || u[1] < -0.5);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + r * u[j];
+    }
+    algebraic_against_the_samples(x, N);
+}
+END_TEST
+
+START_TEST(params_are_the_fitted_shape)
+{
+    /* params after the offset: s for the sphere (its radius: every
+       semi-axis is s), s1 s2 s3 for the axial ellipsoid (its semi-axes
+       along x, y, z: sorted, the reported axes). */
+    enum { N = 4000 };
+    static double x[3 * N];
+    fe_sphere_fit f;
+    int rc;
+    double s[3];
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 78);
+    f = fit_moments(x, N, FE_FIT_SPHERE, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_int_eq(f.algebraic, 0);
+    FE_ASSERT_REL(f.params[3], f.radius, 1e-13);
+    for (int k = 0; k < 3; k++)
+        FE_ASSERT_REL(f.axes[k], f.radius, 1e-13);
+    f = fit_moments(x, N, FE_FIT_AXIAL, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    memcpy(s, f.params + 3, sizeof s);
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (s[j] < s[i]) {
+                double t = s[i];
+                s[i] = s[j];
+                s[j] = t;
+            }
+    for (int k = 0; k < 3; k++)
+        FE_ASSERT_REL(s[k], f.axes[k], 1e-13);
+    ck_assert(fabs(f.params[4] - R0[1]) < fabs(f.params[4] - R0[0]));  /* y is the shortest */
+}
+END_TEST
+
 START_TEST(trace_and_stop)
 {
     enum { N = 3000 };
@@ -834,6 +965,8 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);
     tcase_add_test(t, algebraic_sphere_on_its_own);
+    tcase_add_test(t, algebraic_covariance_is_the_linear_estimators);
+    tcase_add_test(t, params_are_the_fitted_shape);
     tcase_add_test(t, trace_and_stop);
     tcase_add_test(t, damping_when_a_step_fails);
     tcase_add_test(t, refuse_too_few_and_bad_arguments);

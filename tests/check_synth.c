@@ -35,6 +35,55 @@ START_TEST(spec_refusals_at_their_edges)
     s.effect = NULL;
     ck_assert_int_eq(fe_synth_init(&g, &s), FE_EINVAL);
     ck_assert_int_eq(fe_synth_init(NULL, &s), FE_EINVAL);
+    /* The rig of each order: order 2 is the cart, with no temperature for
+       a thermal effect; order 1 the stand, with no velocity for a
+       friction; order 0 takes either; no order above 2. */
+    {
+        static const struct { const char *effect; size_t order; int rc; } rig[] = {
+            {"newton_cooling", 2, FE_EINVAL}, {"newton_cooling", 1, FE_OK},
+            {"newton_cooling", 0, FE_OK}, {"thermal_sensitivity", 2, FE_EINVAL},
+            {"none_thermal", 2, FE_EINVAL}, {"none_thermal", 1, FE_OK},
+            {"viscous_friction", 2, FE_OK}, {"viscous_friction", 1, FE_EINVAL},
+            {"viscous_friction", 0, FE_OK}, {"viscous_friction", 3, FE_EINVAL},
+        };
+        for (size_t i = 0; i < sizeof rig / sizeof rig[0]; i++) {
+            s = fe_synth_default_spec(rig[i].effect, 3);
+            s.rows = 100;
+            s.order = rig[i].order;
+            ck_assert_msg(fe_synth_init(&g, &s) == rig[i].rc, "%s, order %zu", rig[i].effect,
+                          rig[i].order);
+        }
+    }
+}
+END_TEST
+
+START_TEST(rows_carry_the_central_difference_of_sim)
+{
+    /* dsim of row i is (sim[i+1] - sim[i-1]) / (t[i+1] - t[i-1]), one-sided
+       at the ends (literate/synth.org), recomputed from the rows: on each
+       rig, with and without an effect folded into the motion. */
+    enum { N = 150 };
+    static const struct { const char *effect; size_t order; } cases[] = {
+        {"none", 0}, {"none_thermal", 0}, {"viscous_friction", 2}, {"newton_cooling", 1},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        fe_synth g;
+        fe_synth_spec spec = fe_synth_default_spec(cases[c].effect, 5);
+        fe_sample row[N], end;
+        spec.rows = N;
+        spec.order = cases[c].order;
+        ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+        for (size_t i = 0; i < N; i++)
+            ck_assert_int_eq(fe_synth_next(&g, &row[i]), FE_OK);
+        ck_assert_int_eq(fe_synth_next(&g, &end), FE_END);
+        for (size_t i = 0; i < N; i++) {
+            size_t a = i > 0 ? i - 1 : 0, b = i + 1 < N ? i + 1 : N - 1;
+            double want = (row[b].sim - row[a].sim) / (row[b].t - row[a].t);
+            ck_assert_msg(fabs(row[i].dsim - want) <= 1e-12 * (fabs(want) + 1.0),
+                          "%s row %zu: dsim %.17g, want %.17g", cases[c].effect, i, row[i].dsim,
+                          want);
+        }
+    }
 }
 END_TEST
 
@@ -107,6 +156,7 @@ Suite *fe_synth_suite(void)
     tcase_set_timeout(t, 60);           /* 10^6 rows: about 1 s, more on a busy machine */
     tcase_add_test(t, spec_refusals_at_their_edges);
     tcase_add_test(t, thermal_rig_follows_its_equations);
+    tcase_add_test(t, rows_carry_the_central_difference_of_sim);
     suite_add_tcase(s, t);
     return s;
 }
