@@ -431,6 +431,112 @@ START_TEST(algebraic_covariance_is_the_linear_estimators)
 }
 END_TEST
 
+/* The rows of a fit's trace: damping, acceptance, and the parameters
+   after each iteration (frame of the solve). */
+struct sphere_rows { int n; double lambda[64]; int accepted[64]; double beta[64][4]; };
+
+static int keep_sphere_rows(const fe_sphere_iteration *it, void *ctx)
+{
+    struct sphere_rows *t = ctx;
+    if (t->n < 64) {
+        t->lambda[t->n] = it->lambda;
+        t->accepted[t->n] = it->accepted;
+        memcpy(t->beta[t->n], it->params, 4 * sizeof *it->params);
+    }
+    t->n++;
+    return 0;
+}
+
+START_TEST(sphere_stops_where_the_predicted_decrease_is_rounding)
+{
+    /* With xtol = 0 the fit of the sphere model ends only by the second
+       rule (literate/sphere.org): at the first iteration with lambda <=
+       1e-2 whose step's predicted decrease -2 g'd - d'Hd is below 16 eps
+       N.  Recomputed here over the samples in the frame the fit reports,
+       u = (x - c) / sigma: r = 1 - |u - d|^2 / s^2, J = (2 (u - d) / s^2,
+       2 |u - d|^2 / s^3), g = J'r, H = J'J at the parameters before each
+       iteration (the box guess d = 0, s = 1, then the trace's), and the
+       step from (H + lambda diag H) step = -g.  The last iteration's
+       decrease is under the bound, every earlier one with lambda <= 1e-2
+       over it, each within 10 % (either computation rounds to about 1e-8
+       of the decrease).  Noisy points (sd 20) on an ellipsoid of
+       semi-axes 400, 430, 460, where Gauss-Newton converges only
+       linearly: the decreases are 53, 0.93, 1.9e-4, 1.8e-8 and 8.5e-12
+       against a bound of 1.07e-11, so the rule is held at its edge (the
+       seed was picked for a last decrease within 25 % of the bound). */
+    enum { N = 3000 };
+    static double x[3 * N];
+    fe_rng g = fe_rng_seed(14);
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_options o = fe_sphere_default_options();
+    fe_sphere_fit f;
+    static struct sphere_rows t;
+    const double bound = 16.0 * DBL_EPSILON * N;
+    double before[4] = {0, 0, 0, 1};
+    for (int i = 0; i < N; i++) {
+        double u[3];
+        fe_rng_unit_vector(&g, u);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = 100.0 * j + (400.0 + 30.0 * j) * u[j] + 20.0 * fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    o.xtol = 0.0;
+    o.trace = keep_sphere_rows;
+    o.trace_ctx = &t;
+    t.n = 0;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+    ck_assert_int_eq(t.n, f.iterations);
+    ck_assert_int_le(t.n, 64);
+    for (int k = 0; k < t.n; k++) {
+        long double gg[4] = {0}, H[4][5] = {{0}}, dg[4], pred = 0;
+        double sig = f.frame_scale;
+        for (int i = 0; i < N; i++) {
+            long double v[3], w2 = 0, r, J[4];
+            for (int j = 0; j < 3; j++) {
+                v[j] = (x[3 * i + j] - f.frame_centre[j]) / sig - before[j];
+                w2 += v[j] * v[j];
+            }
+            r = 1 - w2 / ((long double)before[3] * before[3]);
+            for (int j = 0; j < 3; j++)
+                J[j] = 2 * v[j] / ((long double)before[3] * before[3]);
+            J[3] = 2 * w2 / ((long double)before[3] * before[3] * before[3]);
+            for (int a = 0; a < 4; a++) {
+                gg[a] += J[a] * r;
+                for (int b = 0; b < 4; b++)
+                    H[a][b] += J[a] * J[b];
+            }
+        }
+        for (int a = 0; a < 4; a++) {
+            dg[a] = H[a][a];
+            H[a][4] = -gg[a];
+            H[a][a] *= 1 + (long double)t.lambda[k];
+        }
+        for (int c = 0; c < 4; c++)             /* Gauss-Jordan: H[.][4] <- the step */
+            for (int a = 0; a < 4; a++)
+                if (a != c) {
+                    long double fct = H[a][c] / H[c][c];
+                    for (int b = c; b < 5; b++)
+                        H[a][b] -= fct * H[c][b];
+                }
+        /* (H0 + lambda D) st = -g gives st'H0 st = -g'st - lambda st'D st,
+           so the predicted decrease is -g'st + lambda st'D st. */
+        for (int a = 0; a < 4; a++) {
+            long double st = H[a][4] / H[a][a];
+            pred += -gg[a] * st + (long double)t.lambda[k] * dg[a] * st * st;
+        }
+        if (t.lambda[k] <= 1e-2) {
+            if (k + 1 == t.n)
+                ck_assert_msg(pred <= 1.1 * bound, "last row %d: predicted %Lg > %g", k + 1, pred,
+                              bound);
+            else
+                ck_assert_msg(pred > bound / 1.1, "row %d: predicted %Lg <= %g, not the last",
+                              k + 1, pred, bound);
+        }
+        memcpy(before, t.beta[k], sizeof before);
+    }
+}
+END_TEST
+
 START_TEST(params_are_the_fitted_shape)
 {
     /* params after the offset: s for the sphere (its radius: every
@@ -967,6 +1073,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, algebraic_sphere_on_its_own);
     tcase_add_test(t, algebraic_covariance_is_the_linear_estimators);
     tcase_add_test(t, params_are_the_fitted_shape);
+    tcase_add_test(t, sphere_stops_where_the_predicted_decrease_is_rounding);
     tcase_add_test(t, trace_and_stop);
     tcase_add_test(t, damping_when_a_step_fails);
     tcase_add_test(t, refuse_too_few_and_bad_arguments);
