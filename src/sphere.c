@@ -871,3 +871,29 @@ void fe_sphere_apply(const fe_sphere_fit *fit, const double x[3], double y[3])
         y[i] = out[i];
 }
 /* Evaluate and apply a calibration ends here */
+/* [[file:../literate/sphere.org::Scale a calibration to a known field][Scale a calibration to a known field]] */
+int fe_sphere_scale(const fe_sphere_fit *fit, double field, fe_sphere_scaled *out)
+{
+    double f;
+    if (fit == NULL || out == NULL || !(field >= 0.0) || !isfinite(field)
+        || !(fit->radius > 0.0) || !isfinite(fit->radius))
+        return FE_EINVAL;
+    f = field > 0.0 ? field : fit->radius;
+    out->field = f;
+    memcpy(out->offset, fit->offset, sizeof out->offset);
+    for (int k = 0; k < 9; k++)
+        out->matrix[k] = f * fit->matrix[k];
+    out->gain = fit->radius / f;
+    return FE_OK;
+}
+
+void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3], double y[3])
+{
+    double u[3];
+    for (int j = 0; j < 3; j++)
+        u[j] = x[j] - s->offset[j];
+    for (int i = 0; i < 3; i++)
+        y[i] = s->matrix[i * 3] * u[0] + s->matrix[i * 3 + 1] * u[1]
+             + s->matrix[i * 3 + 2] * u[2];
+}
+/* Scale a calibration to a known field ends here */

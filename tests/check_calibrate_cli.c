@@ -210,12 +210,66 @@ START_TEST(refusals_and_errors)
 }
 END_TEST
 
+
+/* --field: the calibrated samples written by --apply have magnitude F, and
+   the gain is the recording's field (cbrt of the product of its semi-axes
+   400, 380, 420) over F. */
+START_TEST(known_field)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[8192], applied[64], line[256];
+    int fd = mkstemp(path), status;
+    double worst = 0.0, F = 47.5;
+    FILE *f;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 2000, WHOLE, NULL);
+    snprintf(applied, sizeof applied, "%s.out", path);
+    status = run("%1$s calibrate --columns mx,my,mz --field 47.5 --json --apply %2$s.out %2$s"
+                 " 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_double_eq(json_number(out, "field", 0), F);
+    ck_assert_double_eq_tol(json_number(out, "gain", 0) * F, cbrt(400.0 * 380 * 420), 0.5);
+    ck_assert_double_eq_tol(json_number(out, "gain", 0) * F, json_number(out, "radius", 0),
+                            1e-9 * F);
+    ck_assert_double_eq_tol(json_number(out, "field_matrix", 0),
+                            F * json_number(out, "matrix", 0), 1e-12);
+    f = fopen(applied, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    while (fgets(line, sizeof line, f) != NULL) {
+        double y[3];
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf", &y[0], &y[1], &y[2]), 3);
+        worst = fmax(worst, fabs(sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) / F - 1));
+    }
+    fclose(f);
+    ck_assert_double_lt(worst, 0.03);    /* noise 2 on a radius of 400 */
+    unlink(applied);
+    status = run("%s calibrate --columns mx,my,mz --field 47.5 %s 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 0);
+    ck_assert_ptr_nonnull(strstr(out, "known field      F = 47.5"));
+    /* No --field: no field in the JSON. */
+    status = run("%s calibrate --columns mx,my,mz --json %s 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 0);
+    ck_assert_ptr_null(strstr(out, "\"gain\""));
+    for (int k = 0; k < 3; k++) {
+        static const char *const bad[3] = {"-1", "0", "inf"};
+        char cmd[256];
+        snprintf(cmd, sizeof cmd, "%%1$s calibrate --columns mx,my,mz --field %s %%2$s 2>&1",
+                 bad[k]);
+        status = run(cmd, path, out, sizeof out);
+        ck_assert_msg(status == 2, "--field %s: status %d: %s", bad[k], status, out);
+    }
+    unlink(path);
+}
+END_TEST
+
 START_TEST(help_documents_everything)
 {
     char out[8192];
     const char *words[] = {"--model", "sphere", "axial", "ellipsoid", "--columns", "--skip",
                            "--json", "--apply OUT.csv", "--trace", "FILE:LINE:COLUMN",
-                           "rms_percent", "coverage", "matrix", "standard input", "algebraic"};
+                           "rms_percent", "coverage", "matrix", "standard input", "algebraic",
+                           "--field F", "gain"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
@@ -261,6 +315,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_test(t, apply_writes_calibrated_samples);
     tcase_add_loop_test(t, refusals_and_errors, 0,
                         (int)(sizeof refusals / sizeof refusals[0]));
+    tcase_add_test(t, known_field);
     tcase_add_test(t, help_documents_everything);
     tcase_add_test(t, real_recording_from_the_command_line);
     suite_add_tcase(s, t);

@@ -820,6 +820,56 @@ START_TEST(real_ximu3_one_hemisphere_is_refused)
 }
 END_TEST
 
+
+/* A known field: an accelerometer whose axes read g1, g2, g3 counts per
+   m/s^2 (semi-axes F g_j), scaled to F = 9.80665: the calibrated samples
+   have magnitude F, and the gain is the geometric mean of the g_j, the
+   counts per m/s^2 the fit cannot tell apart from the field. */
+START_TEST(scale_to_a_known_field)
+{
+    enum { N = 3000 };
+    static double x[3 * N];
+    const double F = 9.80665, g[3] = {400, 380, 420}, c[3] = {35, -20, 60};
+    double r[3], worst = 0.0, y[3];
+    fe_sphere_fit f;
+    fe_sphere_scaled s, before;
+    int rc;
+    for (int j = 0; j < 3; j++)
+        r[j] = F * g[j];
+    fe_test_ellipsoid_points(x, N, c, r, 0.0, 31);
+    f = fit_moments(x, N, FE_FIT_AXIAL, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_int_eq(fe_sphere_scale(&f, F, &s), FE_OK);
+    ck_assert_double_eq(s.field, F);
+    FE_ASSERT_REL(s.gain, cbrt(g[0] * g[1] * g[2]), 1e-9);
+    for (size_t i = 0; i < N; i++) {
+        fe_sphere_scaled_apply(&s, x + 3 * i, y);
+        worst = fmax(worst, fabs(sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) / F - 1.0));
+    }
+    ck_assert_double_le(worst, 1e-9);
+    /* Each axis alone: a sample on the x axis reads F along x. */
+    {
+        double on_x[3] = {c[0] + r[0], c[1], c[2]};
+        fe_sphere_scaled_apply(&s, on_x, y);
+        FE_ASSERT_REL(y[0], F, 1e-9);
+    }
+    /* Field 0: the fitted radius, gain 1. */
+    ck_assert_int_eq(fe_sphere_scale(&f, 0.0, &s), FE_OK);
+    FE_ASSERT_REL(s.field, F * cbrt(g[0] * g[1] * g[2]), 1e-9);
+    ck_assert_double_eq(s.gain, 1.0);
+    /* Bad fields and NULLs: FE_EINVAL, the output unchanged. */
+    before = s;
+    ck_assert_int_eq(fe_sphere_scale(&f, -1.0, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_scale(&f, NAN, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_scale(&f, INFINITY, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_scale(NULL, F, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_scale(&f, F, NULL), FE_EINVAL);
+    ck_assert_mem_eq(&before, &s, sizeof s);
+    f.radius = 0.0;
+    ck_assert_int_eq(fe_sphere_scale(&f, F, &s), FE_EINVAL);
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -830,6 +880,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_loop_test(t, three_algorithms_agree, 0, 3);
     tcase_add_test(t, extents_are_in_half_widths_of_the_fitted_ellipsoid);
     tcase_add_test(t, calibration_maps_to_the_unit_sphere);
+    tcase_add_test(t, scale_to_a_known_field);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);

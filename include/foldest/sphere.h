@@ -139,6 +139,29 @@ int fe_sphere_cost(const fe_quadric *q, const fe_sphere_fit *fit,
 void fe_sphere_apply(const fe_sphere_fit *fit, const double x[3],
                      double y[3]);
 
+/* A calibration scaled to a known field F: y = matrix (x - offset) has
+   magnitude F (9.80665 for an accelerometer in m/s^2, the local Earth
+   field for a magnetometer), and how the fit's field compares with F. */
+typedef struct fe_sphere_scaled {
+    double field;               /* F, in the units the user chose */
+    double offset[3];           /* b, the sensor's units */
+    double matrix[9];           /* F M, row-major */
+    double gain;                /* fitted radius / F: sensor units per unit of F */
+} fe_sphere_scaled;
+
+/* fe_sphere_scale: the calibration `fit` scaled so that calibrated
+   samples have magnitude `field`; field 0 takes the fitted radius (the
+   calibrated samples stay in the sensor's units, gain 1).  FE_EINVAL for
+   NULL, or a field that is negative or not finite, or a fit without a
+   radius; then *out is unchanged.  No allocation. */
+int fe_sphere_scale(const fe_sphere_fit *fit, double field,
+                    fe_sphere_scaled *out);
+
+/* fe_sphere_scaled_apply: y = matrix (x - offset), magnitude about F.
+   x and y may be the same array. */
+void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3],
+                            double y[3]);
+
 /* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
    fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */
 const char *fe_sphere_model_name(int model);

@@ -10,6 +10,7 @@
 static const char fe__calibrate_help[] =
     "usage: foldest calibrate [--model sphere|axial|ellipsoid] [--columns a,b,c]\n"
     "                         [--skip N] [--json] [--trace] [--apply OUT.csv]\n"
+    "                         [--field F]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -30,7 +31,13 @@ static const char fe__calibrate_help[] =
     "                  iterations, algebraic, refusal\n"
     "  --trace         print the Gauss-Newton iterations on standard error\n"
     "  --apply OUT.csv write the calibrated samples R M (x - b) (R: the fitted\n"
-    "                  field) to OUT.csv; needs a file, not standard input\n"
+    "                  field, or F with --field) to OUT.csv; needs a file, not\n"
+    "                  standard input\n"
+    "  --field F       the known field: calibrated samples have magnitude F\n"
+    "                  (9.80665 for an accelerometer in m/s^2, the local Earth\n"
+    "                  field for a magnetometer); the report gives the fitted\n"
+    "                  field R against F (gain R/F, sensor units per unit of F)\n"
+    "                  and --json adds field, field_matrix (F M) and gain\n"
     "\n"
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
     "From a file a second pass counts the coverage exactly from the fitted centre\n"
@@ -52,6 +59,7 @@ typedef struct fe__calibrate_args {
     const char *path, *apply;
     char *columns;
     long skip;
+    double field;               /* 0: not given */
     int json, trace;
     fe_sphere_model model;
 } fe__calibrate_args;
@@ -60,7 +68,7 @@ typedef struct fe__calibrate_args {
    --help, printed). */
 static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
-    {"--trace", 0}, {NULL, 0}};
+    {"--trace", 0}, {"--field", 1}, {NULL, 0}};
 
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
@@ -84,6 +92,14 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
             if (fe_sphere_model_parse(argv[++i], &a->model) != FE_OK) {
                 fprintf(stderr, "foldest calibrate: --model: '%s' is not sphere, axial or ellipsoid\n",
                         argv[i]);
+                return FE_CLI_USAGE;
+            }
+        } else if (strcmp(argv[i], "--field") == 0 && i + 1 < argc) {
+            int bad = fe_cli_parse_double("--field", argv[++i], &a->field, err, sizeof err)
+                      != FE_CLI_OK;
+            if (bad || !(a->field > 0.0) || !isfinite(a->field)) {
+                fprintf(stderr, "foldest calibrate: %s\n",
+                        bad ? err : "--field: the field must be positive");
                 return FE_CLI_USAGE;
             }
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
@@ -188,6 +204,7 @@ typedef struct fe__calibrate_pass2 {
 static int fe__calibrate_second_pass(const fe__calibrate_args *a,
                                      const size_t cols[3],
                                      const fe_sphere_fit *fit,
+                                     const fe_sphere_scaled *sc,
                                      fe__calibrate_pass2 *out)
 {
     char err[1024];
@@ -225,9 +242,10 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
             hit[r] = 1;
         len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
         ss += (len - 1.0) * (len - 1.0);
-        if (apply != NULL)
-            fprintf(o.file, "%.10g,%.10g,%.10g\n", fit->radius * y[0],
-                    fit->radius * y[1], fit->radius * y[2]);
+        if (apply != NULL) {
+            fe_sphere_scaled_apply(sc, x, y);
+            fprintf(o.file, "%.10g,%.10g,%.10g\n", y[0], y[1], y[2]);
+        }
         fe_cli_progress(t);
     }
     fe_cli_progress_done(t);
@@ -270,6 +288,7 @@ static void fe__calibrate_json_key(const char *key, double x)
 }
 
 static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
+                               const fe_sphere_scaled *sc, double field,
                                int rc, const fe__calibrate_pass2 *p2)
 {
     int fitted = rc == FE_OK || f->refusal == FE_SPHERE_HEMISPHERE
@@ -297,6 +316,16 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         printf(", \"params_se\": ");
         fe__calibrate_json_array(f->se, f->nparams);
         fe__calibrate_json_key("rms_percent", f->rms_percent);
+        if (field > 0.0) {
+            fe__calibrate_json_key("field", sc->field);
+            printf(", \"field_matrix\": [");
+            for (int i = 0; i < 3; i++) {
+                printf("%s", i ? ", " : "");
+                fe__calibrate_json_array(sc->matrix + 3 * i, 3);
+            }
+            printf("]");
+            fe__calibrate_json_key("gain", sc->gain);
+        }
     } else {
         printf(", \"offset\": null, \"matrix\": null, \"rms_percent\": null");
     }
@@ -324,6 +353,7 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
 }
 
 static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
+                               const fe_sphere_scaled *sc, double field,
                                const fe__calibrate_pass2 *p2)
 {
     static const char *const axis[3] = {"x", "y", "z"};
@@ -338,6 +368,15 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
                f->matrix[3 * i + 2]);
     printf("  field            %.6g (semi-axes %.6g %.6g %.6g)\n", f->radius, f->axes[0],
            f->axes[1], f->axes[2]);
+    if (field > 0.0) {
+        printf("  known field      F = %.6g: the fitted field is %.6g F (gain %.6g sensor\n"
+               "                   units per unit of F); calibrated samples y = F M (x - b)\n",
+               sc->field, sc->gain, sc->gain);
+        printf("  matrix F M\n");
+        for (int i = 0; i < 3; i++)
+            printf("      %14.7g %14.7g %14.7g\n", sc->matrix[3 * i], sc->matrix[3 * i + 1],
+                   sc->matrix[3 * i + 2]);
+    }
     if (f->model != FE_FIT_ELLIPSOID) {
         printf("  scales          ");
         for (int k = 3; k < f->nparams; k++)
@@ -393,6 +432,7 @@ int fe_cli_calibrate(int argc, char **argv)
     fe_cli_table t;
     fe_quadric q;
     fe_sphere_fit fit;
+    fe_sphere_scaled sc;
     size_t cols[3];
     char err[1024];
     int rc = fe__calibrate_parse(argc, argv, &a), fitrc;
@@ -415,22 +455,25 @@ int fe_cli_calibrate(int argc, char **argv)
         opt.trace = fe__calibrate_trace;
     fitrc = fe_sphere_fit_moments(&q, a.model, &opt, &fit);
     memset(&p2, 0, sizeof p2);
+    memset(&sc, 0, sizeof sc);
+    if (fitrc == FE_OK && fe_sphere_scale(&fit, a.field, &sc) != FE_OK)
+        fitrc = FE_EINVAL;      /* not reached: an accepted fit has a radius */
     if (fitrc == FE_OK) {
-        rc = fe__calibrate_second_pass(&a, cols, &fit, &p2);
+        rc = fe__calibrate_second_pass(&a, cols, &fit, &sc, &p2);
         if (rc != FE_CLI_OK) {
             fe_cli_table_close(&t);
             return rc;
         }
     }
     if (a.json)
-        fe__calibrate_json(&t, &fit, fitrc, &p2);
+        fe__calibrate_json(&t, &fit, &sc, a.field, fitrc, &p2);
     if (fitrc != FE_OK) {
         fe__calibrate_refusal(&t, &fit, fitrc);
         fe_cli_table_close(&t);
         return FE_CLI_REFUSED;
     }
     if (!a.json)
-        fe__calibrate_text(&t, &fit, &p2);
+        fe__calibrate_text(&t, &fit, &sc, a.field, &p2);
     fe_cli_table_close(&t);
     return FE_CLI_OK;
 }
