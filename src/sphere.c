@@ -897,3 +897,22 @@ void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3], double
              + s->matrix[i * 3 + 2] * u[2];
 }
 /* Scale a calibration to a known field ends here */
+/* [[file:../literate/sphere.org::Express a calibration as ArduPilot's parameters][Express a calibration as ArduPilot's parameters]] */
+int fe_sphere_to_ardupilot(const fe_sphere_fit *fit, double field_mgauss,
+                           double mgauss_per_unit, fe_sphere_ardupilot *out)
+{
+    double K = mgauss_per_unit, w;
+    if (fit == NULL || out == NULL || !(K > 0.0) || !isfinite(K) || !(field_mgauss >= 0.0)
+        || !isfinite(field_mgauss) || !(fit->radius > 0.0) || !isfinite(fit->radius))
+        return FE_EINVAL;
+    w = field_mgauss > 0.0 ? field_mgauss / K : fit->radius;     /* F / K */
+    for (int j = 0; j < 3; j++) {
+        out->ofs[j] = -K * fit->offset[j];
+        out->dia[j] = w * fit->matrix[4 * j];
+    }
+    out->odi[0] = w * fit->matrix[1];
+    out->odi[1] = w * fit->matrix[2];
+    out->odi[2] = w * fit->matrix[5];
+    return FE_OK;
+}
+/* Express a calibration as ArduPilot's parameters ends here */

@@ -263,13 +263,125 @@ START_TEST(known_field)
 }
 END_TEST
 
+
+/* --export ardupilot: the parameter file, applied ArduPilot's way to the
+   raw samples (in gauss here: --mgauss 1000), h' = mat (1000 x + OFS),
+   gives 1000 times the samples --apply writes with --field 0.48 (gauss) and
+   --field 480 (milligauss, for the export); --export c: a header that
+   compiles, with the offset and the matrix of --json. */
+START_TEST(export_for_firmware)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[8192], cmd[1024], line[256], hdr[64];
+    char name[32], applied[64], prog[64];
+    int fd = mkstemp(path), status, got = 0;
+    double ofs[3] = {0}, dia[3] = {0}, odi[3] = {0}, worst = 0.0, v;
+    FILE *fa, *fr;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 2000, WHOLE, NULL);
+    status = run("%1$s calibrate --columns mx,my,mz --model ellipsoid --export ardupilot"
+                 " --mgauss 1000 --field 480 %2$s", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    for (char *l = strtok(out, "\n"); l != NULL; l = strtok(NULL, "\n")) {
+        char axis;
+        if (l[0] == '#')
+            continue;
+        ck_assert_int_eq(sscanf(l, "COMPASS_%3[A-Z]_%c %lf", name, &axis, &v), 3);
+        ck_assert(axis >= 'X' && axis <= 'Z');
+        if (strcmp(name, "OFS") == 0)
+            ofs[axis - 'X'] = v;
+        else if (strcmp(name, "DIA") == 0)
+            dia[axis - 'X'] = v;
+        else if (strcmp(name, "ODI") == 0)
+            odi[axis - 'X'] = v;
+        else
+            ck_abort_msg("unexpected parameter %s", l);
+        got++;
+    }
+    ck_assert_int_eq(got, 9);
+    /* The recording's centre (100, -50, 30) in milligauss, negated. */
+    ck_assert_double_eq_tol(ofs[0], -100e3, 500);
+    ck_assert_double_eq_tol(ofs[1], 50e3, 500);
+    snprintf(applied, sizeof applied, "%s.out", path);
+    status = run("%1$s calibrate --columns mx,my,mz --model ellipsoid --field 0.48"
+                 " --apply %2$s.out %2$s", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    fa = fopen(applied, "r");
+    fr = fopen(path, "r");
+    ck_assert_ptr_nonnull(fa);
+    ck_assert_ptr_nonnull(fr);
+    for (int k = 0; k < 3; k++)         /* metadata and header */
+        ck_assert_ptr_nonnull(fgets(line, sizeof line, fr));
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, fa));
+    while (fgets(line, sizeof line, fa) != NULL) {
+        double y[3], t, x[3], h[3], mat[9] = {dia[0], odi[0], odi[1], odi[0], dia[1],
+                                              odi[2], odi[1], odi[2], dia[2]};
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf", &y[0], &y[1], &y[2]), 3);
+        ck_assert_ptr_nonnull(fgets(line, sizeof line, fr));
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf,%lf", &t, &x[0], &x[1], &x[2]), 4);
+        for (int j = 0; j < 3; j++)
+            h[j] = 1000 * x[j] + ofs[j];
+        for (int k = 0; k < 3; k++) {
+            double hk = mat[3 * k] * h[0] + mat[3 * k + 1] * h[1] + mat[3 * k + 2] * h[2];
+            worst = fmax(worst, fabs(hk - 1000 * y[k]));
+        }
+    }
+    fclose(fa);
+    fclose(fr);
+    ck_assert_double_lt(worst, 1e-3);   /* of a field of 480: printing's rounding */
+    unlink(applied);
+    /* The C header compiles, and holds what --json says. */
+    snprintf(hdr, sizeof hdr, "%s.h", path);
+    snprintf(cmd, sizeof cmd, "%%1$s calibrate --columns mx,my,mz --model ellipsoid --field 1"
+                              " --export c %%2$s > %%2$s.h");
+    ck_assert_int_eq(run(cmd, path, out, sizeof out), 0);
+    fe_test_read_file(hdr, out, sizeof out);
+    ck_assert_ptr_nonnull(strstr(out, "static const float FOLDEST_CAL_FIELD = 1.00000000f;"));
+    {
+        const char *m = strstr(out, "FOLDEST_CAL_MATRIX[3][3] = {\n    {");
+        char json[8192];
+        double m00;
+        ck_assert_ptr_nonnull(m);
+        ck_assert_int_eq(sscanf(m + strlen("FOLDEST_CAL_MATRIX[3][3] = {\n    {"), "%lf", &m00), 1);
+        ck_assert_int_eq(run("%s calibrate --columns mx,my,mz --model ellipsoid --json %s", path,
+                             json, sizeof json), 0);
+        FE_ASSERT_REL(m00, json_number(json, "matrix", 0), 1e-7);
+    }
+    snprintf(prog, sizeof prog, "%s.c", path);
+    fa = fopen(prog, "w");
+    ck_assert_ptr_nonnull(fa);
+    fprintf(fa, "#include \"%s\"\nint main(void) { return (int)(FOLDEST_CAL_FIELD"
+                " * FOLDEST_CAL_MATRIX[0][0] * FOLDEST_CAL_OFFSET[0] * 0.0f); }\n", hdr);
+    fclose(fa);
+    snprintf(cmd, sizeof cmd, "cc -std=c11 -Wall -Wextra -Werror -pedantic -fsyntax-only %s 2>&1",
+             prog);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 0);
+    unlink(prog);
+    unlink(hdr);
+    /* Errors: an unknown format, a bad factor, two outputs. */
+    ck_assert_int_eq(run("%s calibrate --columns mx,my,mz --export matlab %s 2>&1", path, out,
+                         sizeof out), 2);
+    ck_assert_ptr_nonnull(strstr(out, "not ardupilot, c or json"));
+    ck_assert_int_eq(run("%s calibrate --columns mx,my,mz --export ardupilot --mgauss 0 %s 2>&1",
+                         path, out, sizeof out), 2);
+    ck_assert_int_eq(run("%s calibrate --columns mx,my,mz --export c --json %s 2>&1", path, out,
+                         sizeof out), 2);
+    /* json: the --json object. */
+    ck_assert_int_eq(run("%s calibrate --columns mx,my,mz --export json %s", path, out,
+                         sizeof out), 0);
+    ck_assert_ptr_nonnull(strstr(out, "\"refusal\": null"));
+    unlink(path);
+}
+END_TEST
+
 START_TEST(help_documents_everything)
 {
     char out[8192];
     const char *words[] = {"--model", "sphere", "axial", "ellipsoid", "--columns", "--skip",
                            "--json", "--apply OUT.csv", "--trace", "FILE:LINE:COLUMN",
                            "rms_percent", "coverage", "matrix", "standard input", "algebraic",
-                           "--field F", "gain"};
+                           "--field F", "gain", "--export", "COMPASS_OFS_X",
+                           "COMPASS_DIA_X", "COMPASS_ODI_X", "milligauss", "--mgauss"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
@@ -316,6 +428,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_loop_test(t, refusals_and_errors, 0,
                         (int)(sizeof refusals / sizeof refusals[0]));
     tcase_add_test(t, known_field);
+    tcase_add_test(t, export_for_firmware);
     tcase_add_test(t, help_documents_everything);
     tcase_add_test(t, real_recording_from_the_command_line);
     suite_add_tcase(s, t);

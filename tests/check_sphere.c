@@ -870,6 +870,74 @@ START_TEST(scale_to_a_known_field)
 }
 END_TEST
 
+
+/* ArduPilot's parameters, the worked example of sphere.org: a sensor in
+   gauss (K = 1000) centred at (0.1, -0.05, 0.03) G with semi-axes 0.4,
+   0.5, 0.45 G and the known field 480 mG.  ArduPilot corrects h = K x as
+   mat (h + ofs) (AP_Compass_Backend::correct_field); applied that way to
+   any sample the parameters give K times foldest's own calibrated sample
+   scaled to 0.48 G. */
+START_TEST(ardupilot_parameters)
+{
+    enum { N = 2000 };
+    static double x[3 * N];
+    const double c[3] = {0.1, -0.05, 0.03}, r[3] = {0.4, 0.5, 0.45}, K = 1000, F = 480;
+    fe_sphere_fit f;
+    fe_sphere_scaled s;
+    fe_sphere_ardupilot ap, before;
+    double worst = 0.0;
+    int rc;
+    fe_test_ellipsoid_points(x, N, c, r, 0.0, 5);
+    /* Tilt it, so that the off-diagonal terms are not zero. */
+    for (size_t i = 0; i < N; i++) {
+        double u = x[3 * i + 1] - c[1], v = x[3 * i + 2] - c[2];
+        x[3 * i + 1] = c[1] + cos(0.3) * u - sin(0.3) * v;
+        x[3 * i + 2] = c[2] + sin(0.3) * u + cos(0.3) * v;
+    }
+    f = fit_moments(x, N, FE_FIT_ELLIPSOID, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, F, K, &ap), FE_OK);
+    ck_assert_int_eq(fe_sphere_scale(&f, F / K, &s), FE_OK);
+    for (int j = 0; j < 3; j++)
+        ck_assert_double_eq_tol(ap.ofs[j], -K * c[j], 1e-9);
+    /* The x axis is untouched by the tilt: D_x = F / (K r_x), as in the prose. */
+    ck_assert_double_eq_tol(ap.dia[0], 1.2, 1e-9);
+    ck_assert_double_eq_tol(ap.odi[0], 0.0, 1e-9);
+    ck_assert_double_eq_tol(ap.odi[1], 0.0, 1e-9);
+    ck_assert_double_gt(fabs(ap.odi[2]), 0.01);
+    for (size_t i = 0; i < N; i++) {
+        double h[3], out[3], y[3];
+        const double mat[9] = {ap.dia[0], ap.odi[0], ap.odi[1], ap.odi[0], ap.dia[1],
+                               ap.odi[2], ap.odi[1], ap.odi[2], ap.dia[2]};
+        for (int j = 0; j < 3; j++)
+            h[j] = K * x[3 * i + j] + ap.ofs[j];          /* mag += offsets */
+        for (int k = 0; k < 3; k++)
+            out[k] = mat[3 * k] * h[0] + mat[3 * k + 1] * h[1] + mat[3 * k + 2] * h[2];
+        fe_sphere_scaled_apply(&s, x + 3 * i, y);
+        for (int j = 0; j < 3; j++)
+            worst = fmax(worst, fabs(out[j] - K * y[j]));
+        ck_assert_double_eq_tol(sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]), F,
+                                1e-6);
+    }
+    ck_assert_double_le(worst, 1e-9);
+    {   /* The sample on the x axis: h + ofs = (400, 0, 0), corrected (480, 0, 0). */
+        const double on_x[3] = {0.5, -0.05, 0.03};
+        double h0 = K * on_x[0] + ap.ofs[0];
+        ck_assert_double_eq_tol(h0, 400.0, 1e-9);
+        ck_assert_double_eq_tol(ap.dia[0] * h0, 480.0, 1e-6);
+    }
+    /* Field 0: the fitted field K R; mat = R M. */
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, 0.0, K, &ap), FE_OK);
+    ck_assert_double_eq_tol(ap.dia[0], cbrt(r[0] * r[1] * r[2]) / r[0], 1e-9);
+    before = ap;
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, F, 0.0, &ap), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, -F, K, &ap), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, F, NAN, &ap), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(NULL, F, K, &ap), FE_EINVAL);
+    ck_assert_mem_eq(&before, &ap, sizeof ap);
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -881,6 +949,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, extents_are_in_half_widths_of_the_fitted_ellipsoid);
     tcase_add_test(t, calibration_maps_to_the_unit_sphere);
     tcase_add_test(t, scale_to_a_known_field);
+    tcase_add_test(t, ardupilot_parameters);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);

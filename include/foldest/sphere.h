@@ -162,6 +162,25 @@ int fe_sphere_scale(const fe_sphere_fit *fit, double field,
 void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3],
                             double y[3]);
 
+/* ArduPilot's compass parameters: its driver corrects a reading h in
+   milligauss as mat (h + ofs), mat symmetric with diagonal dia and
+   off-diagonal odi = (m12, m13, m23). */
+typedef struct fe_sphere_ardupilot {
+    double ofs[3];              /* COMPASS_OFS_X/Y/Z, milligauss */
+    double dia[3];              /* COMPASS_DIA_X/Y/Z */
+    double odi[3];              /* COMPASS_ODI_X/Y/Z */
+} fe_sphere_ardupilot;
+
+/* fe_sphere_to_ardupilot: ArduPilot's parameters for `fit`, whose samples
+   are in units of mgauss_per_unit milligauss (K: 1 in milligauss, 1000 in
+   gauss): ofs = -K b and mat = F M / K, so that ArduPilot's corrected
+   field has magnitude field_mgauss (F; 0: the fitted field K R, and mat
+   is then R M, near the identity).  FE_EINVAL for NULL, a fit without a
+   radius, K not finite and positive, or F negative or not finite (*out
+   unchanged).  No allocation. */
+int fe_sphere_to_ardupilot(const fe_sphere_fit *fit, double field_mgauss,
+                           double mgauss_per_unit, fe_sphere_ardupilot *out);
+
 /* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
    fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */
 const char *fe_sphere_model_name(int model);

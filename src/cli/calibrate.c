@@ -10,7 +10,8 @@
 static const char fe__calibrate_help[] =
     "usage: foldest calibrate [--model sphere|axial|ellipsoid] [--columns a,b,c]\n"
     "                         [--skip N] [--json] [--trace] [--apply OUT.csv]\n"
-    "                         [--field F]\n"
+    "                         [--field F] [--export ardupilot|c|json]\n"
+    "                         [--mgauss K]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -38,6 +39,15 @@ static const char fe__calibrate_help[] =
     "                  field for a magnetometer); the report gives the fitted\n"
     "                  field R against F (gain R/F, sensor units per unit of F)\n"
     "                  and --json adds field, field_matrix (F M) and gain\n"
+    "  --export FORMAT print the calibration for firmware instead of the report:\n"
+    "                  ardupilot: a parameter file, COMPASS_OFS_X/Y/Z (= -b, in\n"
+    "                  milligauss: ArduPilot adds its offsets), COMPASS_DIA_X/Y/Z\n"
+    "                  and COMPASS_ODI_X/Y/Z (the symmetric matrix F M, applied\n"
+    "                  after the offsets; --field in milligauss); c: a C header\n"
+    "                  with the offset b and the matrix F M as float arrays,\n"
+    "                  y = M (x - b); json: as --json\n"
+    "  --mgauss K      milligauss per sensor unit for --export ardupilot\n"
+    "                  (default 1: the samples are in milligauss; 1000 for gauss)\n"
     "\n"
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
     "From a file a second pass counts the coverage exactly from the fitted centre\n"
@@ -55,11 +65,15 @@ static const char fe__calibrate_help[] =
     "Progress is shown on standard error for large files when it is a terminal.\n";
 /* Calibrate Includes and Help ends here */
 /* [[file:../../literate/calibrate.org::Calibrate Options][Calibrate Options]] */
+enum fe__calibrate_export { FE__EXPORT_NONE, FE__EXPORT_ARDUPILOT, FE__EXPORT_C };
+
 typedef struct fe__calibrate_args {
     const char *path, *apply;
     char *columns;
     long skip;
     double field;               /* 0: not given */
+    double mgauss;              /* milligauss per sensor unit */
+    int export_format;          /* fe__calibrate_export */
     int json, trace;
     fe_sphere_model model;
 } fe__calibrate_args;
@@ -68,7 +82,7 @@ typedef struct fe__calibrate_args {
    --help, printed). */
 static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
-    {"--trace", 0}, {"--field", 1}, {NULL, 0}};
+    {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {NULL, 0}};
 
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
@@ -76,6 +90,7 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     int rc;
     memset(a, 0, sizeof *a);
     a->skip = -1;
+    a->mgauss = 1.0;
     a->model = FE_FIT_AXIAL;
     rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
     if (rc != FE_CLI_OK)
@@ -102,6 +117,27 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                         bad ? err : "--field: the field must be positive");
                 return FE_CLI_USAGE;
             }
+        } else if (strcmp(argv[i], "--export") == 0 && i + 1 < argc) {
+            const char *fmt = argv[++i];
+            if (strcmp(fmt, "ardupilot") == 0)
+                a->export_format = FE__EXPORT_ARDUPILOT;
+            else if (strcmp(fmt, "c") == 0)
+                a->export_format = FE__EXPORT_C;
+            else if (strcmp(fmt, "json") == 0)
+                a->json = 1;
+            else {
+                fprintf(stderr, "foldest calibrate: --export: '%s' is not ardupilot, c or json\n",
+                        fmt);
+                return FE_CLI_USAGE;
+            }
+        } else if (strcmp(argv[i], "--mgauss") == 0 && i + 1 < argc) {
+            int bad = fe_cli_parse_double("--mgauss", argv[++i], &a->mgauss, err, sizeof err)
+                      != FE_CLI_OK;
+            if (bad || !(a->mgauss > 0.0) || !isfinite(a->mgauss)) {
+                fprintf(stderr, "foldest calibrate: %s\n",
+                        bad ? err : "--mgauss: the factor must be positive");
+                return FE_CLI_USAGE;
+            }
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
             a->columns = argv[++i];
         } else if (strcmp(argv[i], "--apply") == 0 && i + 1 < argc) {
@@ -125,6 +161,11 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     }
     if (a->path == NULL) {
         fputs(fe__calibrate_help, stderr);
+        return FE_CLI_USAGE;
+    }
+    if (a->export_format != FE__EXPORT_NONE && a->json) {
+        fprintf(stderr, "foldest calibrate: one output: --export %s or --json\n",
+                a->export_format == FE__EXPORT_C ? "c" : "ardupilot");
         return FE_CLI_USAGE;
     }
     if (a->apply != NULL && strcmp(a->path, "-") == 0) {
@@ -398,6 +439,47 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
            f->extent_lo[2], f->extent_hi[2]);
 }
 
+/* --export ardupilot: a parameter file as ArduPilot's tools load it (NAME
+   VALUE, # comments); --export c: a header. */
+static void fe__calibrate_export(const fe__calibrate_args *a, const fe_cli_table *t,
+                                 const fe_sphere_fit *f, const fe_sphere_scaled *sc)
+{
+    static const char xyz[3] = {'X', 'Y', 'Z'};
+    if (a->export_format == FE__EXPORT_ARDUPILOT) {
+        fe_sphere_ardupilot ap;
+        (void)fe_sphere_to_ardupilot(f, a->field, a->mgauss, &ap);  /* checked args */
+        printf("# foldest calibrate: %s, %s fit of %llu samples, rms %.3f %%\n", t->name,
+               fe_sphere_model_name(f->model), (unsigned long long)f->n, f->rms_percent);
+        printf("# ArduPilot corrects h (milligauss) as mat (h + OFS); %g mG per sensor unit;\n"
+               "# corrected field %.6g mG%s\n", a->mgauss,
+               a->field > 0.0 ? a->field : a->mgauss * f->radius,
+               a->field > 0.0 ? " (--field)" : " (the fitted field)");
+        for (int j = 0; j < 3; j++)
+            printf("COMPASS_OFS_%c %.9g\n", xyz[j], ap.ofs[j]);
+        for (int j = 0; j < 3; j++)
+            printf("COMPASS_DIA_%c %.9g\n", xyz[j], ap.dia[j]);
+        for (int j = 0; j < 3; j++)
+            printf("COMPASS_ODI_%c %.9g\n", xyz[j], ap.odi[j]);
+        return;
+    }
+    printf("/* foldest calibrate: %s, %s fit of %llu samples, rms %.3f %% */\n", t->name,
+           fe_sphere_model_name(f->model), (unsigned long long)f->n, f->rms_percent);
+    printf("/* Calibrated sample: y = FOLDEST_CAL_MATRIX (x - FOLDEST_CAL_OFFSET),\n"
+           "   |y| = FOLDEST_CAL_FIELD (%s). */\n",
+           a->field > 0.0 ? "the known field, --field" : "the fitted field, sensor units");
+    printf("#ifndef FOLDEST_CAL_H\n#define FOLDEST_CAL_H\n");
+    /* %#.9g keeps the decimal point: 1 prints as 1.00000000, and 1.f is a
+       float literal where 1f is not; nine digits round-trip a float. */
+    printf("static const float FOLDEST_CAL_FIELD = %#.9gf;\n", sc->field);
+    printf("static const float FOLDEST_CAL_OFFSET[3] = {%#.9gf, %#.9gf, %#.9gf};\n",
+           sc->offset[0], sc->offset[1], sc->offset[2]);
+    printf("static const float FOLDEST_CAL_MATRIX[3][3] = {\n");
+    for (int i = 0; i < 3; i++)
+        printf("    {%#.9gf, %#.9gf, %#.9gf}%s\n", sc->matrix[3 * i], sc->matrix[3 * i + 1],
+               sc->matrix[3 * i + 2], i < 2 ? "," : "");
+    printf("};\n#endif\n");
+}
+
 static void fe__calibrate_refusal(const fe_cli_table *t, const fe_sphere_fit *f, int rc)
 {
     fprintf(stderr, "foldest calibrate: %s: %s fit refused: %s\n", t->name,
@@ -472,7 +554,9 @@ int fe_cli_calibrate(int argc, char **argv)
         fe_cli_table_close(&t);
         return FE_CLI_REFUSED;
     }
-    if (!a.json)
+    if (a.export_format != FE__EXPORT_NONE)
+        fe__calibrate_export(&a, &t, &fit, &sc);
+    else if (!a.json)
         fe__calibrate_text(&t, &fit, &sc, a.field, &p2);
     fe_cli_table_close(&t);
     return FE_CLI_OK;
