@@ -710,3 +710,100 @@ fe_accumulator fe_quadric_accumulator(const double *centre)
     return f;
 }
 /* Moments as an accumulator ends here */
+/* [[file:../literate/quadric.org::Fold in blocks of consecutive samples][Fold in blocks of consecutive samples]] */
+int fe_quadric_blocks_init(fe_quadric_blocks *qb)
+{
+    if (qb == NULL)
+        return FE_EINVAL;
+    *qb = (fe_quadric_blocks){.all = FE_QUADRIC_EMPTY, .block_len = 1};
+    return FE_OK;
+}
+
+/* Merge neighbours pairwise: blocks 2k and 2k+1 become block k. */
+static int fe__quadric_blocks_halve(fe_quadric_blocks *qb)
+{
+    uint32_t n = qb->nblocks, k;
+    for (k = 0; 2 * k < n; k++) {
+        fe_quadric pair = qb->block[2 * k];
+        if (2 * k + 1 < n) {
+            int rc = fe_quadric_merge(&pair, &qb->block[2 * k + 1]);
+            if (rc != FE_OK)
+                return rc;
+        }
+        qb->block[k] = pair;
+    }
+    for (uint32_t j = k; j < n; j++)
+        qb->block[j] = (fe_quadric)FE_QUADRIC_EMPTY;
+    qb->nblocks = k;
+    qb->block_len = (qb->block_len ? qb->block_len : 1) * 2;
+    return FE_OK;
+}
+
+int fe_quadric_blocks_add(fe_quadric_blocks *qb, const double x[3])
+{
+    fe_quadric cur = FE_QUADRIC_EMPTY, all;
+    uint64_t len;
+    int fresh, rc;
+    if (qb == NULL || x == NULL)
+        return FE_EINVAL;
+    len = qb->block_len ? qb->block_len : 1;
+    fresh = qb->nblocks == 0 || qb->block[qb->nblocks - 1].m[0] >= (double)len;
+    if (!fresh)
+        cur = qb->block[qb->nblocks - 1];
+    rc = fe_quadric_add(&cur, x);
+    if (rc != FE_OK)
+        return rc;
+    all = qb->all;
+    rc = fe_quadric_add(&all, x);
+    if (rc != FE_OK)
+        return rc;
+    if (fresh && qb->nblocks == FE_QUADRIC_BLOCKS) {
+        fe_quadric_blocks keep = *qb;
+        rc = fe__quadric_blocks_halve(qb);
+        if (rc != FE_OK) {
+            *qb = keep;
+            return rc;
+        }
+    }
+    qb->all = all;
+    if (fresh)
+        qb->nblocks++;
+    qb->block[qb->nblocks - 1] = cur;
+    return FE_OK;
+}
+
+int fe_quadric_blocks_merge(fe_quadric_blocks *a, const fe_quadric_blocks *b)
+{
+    fe_quadric_blocks x, y;
+    int rc;
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (b->nblocks == 0)
+        return FE_OK;
+    x = *a;
+    y = *b;
+    if (x.block_len == 0)
+        x.block_len = 1;
+    if (y.block_len == 0)
+        y.block_len = 1;
+    rc = fe_quadric_merge(&x.all, &y.all);
+    while (rc == FE_OK && x.nblocks > 0 && x.block_len < y.block_len)
+        rc = fe__quadric_blocks_halve(&x);
+    while (rc == FE_OK && x.nblocks > 0 && y.block_len < x.block_len)
+        rc = fe__quadric_blocks_halve(&y);
+    if (x.nblocks == 0)
+        x.block_len = y.block_len;
+    while (rc == FE_OK && x.nblocks + y.nblocks > FE_QUADRIC_BLOCKS) {
+        rc = fe__quadric_blocks_halve(&x);
+        if (rc == FE_OK)
+            rc = fe__quadric_blocks_halve(&y);
+    }
+    if (rc != FE_OK)
+        return rc;
+    for (uint32_t k = 0; k < y.nblocks; k++)
+        x.block[x.nblocks + k] = y.block[k];
+    x.nblocks += y.nblocks;
+    *a = x;
+    return FE_OK;
+}
+/* Fold in blocks of consecutive samples ends here */

@@ -97,6 +97,9 @@ START_TEST(fit_json_and_text)
     ck_assert_double_lt(json_number(out, "rms_radial_percent", 0), 0.6);
     ck_assert_double_eq(json_number(out, "coverage", 0), 1.0);
     ck_assert_double_gt(json_number(out, "offset_se", 0), 0.0);
+    ck_assert_double_gt(json_number(out, "offset_se_iid", 0), 0.0);
+    ck_assert_double_eq(json_number(out, "se_blocks", 0), 12);  /* 3000 in blocks of 256 */
+    ck_assert_double_gt(json_number(out, "matrix_se", 0), 0.0);
     /* The full ellipsoid, and the plain text. */
     status = run("%s calibrate --columns 2,3,4 --model ellipsoid %s 2>&1", path, out, sizeof out);
     ck_assert_msg(status == 0, "status %d: %s", status, out);
@@ -381,7 +384,8 @@ START_TEST(help_documents_everything)
                            "--json", "--apply OUT.csv", "--trace", "FILE:LINE:COLUMN",
                            "rms_percent", "coverage", "matrix", "standard input", "algebraic",
                            "--field F", "gain", "--export", "COMPASS_OFS_X",
-                           "COMPASS_DIA_X", "COMPASS_ODI_X", "milligauss", "--mgauss"};
+                           "COMPASS_DIA_X", "COMPASS_ODI_X", "milligauss", "--mgauss",
+                           "offset_se_iid", "matrix_se", "batch means"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);

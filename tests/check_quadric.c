@@ -505,6 +505,79 @@ START_TEST(state_size)
 }
 END_TEST
 
+
+/* Blocks in time: `all` is the plain fold, the blocks partition the stream
+   in order (every block block_len long but the last, 8 to 16 of them),
+   two halves split at a multiple of the block length merge into exactly
+   the fold of the whole, and a refused sample changes nothing. */
+START_TEST(blocks_partition_the_stream_and_merge_in_time)
+{
+    enum { N = 4096 + 77 };
+    static double x[3 * N];
+    static fe_quadric_blocks whole, a, b, before;
+    const double c[3] = {10, -20, 5}, r[3] = {30, 45, 60};
+    fe_quadric plain = FE_QUADRIC_EMPTY, sum = FE_QUADRIC_EMPTY;
+    double apart, total = 0.0;
+    fe_test_ellipsoid_points(x, N, c, r, 0.5, 4);
+    ck_assert_int_eq(fe_quadric_blocks_init(&whole), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        ck_assert_int_eq(fe_quadric_blocks_add(&whole, x + 3 * i), FE_OK);
+        ck_assert_int_eq(fe_quadric_add(&plain, x + 3 * i), FE_OK);
+        if (i + 1 >= FE_QUADRIC_BLOCKS) {
+            ck_assert_uint_ge(whole.nblocks, FE_QUADRIC_BLOCKS / 2);
+            ck_assert_uint_le(whole.nblocks, FE_QUADRIC_BLOCKS);
+        }
+    }
+    ck_assert_mem_eq(&whole.all, &plain, sizeof plain);
+    /* 4173 samples in blocks of 512: 8 full and one of 77. */
+    ck_assert_uint_eq(whole.block_len, 512);
+    ck_assert_uint_eq(whole.nblocks, 9);
+    for (uint32_t k = 0; k < whole.nblocks; k++) {
+        double want = k + 1 < whole.nblocks ? 512.0 : 77.0;
+        ck_assert_double_eq(whole.block[k].m[0], want);
+        /* Block k holds samples 512 k ..: its extremes are theirs. */
+        for (int j = 0; j < 3; j++) {
+            double lo = INFINITY;
+            for (size_t i = 512 * k; i < 512 * k + (size_t)want; i++)
+                lo = fmin(lo, x[3 * i + j]);
+            ck_assert_double_eq(whole.block[k].lo[j], lo);
+        }
+        ck_assert_int_eq(fe_quadric_merge(&sum, &whole.block[k]), FE_OK);
+        total += whole.block[k].m[0];
+    }
+    ck_assert_double_eq(total, N);
+    ck_assert_int_eq(fe_quadric_recentre(&sum, plain.ref), FE_OK);
+    ck_assert_int_eq(fe_quadric_compare(&sum, &plain, &apart), FE_OK);
+    ck_assert_double_le(apart, 1e-12);
+    /* Halves at 2048: blocks of 128 each, merged into blocks of 512. */
+    fe_quadric_blocks_init(&a);
+    fe_quadric_blocks_init(&b);
+    for (size_t i = 0; i < N; i++)
+        ck_assert_int_eq(fe_quadric_blocks_add(i < 2048 ? &a : &b, x + 3 * i), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_merge(&a, &b), FE_OK);
+    ck_assert_uint_eq(a.nblocks, whole.nblocks);
+    ck_assert_uint_eq(a.block_len, whole.block_len);
+    for (uint32_t k = 0; k < a.nblocks; k++) {
+        fe_quadric moved = a.block[k];
+        ck_assert_double_eq(moved.m[0], whole.block[k].m[0]);
+        ck_assert_int_eq(fe_quadric_recentre(&moved, whole.block[k].ref), FE_OK);
+        ck_assert_int_eq(fe_quadric_compare(&moved, &whole.block[k], &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+    }
+    /* Refused samples: nothing changes. */
+    before = whole;
+    {
+        const double bad[3] = {NAN, 1, 2}, huge[3] = {1e300, 0, 0};
+        ck_assert_int_eq(fe_quadric_blocks_add(&whole, bad), FE_ENONFINITE);
+        ck_assert_int_ne(fe_quadric_blocks_add(&whole, huge), FE_OK);
+    }
+    ck_assert_mem_eq(&before, &whole, sizeof whole);
+    ck_assert_int_eq(fe_quadric_blocks_add(NULL, x), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_merge(&whole, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_init(NULL), FE_EINVAL);
+}
+END_TEST
+
 Suite *fe_quadric_suite(void)
 {
     Suite *s = suite_create("quadric");
@@ -514,6 +587,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, empty_and_one_sample);
     tcase_add_test(t, step_equals_block);
     tcase_add_test(t, two_shards_equal_one);
+    tcase_add_test(t, blocks_partition_the_stream_and_merge_in_time);
     tcase_add_test(t, merge_every_split_and_associativity);
     tcase_add_test(t, merged_hemispheres_cover_the_sphere);
     tcase_add_test(t, recentre_equals_accumulating_there);

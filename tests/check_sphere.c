@@ -938,6 +938,145 @@ START_TEST(ardupilot_parameters)
 }
 END_TEST
 
+
+/* A hand-turned recording: the direction wanders slowly (a random walk on
+   the sphere) and the noise is an AR(1) process with correlation 0.98
+   from sample to sample.  Over 40 such recordings the offsets scatter far
+   more than the independent-sample errors say; the batch-means errors
+   match the scatter.  On independent samples both errors agree. */
+static void hand_turned(double *x, size_t n, double rho, double walk, uint64_t seed)
+{
+    fe_rng g = fe_rng_seed(seed);
+    double v[3], e[3] = {0, 0, 0};
+    fe_rng_unit_vector(&g, v);
+    for (size_t i = 0; i < n; i++) {
+        double len = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] += walk * fe_rng_normal(&g);
+            len += v[j] * v[j];
+        }
+        for (int j = 0; j < 3; j++) {
+            v[j] /= sqrt(len);
+            e[j] = rho * e[j] + sqrt(1.0 - rho * rho) * 4.0 * fe_rng_normal(&g);
+            x[3 * i + j] = C0[j] + R0[j] * v[j] + e[j];
+        }
+    }
+}
+
+START_TEST(batch_means_errors_match_the_scatter)
+{
+    enum { N = 16384, RUNS = 40 };
+    static double x[3 * N];
+    static fe_quadric_blocks qb;
+    for (int kind = 0; kind < 2; kind++) {
+        double sum[3] = {0}, sq[3] = {0}, se[3] = {0}, iid[3] = {0};
+        for (int run = 0; run < RUNS; run++) {
+            fe_sphere_fit f;
+            if (kind == 0)
+                hand_turned(x, N, 0.98, 0.15, 100 + (uint64_t)run);
+            else
+                hand_turned(x, N, 0.0, 10.0, 100 + (uint64_t)run);
+            fe_quadric_blocks_init(&qb);
+            for (size_t i = 0; i < N; i++)
+                ck_assert_int_eq(fe_quadric_blocks_add(&qb, x + 3 * i), FE_OK);
+            ck_assert_int_eq(fe_sphere_fit_blocks(&qb, FE_FIT_ELLIPSOID, NULL, &f), FE_OK);
+            ck_assert_int_ge(f.se_blocks, 8);
+            for (int j = 0; j < 3; j++) {
+                sum[j] += f.offset[j];
+                sq[j] += f.offset[j] * f.offset[j];
+                se[j] += f.se[j] / RUNS;
+                iid[j] += f.se_iid[j] / RUNS;
+                ck_assert_double_gt(f.matrix_se[4 * j], 0.0);
+            }
+        }
+        for (int j = 0; j < 3; j++) {
+            double mean = sum[j] / RUNS, sd = sqrt((sq[j] - RUNS * mean * mean) / (RUNS - 1));
+            /* 40 runs know the scatter to about 11 %.  The blocks (1024 to
+               2048 samples) are 10 to 20 times the noise's correlation
+               time (1.98 / 0.02 = 99 samples); shorter blocks miss part
+               of the correlation (with N = 4096 the ratio was 0.71). */
+            ck_assert_msg(se[j] / sd > 0.65 && se[j] / sd < 1.5,
+                          "kind %d axis %d: batch-means error %g, scatter %g", kind, j, se[j], sd);
+            if (kind == 0)
+                ck_assert_msg(iid[j] / sd < 0.4, "axis %d: independent error %g, scatter %g", j,
+                              iid[j], sd);
+            else
+                ck_assert_msg(iid[j] / sd > 0.7 && iid[j] / sd < 1.4,
+                              "axis %d: independent error %g, scatter %g", j, iid[j], sd);
+        }
+    }
+}
+END_TEST
+
+/* The matrix's errors, against the scatter of M over seeds (independent
+   samples; the ellipsoid tilted so that off-diagonal entries move too). */
+START_TEST(matrix_errors_match_the_scatter)
+{
+    enum { N = 3000, RUNS = 40 };
+    static double x[3 * N];
+    double sum[9] = {0}, sq[9] = {0}, se[9] = {0};
+    for (int run = 0; run < RUNS; run++) {
+        fe_sphere_fit f;
+        int rc;
+        fe_test_ellipsoid_points(x, N, C0, R0, 4.0, 700 + (uint64_t)run);
+        for (size_t i = 0; i < N; i++) {
+            double u = x[3 * i] - C0[0], v = x[3 * i + 1] - C0[1];
+            x[3 * i] = C0[0] + cos(0.4) * u - sin(0.4) * v;
+            x[3 * i + 1] = C0[1] + sin(0.4) * u + cos(0.4) * v;
+        }
+        f = fit_moments(x, N, FE_FIT_ELLIPSOID, &rc);
+        ck_assert_int_eq(rc, FE_OK);
+        for (int k = 0; k < 9; k++) {
+            sum[k] += f.matrix[k];
+            sq[k] += f.matrix[k] * f.matrix[k];
+            se[k] += f.matrix_se[k] / RUNS;
+        }
+    }
+    for (int k = 0; k < 9; k++) {
+        double mean = sum[k] / RUNS, sd = sqrt(fmax(sq[k] - RUNS * mean * mean, 0.0) / (RUNS - 1));
+        ck_assert_msg(se[k] / sd > 0.7 && se[k] / sd < 1.4, "entry %d: error %g, scatter %g", k,
+                      se[k], sd);
+    }
+}
+END_TEST
+
+/* The QMC5883L recording's halves: 8 to 14 independent-sample errors
+   apart, within 3 batch-means errors (sphere.org, "Honest standard
+   errors"). */
+START_TEST(real_qmc5883l_halves_agree_within_their_errors)
+{
+    const char *dir = fe_test_data_dir("qmc5883l halves");
+    const char *names[3] = {"mx", "my", "mz"};
+    static fe_quadric_blocks h[2];
+    size_t n;
+    double *x, worst_iid = 0.0;
+    if (dir == NULL)
+        return;
+    x = recording(dir, "qmc5883l_tomisuarez/filtered_raw_data.csv", names, 3, &n);
+    for (int model = FE_FIT_AXIAL; model <= FE_FIT_ELLIPSOID; model++) {
+        fe_sphere_fit f[2];
+        for (int k = 0; k < 2; k++) {
+            fe_quadric_blocks_init(&h[k]);
+            for (size_t i = k ? n / 2 : 0; i < (k ? n : n / 2); i++)
+                ck_assert_int_eq(fe_quadric_blocks_add(&h[k], x + 3 * i), FE_OK);
+            ck_assert_int_eq(fe_sphere_fit_blocks(&h[k], (fe_sphere_model)model, NULL, &f[k]),
+                             FE_OK);
+            ck_assert_int_ge(f[k].se_blocks, 8);
+        }
+        for (int j = 0; j < 3; j++) {
+            double d = fabs(f[0].offset[j] - f[1].offset[j]);
+            double apart = d / hypot(f[0].se[j], f[1].se[j]);
+            double apart_iid = d / hypot(f[0].se_iid[j], f[1].se_iid[j]);
+            ck_assert_msg(apart < 3.0, "model %d axis %d: %g errors apart", model, j, apart);
+            if (model == FE_FIT_ELLIPSOID)
+                worst_iid = fmax(worst_iid, apart_iid);
+        }
+    }
+    ck_assert_double_gt(worst_iid, 8.0);    /* what the independent errors said */
+    free(x);
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -950,6 +1089,8 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, calibration_maps_to_the_unit_sphere);
     tcase_add_test(t, scale_to_a_known_field);
     tcase_add_test(t, ardupilot_parameters);
+    tcase_add_test(t, batch_means_errors_match_the_scatter);
+    tcase_add_test(t, matrix_errors_match_the_scatter);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);
@@ -962,6 +1103,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, refuse_a_hyperboloid);
     tcase_add_test(t, refuse_a_singular_system);
     tcase_add_test(r, real_qmc5883l_soft_iron);
+    tcase_add_test(r, real_qmc5883l_halves_agree_within_their_errors);
     tcase_add_test(r, real_ck_explorer_magnetometer);
     tcase_add_test(r, real_imucal_ferraris_static_poses);
     tcase_add_test(r, real_mpu6050_static_poses);

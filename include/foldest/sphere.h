@@ -91,6 +91,11 @@ typedef struct fe_sphere_fit {
                                    is the algebraic least-squares sphere */
     double frame_centre[3];     /* c and sigma of the solve's frame */
     double frame_scale;
+    double matrix_se[9];        /* standard errors of matrix's entries */
+    double se_iid[FE_SPHERE_MAX_PARAMS]; /* the errors independent samples
+                                   would have (se when se_blocks is 0) */
+    int se_blocks;              /* 0: se assumes independent samples; B:
+                                   batch means over B blocks in time */
 } fe_sphere_fit;
 
 /* fe_sphere_fit_moments: (iii), the fit users call.  Fits `model` to the
@@ -102,6 +107,16 @@ typedef struct fe_sphere_fit {
    a few dozen 10x10 products per iteration, independent of N. */
 int fe_sphere_fit_moments(const fe_quadric *q, fe_sphere_model model,
                           const fe_sphere_options *opt, fe_sphere_fit *fit);
+
+/* fe_sphere_fit_blocks: fe_sphere_fit_moments on qb->all, with standard
+   errors (se, cov, matrix_se) from the spread of the estimating equations
+   over qb's blocks in time (batch means), which holds for correlated
+   samples; se_iid keeps the independent-sample errors.  With fewer than 8
+   blocks, or for the algebraic sphere, the errors are the independent
+   ones and se_blocks is 0.  Errors as fe_sphere_fit_moments.  No
+   allocation; cost: one 10 x 10 moment matrix per block. */
+int fe_sphere_fit_blocks(const fe_quadric_blocks *qb, fe_sphere_model model,
+                         const fe_sphere_options *opt, fe_sphere_fit *fit);
 
 /* fe_sphere_fit_algebraic: the algebraic least-squares sphere, fitted
    linearly from the moments (what fe_sphere_fit_moments falls back to when

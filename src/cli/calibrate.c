@@ -26,7 +26,8 @@ static const char fe__calibrate_help[] =
     "  --skip N        skip N lines before the header (default: found\n"
     "                  automatically after metadata lines)\n"
     "  --json          print one JSON object: model, n, offset, offset_se,\n"
-    "                  matrix (3x3, to the unit sphere), radius, axes, params,\n"
+    "                  offset_se_iid, se_blocks, matrix (3x3, to the unit\n"
+    "                  sphere), matrix_se, radius, axes, params,\n"
     "                  params_se, rms_percent, rms_radial_percent, coverage,\n"
     "                  coverage_fold, planarity, extent_lo, extent_hi,\n"
     "                  iterations, algebraic, refusal\n"
@@ -50,6 +51,10 @@ static const char fe__calibrate_help[] =
     "                  (default 1: the samples are in milligauss; 1000 for gauss)\n"
     "\n"
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
+    "The moments are also kept for 8 to 16 consecutive blocks in time, and the\n"
+    "standard errors come from the blocks' spread (batch means): they hold for\n"
+    "correlated samples, as a sensor turned by hand gives (offset_se_iid: what\n"
+    "independent samples would give).\n"
     "From a file a second pass counts the coverage exactly from the fitted centre\n"
     "(100 equal-area regions), measures the radial RMS error, and writes --apply.\n"
     "rms_percent is 50 sqrt(S/n), S the sum of (1 - |y|^2)^2: the RMS radial\n"
@@ -207,14 +212,14 @@ static int fe__calibrate_columns(fe_cli_table *t, char *spec, size_t cols[3])
     return FE_CLI_OK;
 }
 
-static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[3], fe_quadric *q)
+static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[3], fe_quadric_blocks *q)
 {
     char err[1024];
     double x[3];
     int rc;
-    fe_quadric_init(q, NULL);
+    fe_quadric_blocks_init(q);
     while ((rc = fe_cli_table_next(t, cols, 3, x, err, sizeof err)) == FE_OK) {
-        rc = fe_quadric_add(q, x);
+        rc = fe_quadric_blocks_add(q, x);
         if (rc != FE_OK) {
             fe_cli_progress_done(t);
             fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line,
@@ -343,6 +348,15 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         fe__calibrate_json_array(f->offset, 3);
         printf(", \"offset_se\": ");
         fe__calibrate_json_array(f->se, 3);
+        printf(", \"offset_se_iid\": ");
+        fe__calibrate_json_array(f->se_iid, 3);
+        printf(", \"se_blocks\": %d", f->se_blocks);
+        printf(", \"matrix_se\": [");
+        for (int i = 0; i < 3; i++) {
+            printf("%s", i ? ", " : "");
+            fe__calibrate_json_array(f->matrix_se + 3 * i, 3);
+        }
+        printf("]");
         printf(", \"matrix\": [");
         for (int i = 0; i < 3; i++) {
             printf("%s", i ? ", " : "");
@@ -403,10 +417,16 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
     printf("  offset b         ");
     for (int j = 0; j < 3; j++)
         printf("  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
-    printf("\n  matrix M (y = M (x - b) on the unit sphere)\n");
+    printf("\n  matrix M (y = M (x - b) on the unit sphere), +- standard errors\n");
     for (int i = 0; i < 3; i++)
-        printf("      %14.7g %14.7g %14.7g\n", f->matrix[3 * i], f->matrix[3 * i + 1],
-               f->matrix[3 * i + 2]);
+        printf("      %14.7g %14.7g %14.7g    +- %9.2g %9.2g %9.2g\n", f->matrix[3 * i],
+               f->matrix[3 * i + 1], f->matrix[3 * i + 2], f->matrix_se[3 * i],
+               f->matrix_se[3 * i + 1], f->matrix_se[3 * i + 2]);
+    if (f->se_blocks > 0)
+        printf("  errors           from the spread of %d blocks in time (batch means): the\n"
+               "                   offsets' are %.2g, %.2g, %.2g times what independent\n"
+               "                   samples would give\n", f->se_blocks, f->se[0] / f->se_iid[0],
+               f->se[1] / f->se_iid[1], f->se[2] / f->se_iid[2]);
     printf("  field            %.6g (semi-axes %.6g %.6g %.6g)\n", f->radius, f->axes[0],
            f->axes[1], f->axes[2]);
     if (field > 0.0) {
@@ -512,7 +532,7 @@ int fe_cli_calibrate(int argc, char **argv)
     fe__calibrate_pass2 p2;
     fe_sphere_options opt = fe_sphere_default_options();
     fe_cli_table t;
-    fe_quadric q;
+    fe_quadric_blocks q;
     fe_sphere_fit fit;
     fe_sphere_scaled sc;
     size_t cols[3];
@@ -535,7 +555,7 @@ int fe_cli_calibrate(int argc, char **argv)
     }
     if (a.trace)
         opt.trace = fe__calibrate_trace;
-    fitrc = fe_sphere_fit_moments(&q, a.model, &opt, &fit);
+    fitrc = fe_sphere_fit_blocks(&q, a.model, &opt, &fit);
     memset(&p2, 0, sizeof p2);
     memset(&sc, 0, sizeof sc);
     if (fitrc == FE_OK && fe_sphere_scale(&fit, a.field, &sc) != FE_OK)
