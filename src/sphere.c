@@ -1102,3 +1102,99 @@ int fe_sphere_fit_blocks(const fe_quadric_blocks *qb, fe_sphere_model model,
     return fe__sphere_block_errors(qb, fit);
 }
 /* Measure the errors from blocks in time ends here */
+/* [[file:../literate/sphere.org::Find the still segments][Find the still segments]] */
+enum { FE__STILL_SLOT = 7 };    /* x, y, z, |x|, |rate|, verdict, spare */
+
+fe_still_options fe_still_default_options(void)
+{
+    fe_still_options o = {50, 0.002, 0.0};
+    return o;
+}
+
+size_t fe_still_workspace(size_t window)
+{
+    return FE__STILL_SLOT * window;
+}
+
+int fe_still_init(fe_still *s, const fe_still_options *opt, double *work, size_t work_len)
+{
+    fe_still_options o = opt != NULL ? *opt : fe_still_default_options();
+    if (s == NULL || work == NULL || o.window < 2 || !(o.max_rel_sd >= 0.0)
+        || !isfinite(o.max_rel_sd) || !(o.max_rate >= 0.0) || !isfinite(o.max_rate))
+        return FE_EINVAL;
+    if (work_len < fe_still_workspace(o.window))
+        return FE_ESIZE;
+    memset(s, 0, sizeof *s);
+    s->opt = o;
+    s->ring = work;
+    return FE_OK;
+}
+
+/* Hand back the oldest sample held. */
+static void fe__still_pop(fe_still *s, double out[3], int *still)
+{
+    const double *slot = s->ring + FE__STILL_SLOT * s->head;
+    for (int j = 0; j < 3; j++)
+        out[j] = slot[j];
+    *still = slot[5] != 0.0;
+    if (*still)
+        s->still++;
+    else
+        s->moving++;
+    s->head = (s->head + 1) % s->opt.window;
+    s->count--;
+}
+
+/* Judge the full window: the sd of |x| against its mean, the largest rate. */
+static void fe__still_judge(fe_still *s)
+{
+    size_t w = s->opt.window;
+    double mean = 0.0, ss = 0.0, worst = 0.0;
+    for (size_t k = 0; k < w; k++)
+        mean += s->ring[FE__STILL_SLOT * k + 3] / (double)w;
+    for (size_t k = 0; k < w; k++) {
+        double d = s->ring[FE__STILL_SLOT * k + 3] - mean;
+        ss += d * d;
+        worst = fmax(worst, s->ring[FE__STILL_SLOT * k + 4]);
+    }
+    if (sqrt(ss / (double)(w - 1)) <= s->opt.max_rel_sd * mean
+        && (s->opt.max_rate == 0.0 || worst <= s->opt.max_rate))
+        for (size_t k = 0; k < w; k++)
+            s->ring[FE__STILL_SLOT * k + 5] = 1.0;
+}
+
+int fe_still_push(fe_still *s, const double x[3], const double *rate, double out[3],
+                  int *still, int *ready)
+{
+    double *slot;
+    if (s == NULL || x == NULL || out == NULL || still == NULL || ready == NULL)
+        return FE_EINVAL;
+    for (int j = 0; j < 3; j++)
+        if (!isfinite(x[j]) || (rate != NULL && !isfinite(rate[j])))
+            return FE_ENONFINITE;
+    *ready = s->count == s->opt.window;
+    if (*ready)
+        fe__still_pop(s, out, still);
+    slot = s->ring + FE__STILL_SLOT * ((s->head + s->count) % s->opt.window);
+    for (int j = 0; j < 3; j++)
+        slot[j] = x[j];
+    slot[3] = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    slot[4] = rate != NULL ? sqrt(rate[0] * rate[0] + rate[1] * rate[1] + rate[2] * rate[2])
+                           : 0.0;
+    slot[5] = 0.0;
+    s->count++;
+    if (s->count == s->opt.window)
+        fe__still_judge(s);
+    return FE_OK;
+}
+
+int fe_still_flush(fe_still *s, double out[3], int *still)
+{
+    if (s == NULL || out == NULL || still == NULL)
+        return FE_EINVAL;
+    if (s->count == 0)
+        return FE_END;
+    fe__still_pop(s, out, still);
+    return FE_OK;
+}
+/* Find the still segments ends here */

@@ -385,7 +385,9 @@ START_TEST(help_documents_everything)
                            "rms_percent", "coverage", "matrix", "standard input", "algebraic",
                            "--field F", "gain", "--export", "COMPASS_OFS_X",
                            "COMPASS_DIA_X", "COMPASS_ODI_X", "milligauss", "--mgauss",
-                           "offset_se_iid", "matrix_se", "batch means"};
+                           "offset_se_iid", "matrix_se", "batch means", "--static",
+                           "--window N", "--still-sd E", "--gyro a,b,c", "--max-rate R",
+                           "static_kept", "static_left_out"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
@@ -422,6 +424,87 @@ START_TEST(real_recording_from_the_command_line)
 }
 END_TEST
 
+
+/* The issue's acceptance: on the Ferraris session, --field 9.80665
+   --static puts the mean calibrated magnitude of each of the six static
+   poses (their sample ranges from the session's own list) within 0.3 % of
+   g; fitting every sample does not (the turns and the handling are not on
+   the sphere). */
+static double pose_worst(const char *dir, const char *applied)
+{
+    static const char *const poses[6] = {"x_p", "x_a", "y_p", "y_a", "z_p", "z_a"};
+    char path[4096], list[4096], line[256];
+    static double mag[20000];
+    size_t n = 0;
+    double worst = 0.0;
+    FILE *f = fopen(applied, "r");
+    ck_assert_ptr_nonnull(f);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+    while (n < 20000 && fgets(line, sizeof line, f) != NULL) {
+        double y[3];
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf", &y[0], &y[1], &y[2]), 3);
+        mag[n++] = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+    }
+    fclose(f);
+    ck_assert_uint_eq(n, 10376);
+    snprintf(path, sizeof path, "%s/imucal_ferraris/example_ferraris_session_list.json", dir);
+    fe_test_read_file(path, list, sizeof list);
+    for (int p = 0; p < 6; p++) {
+        char key[32];
+        const char *at;
+        long start, end;
+        double sum = 0.0;
+        snprintf(key, sizeof key, "\"%s\":{\"start\":", poses[p]);
+        at = strstr(list, key);
+        ck_assert_msg(at != NULL, "no %s in the session list", poses[p]);
+        ck_assert_int_eq(sscanf(at + strlen(key), "%ld,\"end\":%ld", &start, &end), 2);
+        ck_assert(start >= 0 && end > start && (size_t)end <= n);
+        for (long i = start; i < end; i++)
+            sum += mag[i];
+        worst = fmax(worst, fabs(sum / (double)(end - start) / 9.80665 - 1.0));
+    }
+    return worst;
+}
+
+START_TEST(static_poses_of_the_ferraris_session)
+{
+    const char *dir = fe_test_data_dir("calibrate --static on the Ferraris session");
+    char path[4096], out[8192], applied[] = "/tmp/foldest-fer-XXXXXX", cmd[8192];
+    int fd;
+    if (dir == NULL)
+        return;
+    fd = mkstemp(applied);
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    snprintf(path, sizeof path, "%s/imucal_ferraris/example_ferraris_session.csv", dir);
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns acc_x,acc_y,acc_z --field 9.80665 --static"
+             " --json --apply %s %s 2>&1", FE_TEST_CLI, applied, path);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 0);
+    ck_assert_double_gt(json_number(out, "static_left_out", 0), 1000);
+    ck_assert_double_eq(json_number(out, "static_kept", 0) + json_number(out, "static_left_out", 0),
+                        10376);
+    ck_assert_double_eq(json_number(out, "n", 0), json_number(out, "static_kept", 0));
+    ck_assert_double_lt(pose_worst(dir, applied), 0.003);
+    /* The gyroscope as well. */
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns acc_x,acc_y,acc_z --field 9.80665 --static"
+             " --gyro gyr_x,gyr_y,gyr_z --max-rate 2 --apply %s %s 2>&1", FE_TEST_CLI, applied,
+             path);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 0);
+    ck_assert_ptr_nonnull(strstr(out, "still samples kept"));
+    ck_assert_double_lt(pose_worst(dir, applied), 0.003);
+    /* Every sample: the motion pulls the poses off by per cents. */
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns acc_x,acc_y,acc_z --field 9.80665"
+             " --apply %s %s 2>&1", FE_TEST_CLI, applied, path);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 0);
+    ck_assert_double_gt(pose_worst(dir, applied), 0.003);
+    unlink(applied);
+    /* --gyro needs --static. */
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns acc_x,acc_y,acc_z --gyro gyr_x,gyr_y,gyr_z"
+             " %s 2>&1", FE_TEST_CLI, path);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 2);
+}
+END_TEST
+
 Suite *fe_calibrate_cli_suite(void)
 {
     Suite *s = suite_create("calibrate_cli");
@@ -435,6 +518,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_test(t, export_for_firmware);
     tcase_add_test(t, help_documents_everything);
     tcase_add_test(t, real_recording_from_the_command_line);
+    tcase_add_test(t, static_poses_of_the_ferraris_session);
     suite_add_tcase(s, t);
     return s;
 }

@@ -1077,6 +1077,99 @@ START_TEST(real_qmc5883l_halves_agree_within_their_errors)
 }
 END_TEST
 
+
+/* The still gate: a synthetic session of rests and turns.  Rests (300
+   samples each, noise 0.05 % of g) alternate with turns (200 samples)
+   during which the magnitude changes by up to 5 %.  Every rest sample is
+   kept, and no turn sample off the rest's magnitude by more than 2 %.  A
+   turn's first and last samples may be: one sample 1 % off in a window
+   of 40 raises its sd to 0.01 / sqrt(40) = 0.0016 of the mean, below the
+   default 0.002.  Every rest sample
+   but none of the turns' is kept; the gate hands the samples back in
+   order, `window` late; rates beyond max_rate reject a rest; bad input
+   leaves it unchanged. */
+START_TEST(still_segments_are_found)
+{
+    enum { W = 40, REST = 300, TURN = 200, PARTS = 7 };
+    double ring[7 * W], out[3], x[3], rate[3] = {0, 0, 0};
+    fe_still_options o = fe_still_default_options();
+    fe_still s, before;
+    fe_rng g = fe_rng_seed(9);
+    size_t n = 0, next = 0, kept_rest = 0, kept_turn = 0, kept_edge = 0, rests = 0;
+    size_t turn_samples = 0;
+    static double sent[3 * PARTS * REST];
+    static int is_rest[PARTS * REST];
+    int still, ready;
+    o.window = W;
+    ck_assert_uint_eq(fe_still_workspace(W), 7 * W);
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W - 1), FE_ESIZE);
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_OK);
+    for (int part = 0; part < PARTS; part++) {
+        int rest = part % 2 == 0;
+        size_t len = rest ? REST : TURN;
+        double v[3];
+        fe_rng_unit_vector(&g, v);
+        for (size_t i = 0; i < len; i++, n++) {
+            double mag = 9.8 * (rest ? 1.0 + 0.0005 * fe_rng_normal(&g)
+                                     : 1.0 + 0.05 * sin(0.2 * (double)i));
+            for (int j = 0; j < 3; j++)
+                x[j] = sent[3 * n + j] = mag * v[j];
+            is_rest[n] = rest ? 1 : fabs(mag / 9.8 - 1.0) > 0.02 ? 0 : 2;
+            rests += (size_t)rest;
+            turn_samples += !rest;
+            ck_assert_int_eq(fe_still_push(&s, x, NULL, out, &still, &ready), FE_OK);
+            ck_assert_int_eq(ready, n >= W);
+            if (ready) {
+                ck_assert_mem_eq(out, sent + 3 * next, sizeof out);
+                kept_rest += still && is_rest[next] == 1;
+                kept_turn += still && is_rest[next] == 0;
+                kept_edge += still && is_rest[next] == 2;
+                next++;
+            }
+        }
+    }
+    while (fe_still_flush(&s, out, &still) == FE_OK) {
+        ck_assert_mem_eq(out, sent + 3 * next, sizeof out);
+        kept_rest += still && is_rest[next] == 1;
+        kept_turn += still && is_rest[next] == 0;
+        kept_edge += still && is_rest[next] == 2;
+        next++;
+    }
+    ck_assert_uint_eq(next, n);
+    ck_assert_uint_eq(kept_rest, rests);
+    ck_assert_uint_eq(kept_turn, 0);
+    ck_assert_uint_eq(s.still + s.moving, n);
+    ck_assert_uint_eq(s.still, rests + kept_edge);
+    ck_assert_uint_lt(kept_edge, 12);
+    ck_assert_uint_gt(turn_samples, 500);
+    /* A gyroscope turning at 5 units while the magnitude stays: still by
+       the magnitude, not with max_rate 2. */
+    o.max_rate = 2.0;
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_OK);
+    rate[2] = 5.0;
+    x[0] = 9.8, x[1] = 0, x[2] = 0;
+    for (int i = 0; i < 2 * W; i++)
+        ck_assert_int_eq(fe_still_push(&s, x, rate, out, &still, &ready), FE_OK);
+    while (fe_still_flush(&s, out, &still) == FE_OK)
+        ;
+    ck_assert_uint_eq(s.still, 0);
+    /* Refusals. */
+    before = s;
+    x[1] = NAN;
+    ck_assert_int_eq(fe_still_push(&s, x, NULL, out, &still, &ready), FE_ENONFINITE);
+    x[1] = 0;
+    rate[0] = INFINITY;
+    ck_assert_int_eq(fe_still_push(&s, x, rate, out, &still, &ready), FE_ENONFINITE);
+    ck_assert_mem_eq(&before, &s, sizeof s);
+    o.window = 1;
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_EINVAL);
+    o.window = W;
+    o.max_rel_sd = -1;
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_EINVAL);
+    ck_assert_int_eq(fe_still_flush(NULL, out, &still), FE_EINVAL);
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -1091,6 +1184,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, ardupilot_parameters);
     tcase_add_test(t, batch_means_errors_match_the_scatter);
     tcase_add_test(t, matrix_errors_match_the_scatter);
+    tcase_add_test(t, still_segments_are_found);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);

@@ -196,6 +196,50 @@ typedef struct fe_sphere_ardupilot {
 int fe_sphere_to_ardupilot(const fe_sphere_fit *fit, double field_mgauss,
                            double mgauss_per_unit, fe_sphere_ardupilot *out);
 
+/* Still segments: a streaming gate that passes the samples taken at rest
+   (an accelerometer reads gravity only then).  A window of `window`
+   consecutive samples is still when the standard deviation of |x| over it
+   is at most max_rel_sd times its mean, and, when rates are given (a
+   gyroscope), no rate's norm in it exceeds max_rate; every sample of a
+   still window is still.  Decisions are final `window` samples later, so
+   the gate hands samples back in order with that delay. */
+typedef struct fe_still_options {
+    size_t window;              /* default 50 */
+    double max_rel_sd;          /* default 0.002 */
+    double max_rate;            /* default 0: rates not tested */
+} fe_still_options;
+
+typedef struct fe_still {
+    fe_still_options opt;
+    double *ring;               /* the caller's: fe_still_workspace doubles */
+    size_t head, count;         /* oldest sample, samples held */
+    uint64_t still, moving;     /* samples handed back, by verdict */
+} fe_still;
+
+/* fe_still_default_options: the defaults above, by value. */
+fe_still_options fe_still_default_options(void);
+
+/* fe_still_workspace: doubles of ring fe_still_init needs: 7 window. */
+size_t fe_still_workspace(size_t window);
+
+/* fe_still_init: an empty gate over the caller's `work` (work_len
+   doubles; FE_ESIZE if too small).  FE_EINVAL for NULL, a window below 2,
+   or thresholds that are negative or not finite. */
+int fe_still_init(fe_still *s, const fe_still_options *opt, double *work,
+                  size_t work_len);
+
+/* fe_still_push: take x (and rate, 3 doubles, or NULL); when the ring is
+   full the oldest sample is handed back first: *ready = 1, out its x,
+   *still its verdict; otherwise *ready = 0.  FE_ENONFINITE for a
+   non-finite x or rate, FE_EINVAL for NULL; then s is unchanged.  No
+   allocation; cost O(window). */
+int fe_still_push(fe_still *s, const double x[3], const double *rate,
+                  double out[3], int *still, int *ready);
+
+/* fe_still_flush: at the end of the stream, hand back the oldest sample
+   held (out, *still): FE_OK, or FE_END when none is left. */
+int fe_still_flush(fe_still *s, double out[3], int *still);
+
 /* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
    fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */
 const char *fe_sphere_model_name(int model);

@@ -7,11 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char fe__calibrate_help[] =
+/* The help in parts: C11 compilers need only take strings of 4095 bytes. */
+static const char *const fe__calibrate_help[] = {
     "usage: foldest calibrate [--model sphere|axial|ellipsoid] [--columns a,b,c]\n"
     "                         [--skip N] [--json] [--trace] [--apply OUT.csv]\n"
     "                         [--field F] [--export ardupilot|c|json]\n"
-    "                         [--mgauss K]\n"
+    "                         [--mgauss K] [--static [--window N] [--still-sd E]\n"
+    "                         [--gyro a,b,c --max-rate R]]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -35,6 +37,7 @@ static const char fe__calibrate_help[] =
     "  --apply OUT.csv write the calibrated samples R M (x - b) (R: the fitted\n"
     "                  field, or F with --field) to OUT.csv; needs a file, not\n"
     "                  standard input\n"
+    ,
     "  --field F       the known field: calibrated samples have magnitude F\n"
     "                  (9.80665 for an accelerometer in m/s^2, the local Earth\n"
     "                  field for a magnetometer); the report gives the fitted\n"
@@ -49,7 +52,20 @@ static const char fe__calibrate_help[] =
     "                  y = M (x - b); json: as --json\n"
     "  --mgauss K      milligauss per sensor unit for --export ardupilot\n"
     "                  (default 1: the samples are in milligauss; 1000 for gauss)\n"
+    "  --static        fit the still segments only (an accelerometer at rest, as\n"
+    "                  in a six-pose calibration): a window of N samples is still\n"
+    "                  when the standard deviation of |x| over it is at most E\n"
+    "                  times its mean (and, with --gyro, no angular rate in it\n"
+    "                  exceeds R); every sample of a still window is kept, the\n"
+    "                  others are left out and counted (static_kept,\n"
+    "                  static_left_out); --apply still writes every sample\n"
+    "  --window N      the still window, in samples (default 50)\n"
+    "  --still-sd E    the relative standard deviation of a still window\n"
+    "                  (default 0.002)\n"
+    "  --gyro a,b,c    gyroscope columns for --static, tested with --max-rate R\n"
+    "                  (in the gyroscope's units; default 0: not tested)\n"
     "\n"
+    ,
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
     "The moments are also kept for 8 to 16 consecutive blocks in time, and the\n"
     "standard errors come from the blocks' spread (batch means): they hold for\n"
@@ -67,7 +83,14 @@ static const char fe__calibrate_help[] =
     "quadric that is not an ellipsoid.  A malformed field gives\n"
     "FILE:LINE:COLUMN: message and exit status 3, with no output.  Exit status:\n"
     "0 success, 1 refused, 2 usage, 3 malformed input, 4 input/output error.\n"
-    "Progress is shown on standard error for large files when it is a terminal.\n";
+    "Progress is shown on standard error for large files when it is a terminal.\n",
+    NULL};
+
+static void fe__calibrate_usage(FILE *out)
+{
+    for (int k = 0; fe__calibrate_help[k] != NULL; k++)
+        fputs(fe__calibrate_help[k], out);
+}
 /* Calibrate Includes and Help ends here */
 /* [[file:../../literate/calibrate.org::Calibrate Options][Calibrate Options]] */
 enum fe__calibrate_export { FE__EXPORT_NONE, FE__EXPORT_ARDUPILOT, FE__EXPORT_C };
@@ -78,6 +101,9 @@ typedef struct fe__calibrate_args {
     long skip;
     double field;               /* 0: not given */
     double mgauss;              /* milligauss per sensor unit */
+    int still;                  /* --static */
+    char *gyro;                 /* --gyro columns, or NULL */
+    fe_still_options still_opt;
     int export_format;          /* fe__calibrate_export */
     int json, trace;
     fe_sphere_model model;
@@ -87,7 +113,8 @@ typedef struct fe__calibrate_args {
    --help, printed). */
 static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
-    {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {NULL, 0}};
+    {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {"--static", 0}, {"--window", 1},
+    {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {NULL, 0}};
 
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
@@ -96,13 +123,14 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     memset(a, 0, sizeof *a);
     a->skip = -1;
     a->mgauss = 1.0;
+    a->still_opt = fe_still_default_options();
     a->model = FE_FIT_AXIAL;
     rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
     if (rc != FE_CLI_OK)
         return rc;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(fe__calibrate_help, stdout);
+            fe__calibrate_usage(stdout);
             return -1;
         } else if (strcmp(argv[i], "--json") == 0) {
             a->json = 1;
@@ -135,6 +163,33 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                         fmt);
                 return FE_CLI_USAGE;
             }
+        } else if (strcmp(argv[i], "--static") == 0) {
+            a->still = 1;
+        } else if (strcmp(argv[i], "--gyro") == 0 && i + 1 < argc) {
+            a->gyro = argv[++i];
+        } else if (strcmp(argv[i], "--window") == 0 && i + 1 < argc) {
+            long w;
+            int bad = fe_cli_parse_long("--window", argv[++i], &w, err, sizeof err) != FE_CLI_OK;
+            if (bad || w < 2 || w > 1000000) {
+                fprintf(stderr, "foldest calibrate: %s\n",
+                        bad ? err : "--window: from 2 to 1000000 samples");
+                return FE_CLI_USAGE;
+            }
+            a->still_opt.window = (size_t)w;
+        } else if ((strcmp(argv[i], "--still-sd") == 0 || strcmp(argv[i], "--max-rate") == 0)
+                   && i + 1 < argc) {
+            const char *name = argv[i];
+            double v;
+            int bad = fe_cli_parse_double(name, argv[++i], &v, err, sizeof err) != FE_CLI_OK;
+            if (bad || !(v >= 0.0) || !isfinite(v)) {
+                fprintf(stderr, "foldest calibrate: %s%s\n", bad ? err : name,
+                        bad ? "" : ": a finite number, at least 0");
+                return FE_CLI_USAGE;
+            }
+            if (name[2] == 's')
+                a->still_opt.max_rel_sd = v;
+            else
+                a->still_opt.max_rate = v;
         } else if (strcmp(argv[i], "--mgauss") == 0 && i + 1 < argc) {
             int bad = fe_cli_parse_double("--mgauss", argv[++i], &a->mgauss, err, sizeof err)
                       != FE_CLI_OK;
@@ -154,8 +209,9 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                 return FE_CLI_USAGE;
             }
         } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-            fprintf(stderr, "foldest calibrate: unknown option or missing value '%s'\n%s",
-                    argv[i], fe__calibrate_help);
+            fprintf(stderr, "foldest calibrate: unknown option or missing value '%s'\n",
+                    argv[i]);
+            fe__calibrate_usage(stderr);
             return FE_CLI_USAGE;
         } else if (a->path == NULL) {
             a->path = argv[i];
@@ -165,12 +221,16 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
         }
     }
     if (a->path == NULL) {
-        fputs(fe__calibrate_help, stderr);
+        fe__calibrate_usage(stderr);
         return FE_CLI_USAGE;
     }
     if (a->export_format != FE__EXPORT_NONE && a->json) {
         fprintf(stderr, "foldest calibrate: one output: --export %s or --json\n",
                 a->export_format == FE__EXPORT_C ? "c" : "ardupilot");
+        return FE_CLI_USAGE;
+    }
+    if (!a->still && (a->gyro != NULL || a->still_opt.max_rate > 0.0)) {
+        fprintf(stderr, "foldest calibrate: --gyro and --max-rate go with --static\n");
         return FE_CLI_USAGE;
     }
     if (a->apply != NULL && strcmp(a->path, "-") == 0) {
@@ -186,6 +246,8 @@ static int fe__calibrate_columns(fe_cli_table *t, char *spec, size_t cols[3])
 {
     char err[2048], *names[4];
     int n;
+    if (spec == NULL && cols == NULL)
+        return FE_CLI_OK;
     if (spec == NULL) {
         if (t->ncols == 3) {
             for (size_t j = 0; j < 3; j++)
@@ -212,14 +274,22 @@ static int fe__calibrate_columns(fe_cli_table *t, char *spec, size_t cols[3])
     return FE_CLI_OK;
 }
 
-static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[3], fe_quadric_blocks *q)
+/* Fold the samples, or with a gate (--static) the still ones, which it
+   hands back `window` samples late, and the rest at the end. */
+static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncols,
+                              fe_still *gate, fe_quadric_blocks *q)
 {
     char err[1024];
-    double x[3];
-    int rc;
+    double x[6], y[3];
+    int rc, still = 1, ready = 1;
     fe_quadric_blocks_init(q);
-    while ((rc = fe_cli_table_next(t, cols, 3, x, err, sizeof err)) == FE_OK) {
-        rc = fe_quadric_blocks_add(q, x);
+    while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
+        if (gate != NULL)
+            rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still, &ready);
+        else
+            memcpy(y, x, sizeof y);
+        if (rc == FE_OK && ready && still)
+            rc = fe_quadric_blocks_add(q, y);
         if (rc != FE_OK) {
             fe_cli_progress_done(t);
             fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line,
@@ -233,6 +303,11 @@ static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[3], fe_quadric_
         fprintf(stderr, "foldest calibrate: %s\n", err);
         return rc;
     }
+    while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
+        if (still && (rc = fe_quadric_blocks_add(q, y)) != FE_OK) {
+            fprintf(stderr, "foldest calibrate: %s: %s\n", t->name, fe_strerror(rc));
+            return FE_CLI_INPUT;
+        }
     if (t->rows == 0) {
         fprintf(stderr, "foldest calibrate: %s: no data rows\n", t->name);
         return FE_CLI_INPUT;
@@ -245,21 +320,53 @@ typedef struct fe__calibrate_pass2 {
     int done;                   /* the pass ran */
     int regions;
     double rms_radial_percent;
+    int still;                  /* --static: the counts below */
+    uint64_t kept, left_out;
 } fe__calibrate_pass2;
 
+/* One sample of the second pass: measured when it was fitted (still, or
+   no gate), written in any case. */
+typedef struct fe__calibrate_measure {
+    unsigned char hit[FE_QUADRIC_REGIONS];
+    double ss, n;
+    FILE *apply;
+} fe__calibrate_measure;
+
+static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit,
+                              const fe_sphere_scaled *sc, const double x[3], int still)
+{
+    double y[3], len;
+    int r;
+    if (still) {
+        fe_sphere_apply(fit, x, y);
+        r = fe_quadric_region(y);
+        if (r >= 0)
+            m->hit[r] = 1;
+        len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+        m->ss += (len - 1.0) * (len - 1.0);
+        m->n += 1.0;
+    }
+    if (m->apply != NULL) {
+        fe_sphere_scaled_apply(sc, x, y);
+        fprintf(m->apply, "%.10g,%.10g,%.10g\n", y[0], y[1], y[2]);
+    }
+}
+
 static int fe__calibrate_second_pass(const fe__calibrate_args *a,
-                                     const size_t cols[3],
+                                     const size_t cols[6], size_t ncols,
+                                     fe_still *gate,
                                      const fe_sphere_fit *fit,
                                      const fe_sphere_scaled *sc,
                                      fe__calibrate_pass2 *out)
 {
     char err[1024];
-    unsigned char hit[FE_QUADRIC_REGIONS] = {0};
-    double x[3], y[3], ss = 0.0;
+    static const fe__calibrate_measure none;
+    fe__calibrate_measure m = none;
+    double x[6], y[3];
     const char *apply = a->apply;
     fe_cli_output o;
     fe_cli_table table, *t = &table;
-    int rc;
+    int rc, still = 1, ready = 1;
 
     memset(out, 0, sizeof *out);
     if (strcmp(a->path, "-") == 0)
@@ -278,23 +385,24 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
         }
         fprintf(o.file, "%s_cal,%s_cal,%s_cal\n", t->names[cols[0]],
                 t->names[cols[1]], t->names[cols[2]]);
+        m.apply = o.file;
     }
-    while ((rc = fe_cli_table_next(t, cols, 3, x, err, sizeof err)) == FE_OK) {
-        int r;
-        double len;
-        fe_sphere_apply(fit, x, y);
-        r = fe_quadric_region(y);
-        if (r >= 0)
-            hit[r] = 1;
-        len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-        ss += (len - 1.0) * (len - 1.0);
-        if (apply != NULL) {
-            fe_sphere_scaled_apply(sc, x, y);
-            fprintf(o.file, "%.10g,%.10g,%.10g\n", y[0], y[1], y[2]);
-        }
+    if (gate != NULL)
+        fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
+    while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
+        if (gate != NULL && (rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still,
+                                                &ready)) != FE_OK)
+            break;
+        if (gate == NULL)
+            memcpy(y, x, sizeof y);
+        if (ready)
+            fe__calibrate_one(&m, fit, sc, y, still);
         fe_cli_progress(t);
     }
     fe_cli_progress_done(t);
+    if (rc == FE_END)
+        while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
+            fe__calibrate_one(&m, fit, sc, y, still);
     if (rc != FE_END) {
         fprintf(stderr, "foldest calibrate: %s\n", err);
         if (apply != NULL)
@@ -309,8 +417,8 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     out->done = 1;
     for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
-        out->regions += hit[r];
-    out->rms_radial_percent = t->rows > 0 ? 100.0 * sqrt(ss / (double)t->rows) : 0.0;
+        out->regions += m.hit[r];
+    out->rms_radial_percent = m.n > 0 ? 100.0 * sqrt(m.ss / m.n) : 0.0;
     fe_cli_table_close(t);
     return FE_CLI_OK;
 }
@@ -394,6 +502,9 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         printf(", \"extent_hi\": ");
         fe__calibrate_json_array(f->extent_hi, 3);
     }
+    if (p2->still)
+        printf(", \"static_kept\": %llu, \"static_left_out\": %llu",
+               (unsigned long long)p2->kept, (unsigned long long)p2->left_out);
     printf(", \"bad_rows\": ");
     fe_cli_json_bad_rows(stdout);
     printf(", \"iterations\": %d, \"algebraic\": %s, \"refusal\": ", f->iterations,
@@ -414,6 +525,9 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
     static const char *const axis[3] = {"x", "y", "z"};
     printf("%s: %s fit of %llu samples, %d iterations\n", t->name,
            fe_sphere_model_name(f->model), (unsigned long long)f->n, f->iterations);
+    if (p2->still)
+        printf("  static           %llu still samples kept, %llu left out (moving or handled)\n",
+               (unsigned long long)p2->kept, (unsigned long long)p2->left_out);
     printf("  offset b         ");
     for (int j = 0; j < 3; j++)
         printf("  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
@@ -535,8 +649,11 @@ int fe_cli_calibrate(int argc, char **argv)
     fe_quadric_blocks q;
     fe_sphere_fit fit;
     fe_sphere_scaled sc;
-    size_t cols[3];
+    fe_still gate, *g = NULL;
+    double *ring = NULL;
+    size_t cols[6], ncols;
     char err[1024];
+    uint64_t still_kept = 0, still_out = 0;
     int rc = fe__calibrate_parse(argc, argv, &a), fitrc;
 
     if (rc != FE_CLI_OK)
@@ -548,10 +665,28 @@ int fe_cli_calibrate(int argc, char **argv)
     }
     rc = fe__calibrate_columns(&t, a.columns, cols);
     if (rc == FE_CLI_OK)
-        rc = fe__calibrate_fold(&t, cols, &q);
+        rc = fe__calibrate_columns(&t, a.gyro, a.gyro != NULL ? cols + 3 : NULL);
+    ncols = a.gyro != NULL ? 6 : 3;
+    if (rc == FE_CLI_OK && a.still) {
+        size_t len = fe_still_workspace(a.still_opt.window);
+        ring = malloc(len * sizeof *ring);
+        if (ring == NULL || fe_still_init(&gate, &a.still_opt, ring, len) != FE_OK) {
+            fprintf(stderr, "foldest calibrate: --window %zu: out of memory\n",
+                    a.still_opt.window);
+            rc = FE_CLI_IO;
+        }
+        g = &gate;
+    }
+    if (rc == FE_CLI_OK)
+        rc = fe__calibrate_fold(&t, cols, ncols, g, &q);
     if (rc != FE_CLI_OK) {
+        free(ring);
         fe_cli_table_close(&t);
         return rc;
+    }
+    if (g != NULL) {
+        still_kept = g->still;
+        still_out = g->moving;
     }
     if (a.trace)
         opt.trace = fe__calibrate_trace;
@@ -561,12 +696,17 @@ int fe_cli_calibrate(int argc, char **argv)
     if (fitrc == FE_OK && fe_sphere_scale(&fit, a.field, &sc) != FE_OK)
         fitrc = FE_EINVAL;      /* not reached: an accepted fit has a radius */
     if (fitrc == FE_OK) {
-        rc = fe__calibrate_second_pass(&a, cols, &fit, &sc, &p2);
+        rc = fe__calibrate_second_pass(&a, cols, ncols, g, &fit, &sc, &p2);
         if (rc != FE_CLI_OK) {
+            free(ring);
             fe_cli_table_close(&t);
             return rc;
         }
     }
+    free(ring);
+    p2.still = a.still;
+    p2.kept = still_kept;
+    p2.left_out = still_out;
     if (a.json)
         fe__calibrate_json(&t, &fit, &sc, a.field, fitrc, &p2);
     if (fitrc != FE_OK) {
