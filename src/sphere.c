@@ -1198,3 +1198,54 @@ int fe_still_flush(fe_still *s, double out[3], int *still)
     return FE_OK;
 }
 /* Find the still segments ends here */
+/* [[file:../literate/sphere.org::Measure radial residuals and their robust scale][Measure radial residuals and their robust scale]] */
+double fe_sphere_radial(const fe_sphere_fit *fit, const double x[3])
+{
+    double y[3];
+    fe_sphere_apply(fit, x, y);
+    return sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0;
+}
+
+/* Bin k holds |e| in [10^(k/25 - 7), 10^((k+1)/25 - 7)). */
+int fe_radial_hist_add(fe_radial_hist *h, double e)
+{
+    double a = fabs(e);
+    int k;
+    if (h == NULL)
+        return FE_EINVAL;
+    if (!isfinite(e))
+        return FE_ENONFINITE;
+    k = a > 0.0 ? (int)floor(25.0 * (log10(a) + 7.0)) : 0;
+    k = k < 0 ? 0 : k >= FE_RADIAL_BINS ? FE_RADIAL_BINS - 1 : k;
+    h->count[k] += 1.0;
+    h->n += 1.0;
+    return FE_OK;
+}
+
+int fe_radial_hist_merge(fe_radial_hist *a, const fe_radial_hist *b)
+{
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    for (int k = 0; k < FE_RADIAL_BINS; k++)
+        a->count[k] += b->count[k];
+    a->n += b->n;
+    return FE_OK;
+}
+
+double fe_radial_hist_scale(const fe_radial_hist *h)
+{
+    double half, below = 0.0;
+    if (h == NULL || !(h->n > 0.0))
+        return 0.0;
+    half = 0.5 * h->n;
+    for (int k = 0; k < FE_RADIAL_BINS; k++) {
+        if (below + h->count[k] >= half) {
+            /* Interpolate in log |e| within the bin. */
+            double f = h->count[k] > 0.0 ? (half - below) / h->count[k] : 0.0;
+            return 1.4826 * pow(10.0, ((double)k + f) / 25.0 - 7.0);
+        }
+        below += h->count[k];
+    }
+    return 1.4826 * 10.0;
+}
+/* Measure radial residuals and their robust scale ends here */

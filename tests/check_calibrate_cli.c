@@ -17,7 +17,7 @@
 /* A recording: metadata lines, a header, then n samples on an ellipsoid
    (centre 100, -50, 30; semi-axes 400, 380, 420), or only the upper half
    (hemisphere), or a circle in a plane (planar). */
-enum shape { WHOLE, HEMISPHERE, PLANAR };
+enum shape { WHOLE, HEMISPHERE, PLANAR, OUTLIERS };
 
 static void write_recording(const char *path, size_t n, enum shape shape,
                             const char *bad_line)
@@ -37,6 +37,8 @@ static void write_recording(const char *path, size_t n, enum shape shape,
             v[2] = fabs(v[2]);
         if (shape == PLANAR)
             v[2] = 0.0, s = sqrt(v[0] * v[0] + v[1] * v[1]);
+        if (shape == OUTLIERS && i % 50 == 7)
+            s /= 1.3;           /* one sample in 50 is 30 % off the sphere */
         fprintf(f, "%.3f,%.4f,%.4f,%.4f\n", 0.02 * (double)i,
                 100 + 400 * v[0] / s + 2 * fe_rng_normal(&g),
                 -50 + 380 * v[1] / s + 2 * fe_rng_normal(&g),
@@ -377,6 +379,47 @@ START_TEST(export_for_firmware)
 }
 END_TEST
 
+
+/* --robust: one sample in 50 lies 30 % outside the ellipsoid (noise 0.5 %).
+   From the file exactly those are rejected and the offset returns to the
+   recording's centre; from standard input they are flagged, not
+   rejected. */
+START_TEST(robust_rejects_outliers)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", out[8192];
+    int fd = mkstemp(path), status;
+    double plain, robust;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 3000, OUTLIERS, NULL);
+    status = run("%s calibrate --columns mx,my,mz --json %s 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    plain = json_number(out, "rms_percent", 0);
+    status = run("%s calibrate --columns mx,my,mz --robust --json %s 2>&1", path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_double_eq(json_number(out, "robust_rejected", 0), 60);
+    ck_assert_double_eq(json_number(out, "n", 0), 2940);
+    robust = json_number(out, "rms_percent", 0);
+    ck_assert_double_lt(robust, 0.6);          /* the noise alone */
+    ck_assert_double_gt(plain, 3 * robust);
+    ck_assert_double_eq_tol(json_number(out, "offset", 0), 100.0, 0.5);
+    ck_assert_double_eq_tol(json_number(out, "offset", 1), -50.0, 0.5);
+    ck_assert_double_lt(json_number(out, "rms_radial_percent", 0), 0.6);
+    status = run("cat %2$s | %1$s calibrate --columns mx,my,mz --robust --json - 2>&1", path,
+                 out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_double_eq(json_number(out, "n", 0), 3000);
+    ck_assert_double_ge(json_number(out, "robust_flagged", 0), 45);   /* after the first 512 */
+    ck_assert_double_le(json_number(out, "robust_flagged", 0), 60);
+    status = run("cat %2$s | %1$s calibrate --columns mx,my,mz --robust - 2>&1", path, out,
+                 sizeof out);
+    ck_assert_ptr_nonnull(strstr(out, "none rejected"));
+    status = run("%s calibrate --columns mx,my,mz --robust-k 0 %s 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 2);
+    unlink(path);
+}
+END_TEST
+
 START_TEST(help_documents_everything)
 {
     char out[8192];
@@ -387,7 +430,8 @@ START_TEST(help_documents_everything)
                            "COMPASS_DIA_X", "COMPASS_ODI_X", "milligauss", "--mgauss",
                            "offset_se_iid", "matrix_se", "batch means", "--static",
                            "--window N", "--still-sd E", "--gyro a,b,c", "--max-rate R",
-                           "static_kept", "static_left_out"};
+                           "static_kept", "static_left_out", "--robust", "--robust-k K",
+                           "robust_rejected", "robust_flagged"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
@@ -515,6 +559,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_loop_test(t, refusals_and_errors, 0,
                         (int)(sizeof refusals / sizeof refusals[0]));
     tcase_add_test(t, known_field);
+    tcase_add_test(t, robust_rejects_outliers);
     tcase_add_test(t, export_for_firmware);
     tcase_add_test(t, help_documents_everything);
     tcase_add_test(t, real_recording_from_the_command_line);

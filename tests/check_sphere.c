@@ -1170,6 +1170,57 @@ START_TEST(still_segments_are_found)
 }
 END_TEST
 
+
+/* The robust scale: 1.4826 median |e| is the standard deviation of normal
+   errors (to the histogram's few per cent); a tenth of gross outliers
+   moves it by about a tenth (the median's breakdown), where the RMS grows
+   tenfold.  Merging two histograms is filling one.  fe_sphere_radial is
+   |M (x - b)| - 1. */
+START_TEST(robust_scale_of_radial_errors)
+{
+    fe_radial_hist h, a, b, none;
+    fe_rng g = fe_rng_seed(17);
+    double ss = 0.0;
+    memset(&h, 0, sizeof h);
+    memset(&a, 0, sizeof a);
+    memset(&b, 0, sizeof b);
+    memset(&none, 0, sizeof none);
+    ck_assert_double_eq(fe_radial_hist_scale(&h), 0.0);
+    for (int i = 0; i < 20000; i++) {
+        double e = 0.004 * fe_rng_normal(&g);
+        if (i % 10 == 0)
+            e = 0.5 + 0.1 * fe_rng_normal(&g);     /* gross outliers */
+        ss += e * e;
+        ck_assert_int_eq(fe_radial_hist_add(&h, e), FE_OK);
+        ck_assert_int_eq(fe_radial_hist_add(i < 7000 ? &a : &b, e), FE_OK);
+    }
+    /* With 10 % outliers the median |e| of the rest sits at the 55 %
+       point: 1.4826 * 0.004 * 0.755 (the normal's 77.5 % quantile). */
+    ck_assert_double_eq_tol(fe_radial_hist_scale(&h), 1.4826 * 0.004 * 0.7554, 0.0002);
+    ck_assert_double_gt(sqrt(ss / 20000), 0.1);
+    ck_assert_int_eq(fe_radial_hist_merge(&a, &b), FE_OK);
+    ck_assert_mem_eq(&a, &h, sizeof h);
+    ck_assert_int_eq(fe_radial_hist_add(&h, NAN), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &h, sizeof h);
+    ck_assert_int_eq(fe_radial_hist_add(NULL, 0.1), FE_EINVAL);
+    memset(&h, 0, sizeof h);
+    for (int i = 0; i < 20000; i++)
+        fe_radial_hist_add(&h, 0.01 * fe_rng_normal(&g));
+    ck_assert_double_eq_tol(fe_radial_hist_scale(&h), 0.01, 0.0004);
+    {
+        enum { N = 2000 };
+        static double x[3 * N];
+        fe_sphere_fit f;
+        int rc;
+        double p[3] = {C0[0] + 1.1 * R0[0], C0[1], C0[2]};
+        fe_test_ellipsoid_points(x, N, C0, R0, 0.0, 3);
+        f = fit_moments(x, N, FE_FIT_AXIAL, &rc);
+        ck_assert_int_eq(rc, FE_OK);
+        ck_assert_double_eq_tol(fe_sphere_radial(&f, p), 0.1, 1e-9);
+    }
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -1185,6 +1236,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, batch_means_errors_match_the_scatter);
     tcase_add_test(t, matrix_errors_match_the_scatter);
     tcase_add_test(t, still_segments_are_found);
+    tcase_add_test(t, robust_scale_of_radial_errors);
     tcase_add_test(t, precision_with_a_large_offset);
     tcase_add_test(t, merged_shards_fit_like_the_whole);
     tcase_add_test(t, runaway_sphere_falls_back_to_the_algebraic_sphere);

@@ -240,6 +240,33 @@ int fe_still_push(fe_still *s, const double x[3], const double *rate,
    held (out, *still): FE_OK, or FE_END when none is left. */
 int fe_still_flush(fe_still *s, double out[3], int *still);
 
+/* Radial residuals and a robust scale for them, to reject outliers
+   (samples far outside the bulk: a magnet passing by, a knock on an
+   accelerometer).  fe_sphere_radial: e = |M (x - b)| - 1, the sample's
+   radial error as a fraction of the field. */
+double fe_sphere_radial(const fe_sphere_fit *fit, const double x[3]);
+
+/* A histogram of |e| in constant memory: 25 bins a decade from 1e-7 to
+   10 (below and above go to the end bins); the median of |e| is read to
+   within 5 %.  All zero bytes is the empty histogram. */
+enum { FE_RADIAL_BINS = 200 };
+typedef struct fe_radial_hist {
+    double count[FE_RADIAL_BINS];
+    double n;
+} fe_radial_hist;
+
+/* fe_radial_hist_add: count |e|.  FE_ENONFINITE for a non-finite e (h
+   unchanged), FE_EINVAL for NULL. */
+int fe_radial_hist_add(fe_radial_hist *h, double e);
+
+/* fe_radial_hist_merge: a <- a + b.  FE_EINVAL for NULL. */
+int fe_radial_hist_merge(fe_radial_hist *a, const fe_radial_hist *b);
+
+/* fe_radial_hist_scale: the robust scale of e, 1.4826 times the median
+   of |e| (the standard deviation for normal errors centred on zero, as a
+   fit's are); 0 for an empty histogram. */
+double fe_radial_hist_scale(const fe_radial_hist *h);
+
 /* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
    fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */
 const char *fe_sphere_model_name(int model);

@@ -13,7 +13,7 @@ static const char *const fe__calibrate_help[] = {
     "                         [--skip N] [--json] [--trace] [--apply OUT.csv]\n"
     "                         [--field F] [--export ardupilot|c|json]\n"
     "                         [--mgauss K] [--static [--window N] [--still-sd E]\n"
-    "                         [--gyro a,b,c --max-rate R]]\n"
+    "                         [--gyro a,b,c --max-rate R]] [--robust [--robust-k K]]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -64,6 +64,15 @@ static const char *const fe__calibrate_help[] = {
     "                  (default 0.002)\n"
     "  --gyro a,b,c    gyroscope columns for --static, tested with --max-rate R\n"
     "                  (in the gyroscope's units; default 0: not tested)\n"
+    "  --robust        reject outliers: samples whose radial error |y| - 1 is\n"
+    "                  beyond K robust standard deviations (1.4826 times the\n"
+    "                  median |error|) of the first fit, and fit again from the\n"
+    "                  kept samples' moments (two more passes: robust_rejected);\n"
+    "                  from standard input the samples cannot be read again, so\n"
+    "                  they are only counted against provisional fits made while\n"
+    "                  folding (robust_flagged), and not rejected\n"
+    "  --robust-k K    the rejection threshold in robust standard deviations\n"
+    "                  (default 5)\n"
     "\n"
     ,
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
@@ -102,6 +111,8 @@ typedef struct fe__calibrate_args {
     double field;               /* 0: not given */
     double mgauss;              /* milligauss per sensor unit */
     int still;                  /* --static */
+    int robust;                 /* --robust */
+    double robust_k;
     char *gyro;                 /* --gyro columns, or NULL */
     fe_still_options still_opt;
     int export_format;          /* fe__calibrate_export */
@@ -114,7 +125,8 @@ typedef struct fe__calibrate_args {
 static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
     {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {"--static", 0}, {"--window", 1},
-    {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {NULL, 0}};
+    {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {"--robust", 0},
+    {"--robust-k", 1}, {NULL, 0}};
 
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
@@ -124,6 +136,7 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     a->skip = -1;
     a->mgauss = 1.0;
     a->still_opt = fe_still_default_options();
+    a->robust_k = 5.0;
     a->model = FE_FIT_AXIAL;
     rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
     if (rc != FE_CLI_OK)
@@ -161,6 +174,16 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
             else {
                 fprintf(stderr, "foldest calibrate: --export: '%s' is not ardupilot, c or json\n",
                         fmt);
+                return FE_CLI_USAGE;
+            }
+        } else if (strcmp(argv[i], "--robust") == 0) {
+            a->robust = 1;
+        } else if (strcmp(argv[i], "--robust-k") == 0 && i + 1 < argc) {
+            int bad = fe_cli_parse_double("--robust-k", argv[++i], &a->robust_k, err, sizeof err)
+                      != FE_CLI_OK;
+            if (bad || !(a->robust_k > 0.0) || !isfinite(a->robust_k)) {
+                fprintf(stderr, "foldest calibrate: %s\n",
+                        bad ? err : "--robust-k: a positive number");
                 return FE_CLI_USAGE;
             }
         } else if (strcmp(argv[i], "--static") == 0) {
@@ -274,10 +297,38 @@ static int fe__calibrate_columns(fe_cli_table *t, char *spec, size_t cols[3])
     return FE_CLI_OK;
 }
 
+/* --robust from standard input: count the samples far outside the bulk
+   of a provisional fit, refitted each time the blocks double. */
+typedef struct fe__calibrate_flags {
+    fe_sphere_model model;
+    double k;
+    uint64_t len_seen, flagged;
+    int have;
+    fe_sphere_fit fit;
+    fe_radial_hist hist;
+} fe__calibrate_flags;
+
+static void fe__calibrate_flag(fe__calibrate_flags *fl, const fe_quadric_blocks *q,
+                               const double y[3])
+{
+    double e;
+    if (q->block_len != fl->len_seen && q->all.m[0] >= 512) {
+        fl->len_seen = q->block_len;
+        fl->have = fe_sphere_fit_moments(&q->all, fl->model, NULL, &fl->fit) == FE_OK;
+    }
+    if (!fl->have)
+        return;
+    e = fe_sphere_radial(&fl->fit, y);
+    if (fl->hist.n >= 100 && fabs(e) > fl->k * fe_radial_hist_scale(&fl->hist))
+        fl->flagged++;
+    fe_radial_hist_add(&fl->hist, e);
+}
+
 /* Fold the samples, or with a gate (--static) the still ones, which it
-   hands back `window` samples late, and the rest at the end. */
+   hands back `window` samples late, and the rest at the end; flag them
+   when asked. */
 static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncols,
-                              fe_still *gate, fe_quadric_blocks *q)
+                              fe_still *gate, fe__calibrate_flags *fl, fe_quadric_blocks *q)
 {
     char err[1024];
     double x[6], y[3];
@@ -288,8 +339,11 @@ static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncol
             rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still, &ready);
         else
             memcpy(y, x, sizeof y);
-        if (rc == FE_OK && ready && still)
+        if (rc == FE_OK && ready && still) {
             rc = fe_quadric_blocks_add(q, y);
+            if (rc == FE_OK && fl != NULL)
+                fe__calibrate_flag(fl, q, y);
+        }
         if (rc != FE_OK) {
             fe_cli_progress_done(t);
             fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line,
@@ -322,13 +376,89 @@ typedef struct fe__calibrate_pass2 {
     double rms_radial_percent;
     int still;                  /* --static: the counts below */
     uint64_t kept, left_out;
+    int robust;                 /* 1: rejected, 2: flagged only */
+    uint64_t rejected;
+    double threshold;           /* |e| beyond it rejected (robust 1) */
 } fe__calibrate_pass2;
+
+/* Read the file again and hand every sample the fit used (all, or the
+   gate's still ones) to visit; for --robust. */
+typedef int fe__calibrate_visit(void *ctx, const double x[3]);
+
+static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
+                              size_t ncols, fe_still *gate, fe__calibrate_visit *visit,
+                              void *ctx)
+{
+    char err[1024];
+    double x[6], y[3];
+    fe_cli_table t;
+    int rc, still = 1, ready = 1;
+    rc = fe_cli_table_open(&t, a->path, a->skip, err, sizeof err);
+    if (rc != FE_CLI_OK) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        return rc;
+    }
+    if (gate != NULL)
+        fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
+    while ((rc = fe_cli_table_next(&t, cols, ncols, x, err, sizeof err)) == FE_OK) {
+        if (gate != NULL && (rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still,
+                                                &ready)) != FE_OK)
+            break;
+        if (gate == NULL)
+            memcpy(y, x, sizeof y);
+        if (ready && still && (rc = visit(ctx, y)) != FE_OK)
+            break;
+    }
+    if (rc == FE_END) {
+        rc = FE_OK;
+        while (rc == FE_OK && gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
+            if (still)
+                rc = visit(ctx, y);
+        if (rc == FE_OK) {
+            fe_cli_table_close(&t);
+            return FE_CLI_OK;
+        }
+        snprintf(err, sizeof err, "%s: %s", t.name, fe_strerror(rc));
+    } else if (rc > FE_END) {
+        snprintf(err, sizeof err, "%s:%zu:1: %s", t.name, t.line, fe_strerror(rc));
+    }
+    fprintf(stderr, "foldest calibrate: %s\n", err);
+    fe_cli_table_close(&t);
+    return FE_CLI_INPUT;
+}
+
+/* --robust on a file: the histogram of the radial errors under the first
+   fit, then the samples within k robust standard deviations folded anew. */
+typedef struct fe__calibrate_robust {
+    const fe_sphere_fit *fit;
+    fe_radial_hist hist;
+    double threshold;
+    uint64_t rejected;
+    fe_quadric_blocks *q;
+} fe__calibrate_robust;
+
+static int fe__calibrate_robust_hist(void *ctx, const double x[3])
+{
+    fe__calibrate_robust *r = ctx;
+    return fe_radial_hist_add(&r->hist, fe_sphere_radial(r->fit, x));
+}
+
+static int fe__calibrate_robust_keep(void *ctx, const double x[3])
+{
+    fe__calibrate_robust *r = ctx;
+    if (fabs(fe_sphere_radial(r->fit, x)) > r->threshold) {
+        r->rejected++;
+        return FE_OK;
+    }
+    return fe_quadric_blocks_add(r->q, x);
+}
 
 /* One sample of the second pass: measured when it was fitted (still, or
    no gate), written in any case. */
 typedef struct fe__calibrate_measure {
     unsigned char hit[FE_QUADRIC_REGIONS];
     double ss, n;
+    double reject;              /* --robust: |e| beyond it not measured */
     FILE *apply;
 } fe__calibrate_measure;
 
@@ -337,6 +467,8 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
 {
     double y[3], len;
     int r;
+    if (still && m->reject > 0.0 && fabs(fe_sphere_radial(fit, x)) > m->reject)
+        still = 0;
     if (still) {
         fe_sphere_apply(fit, x, y);
         r = fe_quadric_region(y);
@@ -354,7 +486,7 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
 
 static int fe__calibrate_second_pass(const fe__calibrate_args *a,
                                      const size_t cols[6], size_t ncols,
-                                     fe_still *gate,
+                                     fe_still *gate, double reject,
                                      const fe_sphere_fit *fit,
                                      const fe_sphere_scaled *sc,
                                      fe__calibrate_pass2 *out)
@@ -387,6 +519,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
                 t->names[cols[1]], t->names[cols[2]]);
         m.apply = o.file;
     }
+    m.reject = reject;
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
     while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
@@ -505,6 +638,12 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
     if (p2->still)
         printf(", \"static_kept\": %llu, \"static_left_out\": %llu",
                (unsigned long long)p2->kept, (unsigned long long)p2->left_out);
+    if (p2->robust == 1) {
+        printf(", \"robust_rejected\": %llu", (unsigned long long)p2->rejected);
+        fe__calibrate_json_key("robust_threshold_percent", 100.0 * p2->threshold);
+    } else if (p2->robust == 2) {
+        printf(", \"robust_flagged\": %llu", (unsigned long long)p2->rejected);
+    }
     printf(", \"bad_rows\": ");
     fe_cli_json_bad_rows(stdout);
     printf(", \"iterations\": %d, \"algebraic\": %s, \"refusal\": ", f->iterations,
@@ -528,6 +667,14 @@ static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
     if (p2->still)
         printf("  static           %llu still samples kept, %llu left out (moving or handled)\n",
                (unsigned long long)p2->kept, (unsigned long long)p2->left_out);
+    if (p2->robust == 1)
+        printf("  robust           %llu outliers rejected (radial error beyond %.3g %% of the\n"
+               "                   field), fitted again from the kept samples\n",
+               (unsigned long long)p2->rejected, 100.0 * p2->threshold);
+    else if (p2->robust == 2)
+        printf("  robust           %llu outliers flagged against provisional fits; standard\n"
+               "                   input cannot be read again: none rejected\n",
+               (unsigned long long)p2->rejected);
     printf("  offset b         ");
     for (int j = 0; j < 3; j++)
         printf("  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
@@ -650,6 +797,8 @@ int fe_cli_calibrate(int argc, char **argv)
     fe_sphere_fit fit;
     fe_sphere_scaled sc;
     fe_still gate, *g = NULL;
+    fe__calibrate_flags flag_state, *flags = NULL;
+    fe__calibrate_robust robust;
     double *ring = NULL;
     size_t cols[6], ncols;
     char err[1024];
@@ -677,8 +826,15 @@ int fe_cli_calibrate(int argc, char **argv)
         }
         g = &gate;
     }
+    memset(&robust, 0, sizeof robust);
+    if (a.robust && strcmp(a.path, "-") == 0) {
+        memset(&flag_state, 0, sizeof flag_state);
+        flag_state.model = a.model;
+        flag_state.k = a.robust_k;
+        flags = &flag_state;
+    }
     if (rc == FE_CLI_OK)
-        rc = fe__calibrate_fold(&t, cols, ncols, g, &q);
+        rc = fe__calibrate_fold(&t, cols, ncols, g, flags, &q);
     if (rc != FE_CLI_OK) {
         free(ring);
         fe_cli_table_close(&t);
@@ -691,12 +847,30 @@ int fe_cli_calibrate(int argc, char **argv)
     if (a.trace)
         opt.trace = fe__calibrate_trace;
     fitrc = fe_sphere_fit_blocks(&q, a.model, &opt, &fit);
+    if (fitrc == FE_OK && a.robust && flags == NULL) {
+        /* Two more passes: the bulk's scale under this fit, then the
+           samples within k of it folded anew and fitted again. */
+        fe_sphere_fit first = fit;
+        robust.fit = &first;
+        rc = fe__calibrate_walk(&a, cols, ncols, g, fe__calibrate_robust_hist, &robust);
+        robust.threshold = a.robust_k * fe_radial_hist_scale(&robust.hist);
+        robust.q = &q;
+        fe_quadric_blocks_init(&q);
+        if (rc == FE_CLI_OK)
+            rc = fe__calibrate_walk(&a, cols, ncols, g, fe__calibrate_robust_keep, &robust);
+        if (rc != FE_CLI_OK) {
+            free(ring);
+            fe_cli_table_close(&t);
+            return rc;
+        }
+        fitrc = fe_sphere_fit_blocks(&q, a.model, &opt, &fit);
+    }
     memset(&p2, 0, sizeof p2);
     memset(&sc, 0, sizeof sc);
     if (fitrc == FE_OK && fe_sphere_scale(&fit, a.field, &sc) != FE_OK)
         fitrc = FE_EINVAL;      /* not reached: an accepted fit has a radius */
     if (fitrc == FE_OK) {
-        rc = fe__calibrate_second_pass(&a, cols, ncols, g, &fit, &sc, &p2);
+        rc = fe__calibrate_second_pass(&a, cols, ncols, g, robust.threshold, &fit, &sc, &p2);
         if (rc != FE_CLI_OK) {
             free(ring);
             fe_cli_table_close(&t);
@@ -707,6 +881,9 @@ int fe_cli_calibrate(int argc, char **argv)
     p2.still = a.still;
     p2.kept = still_kept;
     p2.left_out = still_out;
+    p2.robust = a.robust ? (flags != NULL ? 2 : 1) : 0;
+    p2.rejected = flags != NULL ? flags->flagged : robust.rejected;
+    p2.threshold = robust.threshold;
     if (a.json)
         fe__calibrate_json(&t, &fit, &sc, a.field, fitrc, &p2);
     if (fitrc != FE_OK) {
