@@ -275,6 +275,11 @@ START_TEST(json_outputs_follow_their_schemas)
         snprintf(cmd, sizeof cmd, "%s calibrate --model %s --columns mx,my,mz --json %s", F, model[m], path);
         json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
     }
+    /* With a known field, still segments and outliers rejected. */
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns mx,my,mz --field 48 --static --still-sd 0.05"
+             " --robust --json %s", F, path);
+    json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"robust_rejected\": ") != NULL, "%s", out);
     snprintf(path, sizeof path, "%s/plane.csv", dir);
     write_text(path, "x,y,z\n1,0,0\n0,1,0\n-1,0,0\n0,-1,0\n0.7,0.7,0\n-0.7,0.7,0\n0.7,-0.7,0\n-0.7,-0.7,0\n"
                      "0.6,0.8,0\n0.8,0.6,0\n-0.6,0.8,0\n0.8,-0.6,0\n");
