@@ -420,6 +420,88 @@ START_TEST(robust_rejects_outliers)
 }
 END_TEST
 
+
+/* --report DIR: the page and its data; the histogram and the coverage map
+   count every fitted sample (here all 3000 of a recording whose radial
+   errors lie within the histogram's 4 RMS but for a few), samples.dat holds
+   every sample; the plots when gnuplot is there; refused from standard
+   input. */
+START_TEST(report_with_plots)
+{
+    char path[] = "/tmp/foldest-cal-XXXXXX", dir[64], file[128], out[16384];
+    static char page[65536];
+    int fd = mkstemp(path), status, plots;
+    double sum = 0.0, v;
+    size_t rows = 0;
+    FILE *f;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 3000, WHOLE, NULL);
+    snprintf(dir, sizeof dir, "%s.d", path);
+    status = run("%1$s calibrate --columns mx,my,mz --report %2$s.d %2$s 2>&1", path, out,
+                 sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "report.md"));
+    snprintf(file, sizeof file, "%s/report.md", dir);
+    fe_test_read_file(file, page, sizeof page);
+    ck_assert_ptr_nonnull(strstr(page, "axial fit of 3000 samples"));
+    ck_assert_ptr_nonnull(strstr(page, "## Coverage"));
+    snprintf(file, sizeof file, "%s/coverage.dat", dir);
+    f = fopen(file, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fscanf(f, "%lf", &v) == 1)
+        sum += v, rows++;
+    fclose(f);
+    ck_assert_uint_eq(rows, 100);
+    ck_assert_double_eq(sum, 3000);
+    snprintf(file, sizeof file, "%s/radial.dat", dir);
+    f = fopen(file, "r");
+    ck_assert_ptr_nonnull(f);
+    sum = 0.0;
+    {
+        double c, k;
+        while (fscanf(f, "%lf %lf", &c, &k) == 2)
+            sum += k;
+    }
+    fclose(f);
+    ck_assert_double_le(sum, 3000);
+    ck_assert_double_ge(sum, 2990);     /* beyond 4 RMS: a few of 3000 normal errors */
+    snprintf(file, sizeof file, "%s/samples.dat", dir);
+    f = fopen(file, "r");
+    ck_assert_ptr_nonnull(f);
+    rows = 0;
+    while (fgets(page, sizeof page, f) != NULL)
+        rows++;
+    fclose(f);
+    ck_assert_uint_eq(rows, 3000);
+    plots = system("gnuplot --version >/dev/null 2>&1") == 0;
+    if (plots) {
+        static const char *const png[] = {"raw", "calibrated", "sphere", "radial", "coverage"};
+        for (int k = 0; k < 5; k++) {
+            snprintf(file, sizeof file, "%s/%s.png", dir, png[k]);
+            ck_assert_msg(access(file, F_OK) == 0, "no %s", file);
+            unlink(file);
+        }
+    } else {
+        fprintf(stderr, "SKIP the report's plots: no gnuplot\n");
+    }
+    {
+        static const char *const names[] = {"report.md", "plots.gp", "samples.dat",
+                                            "radial.dat", "coverage.dat"};
+        for (int k = 0; k < 5; k++) {
+            snprintf(file, sizeof file, "%s/%s", dir, names[k]);
+            unlink(file);
+        }
+        ck_assert_int_eq(rmdir(dir), 0);
+    }
+    status = run("cat %2$s | %1$s calibrate --columns mx,my,mz --report %2$s.d - 2>&1", path,
+                 out, sizeof out);
+    ck_assert_int_eq(status, 2);
+    ck_assert_int_ne(access(dir, F_OK), 0);
+    unlink(path);
+}
+END_TEST
+
 START_TEST(help_documents_everything)
 {
     char out[8192];
@@ -431,7 +513,7 @@ START_TEST(help_documents_everything)
                            "offset_se_iid", "matrix_se", "batch means", "--static",
                            "--window N", "--still-sd E", "--gyro a,b,c", "--max-rate R",
                            "static_kept", "static_left_out", "--robust", "--robust-k K",
-                           "robust_rejected", "robust_flagged"};
+                           "robust_rejected", "robust_flagged", "--report DIR", "coverage map"};
     ck_assert_int_eq(run("%s calibrate --help", "", out, sizeof out), 0);
     for (size_t k = 0; k < sizeof words / sizeof words[0]; k++)
         ck_assert_msg(strstr(out, words[k]) != NULL, "--help lacks %s", words[k]);
@@ -559,6 +641,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_loop_test(t, refusals_and_errors, 0,
                         (int)(sizeof refusals / sizeof refusals[0]));
     tcase_add_test(t, known_field);
+    tcase_add_test(t, report_with_plots);
     tcase_add_test(t, robust_rejects_outliers);
     tcase_add_test(t, export_for_firmware);
     tcase_add_test(t, help_documents_everything);

@@ -19,7 +19,7 @@ _foldest()
         stats) opts="--columns --skip --json" ;;
         calibrate) opts="--model --columns --apply --skip --json --trace --field --export
                          --mgauss --static --window --still-sd --gyro --max-rate --robust
-                         --robust-k" ;;
+                         --robust-k --report" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
                         --alpha --order --report --json --sphere --columns --term --terms
                         --only --exclude" ;;

@@ -3,7 +3,9 @@
 /* [[file:../../literate/calibrate.org::Calibrate Includes and Help][Calibrate Includes and Help]] */
 #include "cli.h"
 
+#include <errno.h>
 #include <math.h>
+#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,6 +16,7 @@ static const char *const fe__calibrate_help[] = {
     "                         [--field F] [--export ardupilot|c|json]\n"
     "                         [--mgauss K] [--static [--window N] [--still-sd E]\n"
     "                         [--gyro a,b,c --max-rate R]] [--robust [--robust-k K]]\n"
+    "                         [--report DIR]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -73,6 +76,10 @@ static const char *const fe__calibrate_help[] = {
     "                  folding (robust_flagged), and not rejected\n"
     "  --robust-k K    the rejection threshold in robust standard deviations\n"
     "                  (default 5)\n"
+    "  --report DIR    write DIR/report.md: the report, with plots (gnuplot, PNG)\n"
+    "                  of the raw and calibrated samples in three projections\n"
+    "                  and on the sphere, the radial errors' histogram and the\n"
+    "                  coverage map, and their data; needs a file\n"
     "\n"
     ,
     "The samples are folded once into 35 moments; the fit never reads them again.\n"
@@ -105,7 +112,7 @@ static void fe__calibrate_usage(FILE *out)
 enum fe__calibrate_export { FE__EXPORT_NONE, FE__EXPORT_ARDUPILOT, FE__EXPORT_C };
 
 typedef struct fe__calibrate_args {
-    const char *path, *apply;
+    const char *path, *apply, *report;
     char *columns;
     long skip;
     double field;               /* 0: not given */
@@ -126,7 +133,7 @@ static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
     {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {"--static", 0}, {"--window", 1},
     {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {"--robust", 0},
-    {"--robust-k", 1}, {NULL, 0}};
+    {"--robust-k", 1}, {"--report", 1}, {NULL, 0}};
 
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
@@ -176,6 +183,8 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                         fmt);
                 return FE_CLI_USAGE;
             }
+        } else if (strcmp(argv[i], "--report") == 0 && i + 1 < argc) {
+            a->report = argv[++i];
         } else if (strcmp(argv[i], "--robust") == 0) {
             a->robust = 1;
         } else if (strcmp(argv[i], "--robust-k") == 0 && i + 1 < argc) {
@@ -254,6 +263,11 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     }
     if (!a->still && (a->gyro != NULL || a->still_opt.max_rate > 0.0)) {
         fprintf(stderr, "foldest calibrate: --gyro and --max-rate go with --static\n");
+        return FE_CLI_USAGE;
+    }
+    if (a->report != NULL && strcmp(a->path, "-") == 0) {
+        fprintf(stderr, "foldest calibrate: --report plots the samples, read again after the "
+                        "fit: give a file, not standard input\n");
         return FE_CLI_USAGE;
     }
     if (a->apply != NULL && strcmp(a->path, "-") == 0) {
@@ -379,6 +393,8 @@ typedef struct fe__calibrate_pass2 {
     int robust;                 /* 1: rejected, 2: flagged only */
     uint64_t rejected;
     double threshold;           /* |e| beyond it rejected (robust 1) */
+    double region_n[FE_QUADRIC_REGIONS];  /* --report: the coverage map */
+    double hist[80], hist_lo, hist_w;     /* --report: radial errors, % */
 } fe__calibrate_pass2;
 
 /* Read the file again and hand every sample the fit used (all, or the
@@ -455,9 +471,15 @@ static int fe__calibrate_robust_keep(void *ctx, const double x[3])
 
 /* One sample of the second pass: measured when it was fitted (still, or
    no gate), written in any case. */
+enum { FE__CAL_HIST = 80 };
+
 typedef struct fe__calibrate_measure {
     unsigned char hit[FE_QUADRIC_REGIONS];
     double ss, n;
+    double region_n[FE_QUADRIC_REGIONS];  /* --report: samples per region */
+    double hist[FE__CAL_HIST], hist_lo, hist_w;   /* radial errors, % */
+    FILE *samples;              /* --report: samples.dat, or NULL */
+    unsigned long seen, stride;
     double reject;              /* --robust: |e| beyond it not measured */
     FILE *apply;
 } fe__calibrate_measure;
@@ -477,6 +499,19 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
         len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
         m->ss += (len - 1.0) * (len - 1.0);
         m->n += 1.0;
+        if (r >= 0)
+            m->region_n[r] += 1.0;
+        if (m->hist_w > 0.0) {
+            double b = floor((100.0 * (len - 1.0) - m->hist_lo) / m->hist_w);
+            if (b >= 0.0 && b < FE__CAL_HIST)
+                m->hist[(int)b] += 1.0;
+        }
+    }
+    if (m->samples != NULL && m->seen++ % m->stride == 0) {
+        fe_sphere_apply(fit, x, y);
+        fprintf(m->samples, "%.10g %.10g %.10g %.8g %.8g %.8g %.6g %d\n", x[0], x[1], x[2],
+                y[0], y[1], y[2],
+                100.0 * (sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0), still);
     }
     if (m->apply != NULL) {
         fe_sphere_scaled_apply(sc, x, y);
@@ -486,7 +521,7 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
 
 static int fe__calibrate_second_pass(const fe__calibrate_args *a,
                                      const size_t cols[6], size_t ncols,
-                                     fe_still *gate, double reject,
+                                     fe_still *gate, double reject, size_t rows,
                                      const fe_sphere_fit *fit,
                                      const fe_sphere_scaled *sc,
                                      fe__calibrate_pass2 *out)
@@ -520,6 +555,21 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
         m.apply = o.file;
     }
     m.reject = reject;
+    if (a->report != NULL) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/samples.dat", a->report);
+        m.samples = fopen(path, "w");
+        if (m.samples == NULL) {
+            fprintf(stderr, "foldest calibrate: %s: cannot write: %s\n", path, strerror(errno));
+            if (apply != NULL)
+                fe_cli_output_abort(&o);
+            fe_cli_table_close(t);
+            return FE_CLI_IO;
+        }
+        m.stride = rows > 20000 ? (unsigned long)((rows + 19999) / 20000) : 1;
+        m.hist_w = 8.0 * fmax(fit->rms_percent, 0.001) / FE__CAL_HIST;
+        m.hist_lo = -0.5 * FE__CAL_HIST * m.hist_w;
+    }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
     while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
@@ -540,17 +590,30 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
         fprintf(stderr, "foldest calibrate: %s\n", err);
         if (apply != NULL)
             fe_cli_output_abort(&o);
+        if (m.samples != NULL)
+            fclose(m.samples);
         fe_cli_table_close(t);
         return rc;
     }
     if (apply != NULL && fe_cli_output_commit(&o, err, sizeof err) != FE_CLI_OK) {
         fprintf(stderr, "foldest calibrate: %s\n", err);
+        if (m.samples != NULL)
+            fclose(m.samples);
         fe_cli_table_close(t);
         return FE_CLI_IO;
     }
     out->done = 1;
     for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
         out->regions += m.hit[r];
+    memcpy(out->region_n, m.region_n, sizeof out->region_n);
+    memcpy(out->hist, m.hist, sizeof out->hist);
+    out->hist_lo = m.hist_lo;
+    out->hist_w = m.hist_w;
+    if (m.samples != NULL && fclose(m.samples) != 0) {
+        fprintf(stderr, "foldest calibrate: %s/samples.dat: cannot write\n", a->report);
+        fe_cli_table_close(t);
+        return FE_CLI_IO;
+    }
     out->rms_radial_percent = m.n > 0 ? 100.0 * sqrt(m.ss / m.n) : 0.0;
     fe_cli_table_close(t);
     return FE_CLI_OK;
@@ -657,65 +720,65 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
     printf("}\n");
 }
 
-static void fe__calibrate_text(const fe_cli_table *t, const fe_sphere_fit *f,
+static void fe__calibrate_text(FILE *out, const fe_cli_table *t, const fe_sphere_fit *f,
                                const fe_sphere_scaled *sc, double field,
                                const fe__calibrate_pass2 *p2)
 {
     static const char *const axis[3] = {"x", "y", "z"};
-    printf("%s: %s fit of %llu samples, %d iterations\n", t->name,
+    fprintf(out, "%s: %s fit of %llu samples, %d iterations\n", t->name,
            fe_sphere_model_name(f->model), (unsigned long long)f->n, f->iterations);
     if (p2->still)
-        printf("  static           %llu still samples kept, %llu left out (moving or handled)\n",
+        fprintf(out, "  static           %llu still samples kept, %llu left out (moving or handled)\n",
                (unsigned long long)p2->kept, (unsigned long long)p2->left_out);
     if (p2->robust == 1)
-        printf("  robust           %llu outliers rejected (radial error beyond %.3g %% of the\n"
+        fprintf(out, "  robust           %llu outliers rejected (radial error beyond %.3g %% of the\n"
                "                   field), fitted again from the kept samples\n",
                (unsigned long long)p2->rejected, 100.0 * p2->threshold);
     else if (p2->robust == 2)
-        printf("  robust           %llu outliers flagged against provisional fits; standard\n"
+        fprintf(out, "  robust           %llu outliers flagged against provisional fits; standard\n"
                "                   input cannot be read again: none rejected\n",
                (unsigned long long)p2->rejected);
-    printf("  offset b         ");
+    fprintf(out, "  offset b         ");
     for (int j = 0; j < 3; j++)
-        printf("  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
-    printf("\n  matrix M (y = M (x - b) on the unit sphere), +- standard errors\n");
+        fprintf(out, "  %s %.6g +- %.2g", axis[j], f->offset[j], f->se[j]);
+    fprintf(out, "\n  matrix M (y = M (x - b) on the unit sphere), +- standard errors\n");
     for (int i = 0; i < 3; i++)
-        printf("      %14.7g %14.7g %14.7g    +- %9.2g %9.2g %9.2g\n", f->matrix[3 * i],
+        fprintf(out, "      %14.7g %14.7g %14.7g    +- %9.2g %9.2g %9.2g\n", f->matrix[3 * i],
                f->matrix[3 * i + 1], f->matrix[3 * i + 2], f->matrix_se[3 * i],
                f->matrix_se[3 * i + 1], f->matrix_se[3 * i + 2]);
     if (f->se_blocks > 0)
-        printf("  errors           from the spread of %d blocks in time (batch means): the\n"
+        fprintf(out, "  errors           from the spread of %d blocks in time (batch means): the\n"
                "                   offsets' are %.2g, %.2g, %.2g times what independent\n"
                "                   samples would give\n", f->se_blocks, f->se[0] / f->se_iid[0],
                f->se[1] / f->se_iid[1], f->se[2] / f->se_iid[2]);
-    printf("  field            %.6g (semi-axes %.6g %.6g %.6g)\n", f->radius, f->axes[0],
+    fprintf(out, "  field            %.6g (semi-axes %.6g %.6g %.6g)\n", f->radius, f->axes[0],
            f->axes[1], f->axes[2]);
     if (field > 0.0) {
-        printf("  known field      F = %.6g: the fitted field is %.6g F (gain %.6g sensor\n"
+        fprintf(out, "  known field      F = %.6g: the fitted field is %.6g F (gain %.6g sensor\n"
                "                   units per unit of F); calibrated samples y = F M (x - b)\n",
                sc->field, sc->gain, sc->gain);
-        printf("  matrix F M\n");
+        fprintf(out, "  matrix F M\n");
         for (int i = 0; i < 3; i++)
-            printf("      %14.7g %14.7g %14.7g\n", sc->matrix[3 * i], sc->matrix[3 * i + 1],
+            fprintf(out, "      %14.7g %14.7g %14.7g\n", sc->matrix[3 * i], sc->matrix[3 * i + 1],
                    sc->matrix[3 * i + 2]);
     }
     if (f->model != FE_FIT_ELLIPSOID) {
-        printf("  scales          ");
+        fprintf(out, "  scales          ");
         for (int k = 3; k < f->nparams; k++)
-            printf("  %.6g +- %.2g", f->params[k], f->se[k]);
-        printf("\n");
+            fprintf(out, "  %.6g +- %.2g", f->params[k], f->se[k]);
+        fprintf(out, "\n");
     }
     if (f->algebraic)
-        printf("  method           the algebraic least-squares sphere: Schmidt's residual\n"
+        fprintf(out, "  method           the algebraic least-squares sphere: Schmidt's residual\n"
                "                   has no finite minimum on these data, which are far from\n"
                "                   a sphere (try --model ellipsoid)\n");
-    printf("  rms residual     %.3f %% of the field", f->rms_percent);
+    fprintf(out, "  rms residual     %.3f %% of the field", f->rms_percent);
     if (p2->done)
-        printf(" (radial, exact: %.3f %%)", p2->rms_radial_percent);
-    printf("\n  coverage         %d %% of 100 equal-area regions%s\n",
+        fprintf(out, " (radial, exact: %.3f %%)", p2->rms_radial_percent);
+    fprintf(out, "\n  coverage         %d %% of 100 equal-area regions%s\n",
            p2->done ? p2->regions : (int)lround(100 * f->coverage),
            p2->done ? "" : " (estimated in the fold)");
-    printf("  extents          x [%.2f, %.2f]  y [%.2f, %.2f]  z [%.2f, %.2f]\n",
+    fprintf(out, "  extents          x [%.2f, %.2f]  y [%.2f, %.2f]  z [%.2f, %.2f]\n",
            f->extent_lo[0], f->extent_hi[0], f->extent_lo[1], f->extent_hi[1],
            f->extent_lo[2], f->extent_hi[2]);
 }
@@ -786,6 +849,163 @@ static int fe__calibrate_trace(const fe_sphere_iteration *it, void *ctx)
     return 0;
 }
 /* Print a calibration ends here */
+/* [[file:../../literate/calibrate.org::Write the report][Write the report]] */
+static const char *const fe__calibrate_report_files[] = {
+    "report.md", "plots.gp", "samples.dat", "radial.dat", "coverage.dat", "raw.png",
+    "calibrated.png", "sphere.png", "radial.png", "coverage.png", NULL};
+
+/* Make the folder (or take it as it is) and register its files. */
+static int fe__calibrate_report_dir(const char *dir)
+{
+    char path[4200];
+    int made = mkdir(dir, 0777) == 0;
+    if (!made && errno != EEXIST) {
+        fprintf(stderr, "foldest calibrate: %s: cannot create: %s\n", dir, strerror(errno));
+        return FE_CLI_IO;
+    }
+    for (int k = 0; fe__calibrate_report_files[k] != NULL; k++) {
+        snprintf(path, sizeof path, "%s/%s", dir, fe__calibrate_report_files[k]);
+        fe_cli_pending_add(path, 0);
+    }
+    if (made)
+        fe_cli_pending_add(dir, 1);
+    return FE_CLI_OK;
+}
+
+static int fe__calibrate_gnuplot(char *const argv[])
+{
+    return fe_cli_spawn(argv);
+}
+
+/* The histogram, the coverage map, the page and the script; then gnuplot. */
+static int fe__calibrate_report(const fe__calibrate_args *a, const fe_cli_table *t,
+                                const size_t cols[6], const fe_sphere_fit *f,
+                                const fe_sphere_scaled *sc, const fe__calibrate_pass2 *p2)
+{
+    char path[4200];
+    char *const version[] = {"gnuplot", "--version", NULL};
+    int plots = fe__calibrate_gnuplot(version) == 0, bad;
+    FILE *o;
+
+    snprintf(path, sizeof path, "%s/radial.dat", a->report);
+    if ((o = fopen(path, "w")) == NULL)
+        goto fail;
+    for (int k = 0; k < 80; k++)
+        fprintf(o, "%.6g %.0f\n", p2->hist_lo + (k + 0.5) * p2->hist_w, p2->hist[k]);
+    if (fclose(o) != 0)
+        goto fail;
+    snprintf(path, sizeof path, "%s/coverage.dat", a->report);
+    if ((o = fopen(path, "w")) == NULL)
+        goto fail;
+    for (int band = 0; band < 10; band++)       /* a row per band of z */
+        for (int sector = 0; sector < 10; sector++)
+            fprintf(o, "%.0f%c", p2->region_n[10 * band + sector], sector < 9 ? ' ' : '\n');
+    if (fclose(o) != 0)
+        goto fail;
+
+    snprintf(path, sizeof path, "%s/report.md", a->report);
+    if ((o = fopen(path, "w")) == NULL)
+        goto fail;
+    fprintf(o, "# foldest calibrate report\n\n"
+               "Columns `%s`, `%s`, `%s` of `%s`.\n\n```\n", t->names[cols[0]],
+            t->names[cols[1]], t->names[cols[2]], t->name);
+    fe__calibrate_text(o, t, f, sc, a->field, p2);
+    fprintf(o, "```\n\n");
+    if (!plots)
+        fprintf(o, "(gnuplot is not installed: no plots.  `gnuplot plots.gp` in this folder "
+                   "draws them where it is.)\n\n");
+    fprintf(o, "## Raw samples\n\n%s"
+               "The samples as recorded, in three planes: an ellipse off the origin is hard "
+               "iron (the offset) and soft iron (the matrix).%s\n\n",
+            plots ? "![raw samples](raw.png)\n\n" : "",
+            p2->still ? "  Grey: left out by --static." : "");
+    fprintf(o, "## Calibrated samples\n\n%s%s"
+               "M (x - b) in the same planes and on the sphere, in units of the field: on "
+               "the unit circle and sphere when the calibration is right.\n\n",
+            plots ? "![calibrated samples](calibrated.png)\n\n" : "",
+            plots ? "![on the sphere](sphere.png)\n\n" : "");
+    fprintf(o, "## Radial error\n\n%s"
+               "The histogram of |M (x - b)| - 1 of the fitted samples, in per cent of the "
+               "field (RMS %.3f %%).\n\n",
+            plots ? "![radial error](radial.png)\n\n" : "", p2->rms_radial_percent);
+    fprintf(o, "## Coverage\n\n%s"
+               "The fitted samples in the 100 equal-area regions of the sphere (rows: 10 "
+               "bands of z from -1 to 1; columns: 10 sectors of 36 degrees of longitude); "
+               "%d regions have samples.  Empty regions are orientations the sensor never "
+               "took.\n\n",
+            plots ? "![coverage](coverage.png)\n\n" : "", p2->regions);
+    fprintf(o, "## Data\n\n"
+               "- `samples.dat`: raw x y z, calibrated x y z (units of the field), radial "
+               "error in per cent, 1 fitted or 0 left out; every sample up to 20000, else "
+               "every k-th.\n- `radial.dat`: bin centre in per cent, samples.\n"
+               "- `coverage.dat`: 10 rows (bands of z) of 10 counts (sectors).\n"
+               "- `plots.gp`: `gnuplot plots.gp` in this folder draws the plots again.\n");
+    bad = ferror(o);
+    if (fclose(o) != 0 || bad)
+        goto fail;
+
+    snprintf(path, sizeof path, "%s/plots.gp", a->report);
+    if ((o = fopen(path, "w")) == NULL)
+        goto fail;
+    fprintf(o, "# foldest calibrate: the report's plots.  In this folder: gnuplot plots.gp\n"
+               "if (ARGC > 0) cd ARG1\n"
+               "set terminal pngcairo size 1200,420 noenhanced\nset grid\nunset key\n"
+               "set output 'raw.png'\nset multiplot layout 1,3 title 'raw samples'\n"
+               "set size ratio -1\n");
+    for (int pl = 0; pl < 2; pl++) {
+        static const char *const lab[3][2] = {{"x", "y"}, {"x", "z"}, {"y", "z"}};
+        static const int c[3][2] = {{1, 2}, {1, 3}, {2, 3}};
+        if (pl == 1)
+            fprintf(o, "set output 'calibrated.png'\n"
+                       "set multiplot layout 1,3 title 'calibrated samples, units of the field'\n"
+                       "set xrange [-1.3:1.3]\nset yrange [-1.3:1.3]\n"
+                       "set object 1 circle at 0,0 size 1 fs empty border lc rgb '#000000'\n");
+        for (int k = 0; k < 3; k++)
+            fprintf(o, "set xlabel '%s'\nset ylabel '%s'\n"
+                       "plot 'samples.dat' using %d:($8 == 1 ? $%d : NaN) with dots "
+                       "lc rgb '#1f4e79', '' using %d:($8 == 0 ? $%d : NaN) with dots "
+                       "lc rgb '#b0b0b0'\n",
+                    lab[k][0], lab[k][1], c[k][0] + 3 * pl, c[k][1] + 3 * pl, c[k][0] + 3 * pl,
+                    c[k][1] + 3 * pl);
+        fprintf(o, "unset multiplot\nunset object 1\nset autoscale\n");
+    }
+    fprintf(o, "set terminal pngcairo size 700,700 noenhanced\nset output 'sphere.png'\n"
+               "set title 'calibrated samples on the unit sphere'\nset view equal xyz\n"
+               "set xyplane at -1.3\nset xrange [-1.3:1.3]\nset yrange [-1.3:1.3]\n"
+               "set zrange [-1.3:1.3]\n"
+               "set parametric\nset isosamples 13,13\nset urange [0:2*pi]\n"
+               "set vrange [-pi/2:pi/2]\nset xlabel 'x'\nset ylabel 'y'\nset zlabel 'z'\n"
+               "splot cos(u)*cos(v), sin(u)*cos(v), sin(v) with lines lc rgb '#d0d0d0', "
+               "'samples.dat' using ($8 == 1 ? $4 : NaN):5:6 with dots lc rgb '#1f4e79'\n"
+               "unset parametric\nunset view\nset autoscale\n"
+               "set terminal pngcairo size 800,500 noenhanced\nset output 'radial.png'\n"
+               "set title 'radial error of the fitted samples'\n"
+               "set xlabel 'radial error |M (x - b)| - 1 (%% of the field)'\n"
+               "set ylabel 'samples'\nset style fill solid 0.6\nset boxwidth %.6g\n"
+               "plot 'radial.dat' using 1:2 with boxes lc rgb '#1f4e79'\n"
+               "set terminal pngcairo size 800,500 noenhanced\nset output 'coverage.png'\n"
+               "set title 'coverage: fitted samples in the 100 equal-area regions'\n"
+               "set xlabel 'longitude (sector of 36 degrees)'\n"
+               "set ylabel 'band of z, from -1 (bottom) to 1 (top)'\n"
+               "set xrange [-0.5:9.5]\nset yrange [-0.5:9.5]\n"
+               "set palette defined (0 '#ffffff', 1 '#9ecae1', 2 '#08306b')\n"
+               "plot 'coverage.dat' matrix with image\n", p2->hist_w);
+    bad = ferror(o);
+    if (fclose(o) != 0 || bad)
+        goto fail;
+    if (plots) {
+        char *const argv[] = {"gnuplot", "-c", path, (char *)a->report, NULL};
+        if (fe__calibrate_gnuplot(argv) != 0) {
+            fprintf(stderr, "foldest calibrate: %s: gnuplot failed\n", path);
+            return FE_CLI_IO;
+        }
+    }
+    return FE_CLI_OK;
+fail:
+    fprintf(stderr, "foldest calibrate: %s: cannot write: %s\n", path, strerror(errno));
+    return FE_CLI_IO;
+}
+/* Write the report ends here */
 /* [[file:../../literate/calibrate.org::Calibrate a recording][Calibrate a recording]] */
 int fe_cli_calibrate(int argc, char **argv)
 {
@@ -870,7 +1090,11 @@ int fe_cli_calibrate(int argc, char **argv)
     if (fitrc == FE_OK && fe_sphere_scale(&fit, a.field, &sc) != FE_OK)
         fitrc = FE_EINVAL;      /* not reached: an accepted fit has a radius */
     if (fitrc == FE_OK) {
-        rc = fe__calibrate_second_pass(&a, cols, ncols, g, robust.threshold, &fit, &sc, &p2);
+        if (a.report != NULL)
+            rc = fe__calibrate_report_dir(a.report);
+        if (rc == FE_CLI_OK)
+            rc = fe__calibrate_second_pass(&a, cols, ncols, g, robust.threshold, t.rows, &fit,
+                                           &sc, &p2);
         if (rc != FE_CLI_OK) {
             free(ring);
             fe_cli_table_close(&t);
@@ -894,7 +1118,17 @@ int fe_cli_calibrate(int argc, char **argv)
     if (a.export_format != FE__EXPORT_NONE)
         fe__calibrate_export(&a, &t, &fit, &sc);
     else if (!a.json)
-        fe__calibrate_text(&t, &fit, &sc, a.field, &p2);
+        fe__calibrate_text(stdout, &t, &fit, &sc, a.field, &p2);
+    if (a.report != NULL) {
+        rc = fe__calibrate_report(&a, &t, cols, &fit, &sc, &p2);
+        if (rc != FE_CLI_OK) {
+            fe_cli_table_close(&t);
+            return rc;
+        }
+        fe_cli_pending_clear();
+        if (!a.json && a.export_format == FE__EXPORT_NONE)
+            printf("  report           %s/report.md\n", a.report);
+    }
     fe_cli_table_close(&t);
     return FE_CLI_OK;
 }
