@@ -58,7 +58,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc check-doc demo run-examples bench size install uninstall clean \
+        check-install check-tangle tangle doc figures check-doc demo run-examples bench size install uninstall clean \
         check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
 
 all: lib cli examples
@@ -397,7 +397,23 @@ check-tangle: tangle-scratch
 	done; \
 	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
 
-doc: $(B)/.deps
+# The book's figures, drawn by the project's own programs when the book is
+# woven: literate/figures/*.py run foldest on data they generate (and on
+# ../shared/data when it is there), count, and draw with gnuplot into
+# $(B)/doc/figures, beside a .dat of the numbers and the .gp that draws them.
+# A figure is redrawn when its script or the command changed;
+# `rm -rf $(B)/doc/figures && make figures` redraws them all (about 30 s).
+FIG          := $(B)/doc/figures
+FIGURES      := $(FIG)/discover-noise.svg $(FIG)/sphere-synthetic.svg
+figures: $(FIGURES)
+$(FIG)/discover-noise.svg: literate/figures/discover_noise.py $(CLI)
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+$(FIG)/sphere-synthetic.svg: literate/figures/sphere_calibration.py $(CLI)
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+
+doc: $(B)/.deps figures
 	@mkdir -p $(B)/doc
 	@emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) >$(B)/doc/weave.log 2>&1 \
 	  || { cat $(B)/doc/weave.log; echo "doc: weaving failed"; exit 1; }
