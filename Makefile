@@ -392,7 +392,8 @@ check-tangle: tangle-scratch
 	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
 	done; \
 	for f in $$(find include src tests examples bench -path tests/fuzz/corpus -prune -o -type f \
-	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el; do \
+	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el \
+	              $(wildcard literate/figures/*.py); do \
 	  head -2 "$$f" | grep -q 'SPDX-License-Identifier: MIT' || { echo "check-tangle: $$f has no SPDX line at its top"; status=1; }; \
 	done; \
 	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
