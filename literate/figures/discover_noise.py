@@ -81,7 +81,7 @@ set output 'discover-noise.svg'
 set datafile missing 'NaN'
 set multiplot layout 1,2 title "A drift concealed in %(seeds)d synthetic records of %(rows)d rows per colour, found by foldest discover" font 'sans,17'
 set xlabel "lag-one correlation {/:Italic ρ} of the AR(1) noise (0: white)"
-set xrange [-0.06:0.96]
+set xrange [-0.1:1.0]
 set xtics (%(xtics)s)
 set ytics 0.2
 set grid ytics lc rgb '#dddddd'
@@ -90,18 +90,19 @@ set style line 2 lc rgb '#c0392b' lw 2.5 pt 5 ps 1.2 dt 2
 set yrange [-0.06:1.14]
 set title 'Power: the drift is named'
 set ylabel 'fraction of the records'
-set key bottom left box opaque width 1 font 'sans,14'
-plot 'discover-noise.dat' u 1:($2==0?$7:NaN) w lp ls 1 t 'noise model (default)', \
+set key top right box opaque font 'sans,14' samplen 2
+plot 'discover-noise.dat' u 1:($2==0?$7:NaN) w lp ls 1 t 'noise model', \
      '' u 1:($2==1?$7:NaN) w lp ls 2 t 'batch means', \
-     '' u 1:($2==0?$7:NaN):(sprintf('%%d/%%d',$4,$3)) w labels offset 0,1 tc rgb '#1f5fa8' font 'sans,12' notitle, \
-     '' u 1:($2==1?$7:NaN):(sprintf('%%d/%%d',$4,$3)) w labels offset 0,-1 tc rgb '#c0392b' font 'sans,12' notitle
+     '' u 1:($2==0?$7:NaN):(sprintf('%%d/%%d',$4,$3)) w labels offset -1.2,0.9 tc rgb '#1f5fa8' font 'sans,12' notitle, \
+     '' u 1:($2==1?$7:NaN):(sprintf('%%d/%%d',$4,$3)) w labels offset 1.2,-0.9 tc rgb '#c0392b' font 'sans,12' notitle
 set title 'Coverage: the 95 %% interval holds the truth'
 set ylabel 'fraction of the intervals given'
+set key bottom left
 plot 0.95 w l lc rgb '#555555' dt 3 lw 1.5 t 'nominal 0.95', \
      'discover-noise.dat' u 1:($2==0?$8:NaN) w lp ls 1 notitle, \
      '' u 1:($2==1?$8:NaN) w lp ls 2 notitle, \
-     '' u 1:($2==0?$8:NaN):(sprintf('%%d/%%d',$5,$4)) w labels offset 0,1 tc rgb '#1f5fa8' font 'sans,12' notitle, \
-     '' u 1:($2==1?$8:NaN):(sprintf('%%d/%%d',$5,$4)) w labels offset 0,-1 tc rgb '#c0392b' font 'sans,12' notitle
+     '' u 1:($2==0?$8:NaN):(sprintf('%%d/%%d',$5,$4)) w labels offset -1.2,0.9 tc rgb '#1f5fa8' font 'sans,12' notitle, \
+     '' u 1:($2==1?$8:NaN):(sprintf('%%d/%%d',$5,$4)) w labels offset 1.2,-0.9 tc rgb '#c0392b' font 'sans,12' notitle
 unset multiplot
 """
 
