@@ -402,17 +402,20 @@ check-tangle: tangle-scratch
 # woven: literate/figures/*.py run foldest on data they generate (and on
 # ../shared/data when it is there), count, and draw with gnuplot into
 # $(B)/doc/figures, beside a .dat of the numbers and the .gp that draws them.
-# A figure is redrawn when its script or the command changed;
-# `rm -rf $(B)/doc/figures && make figures` redraws them all (about 30 s).
+# The discovery figure (160 analyses, about 30 s) is redrawn when its script
+# or the command changed, `rm -rf $(B)/doc/figures && make figures` redraws
+# it anyway; the sphere figures (about a second) are redrawn every time, so
+# that they follow ../shared/data as it comes and goes.
 FIG          := $(B)/doc/figures
 FIGURES      := $(FIG)/discover-noise.svg $(FIG)/sphere-synthetic.svg
 figures: $(FIGURES)
 $(FIG)/discover-noise.svg: literate/figures/discover_noise.py $(CLI)
 	@mkdir -p $(@D)
 	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
-$(FIG)/sphere-synthetic.svg: literate/figures/sphere_calibration.py $(CLI)
+$(FIG)/sphere-synthetic.svg: literate/figures/sphere_calibration.py $(CLI) FORCE
 	@mkdir -p $(@D)
 	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+FORCE:
 
 doc: $(B)/.deps figures
 	@mkdir -p $(B)/doc
