@@ -77,6 +77,42 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* synth --rho sets the noise's colour and nothing else: the same truth
+   (coefficient and noise sd) for white noise and for an AR(1) with lag-one
+   correlation 0.9, and discover's baseline residual has the lag-one
+   correlation asked for. */
+START_TEST(synth_rho_sets_the_noise_colour)
+{
+    static char out[65536];
+    char cmd[2048], truth[2][256];
+    const double rho[2] = {0.0, 0.9};
+    make_dir();
+    for (int k = 0; k < 2; k++) {
+        const char *at, *end, *lag1;
+        snprintf(cmd, sizeof cmd, "%s synth --effect drift --seed 3 --rows 20000 --rho %g "
+                 "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, rho[k], dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+        at = strstr(out, "coefficient ");
+        ck_assert_ptr_nonnull(at);
+        end = strstr(at, ", lag-one correlation");
+        ck_assert_ptr_nonnull(end);
+        snprintf(truth[k], sizeof truth[k], "%.*s", (int)(end - at), at);
+        ck_assert_msg(atof(end + strlen(", lag-one correlation")) == rho[k], "%s", out);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel acceleration "
+                 "--role position=position --role velocity=velocity --role input=input "
+                 "--base bias,gain --json", FE_TEST_CLI, dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+        lag1 = strstr(out, "\"baseline\": {");
+        ck_assert_ptr_nonnull(lag1);
+        lag1 = strstr(lag1, "\"lag1\": ");
+        ck_assert_ptr_nonnull(lag1);
+        ck_assert_double_eq_tol(atof(lag1 + strlen("\"lag1\": ")), rho[k], 0.03);
+    }
+    ck_assert_str_eq(truth[0], truth[1]);
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
 /* Output error (--order K): a cart's missing viscous friction named in its
    acceleration with the synthetic truth inside the interval; a heated
    stand's missing convective loss in its dT/dt; the additive mode on a
@@ -813,6 +849,7 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, synth_rho_sets_the_noise_colour);
     tcase_add_test(t, output_error_is_named_in_the_derivative_it_enters);
     tcase_add_test(t, a_function_of_the_state_left_is_not_explained);
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);
