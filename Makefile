@@ -58,7 +58,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc check-doc demo run-examples bench size install uninstall clean \
+        check-install check-tangle tangle doc figures check-doc demo run-examples bench size install uninstall clean \
         check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
 
 all: lib cli examples
@@ -392,12 +392,32 @@ check-tangle: tangle-scratch
 	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
 	done; \
 	for f in $$(find include src tests examples bench -path tests/fuzz/corpus -prune -o -type f \
-	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el; do \
+	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el \
+	              $(wildcard literate/figures/*.py); do \
 	  head -2 "$$f" | grep -q 'SPDX-License-Identifier: MIT' || { echo "check-tangle: $$f has no SPDX line at its top"; status=1; }; \
 	done; \
 	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
 
-doc: $(B)/.deps
+# The book's figures, drawn by the project's own programs when the book is
+# woven: literate/figures/*.py run foldest on data they generate (and on
+# ../shared/data when it is there), count, and draw with gnuplot into
+# $(B)/doc/figures, beside a .dat of the numbers and the .gp that draws them.
+# The discovery figure (160 analyses, about 30 s) is redrawn when its script
+# or the command changed, `rm -rf $(B)/doc/figures && make figures` redraws
+# it anyway; the sphere figures (about a second) are redrawn every time, so
+# that they follow ../shared/data as it comes and goes.
+FIG          := $(B)/doc/figures
+FIGURES      := $(FIG)/discover-noise.svg $(FIG)/sphere-synthetic.svg
+figures: $(FIGURES)
+$(FIG)/discover-noise.svg: literate/figures/discover_noise.py $(CLI)
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+$(FIG)/sphere-synthetic.svg: literate/figures/sphere_calibration.py $(CLI) FORCE
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+FORCE:
+
+doc: $(B)/.deps figures
 	@mkdir -p $(B)/doc
 	@emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) >$(B)/doc/weave.log 2>&1 \
 	  || { cat $(B)/doc/weave.log; echo "doc: weaving failed"; exit 1; }

@@ -2470,7 +2470,7 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
 /* [[file:../literate/discover.org::Select terms by forward selection][Select terms by forward selection]] */
 fe_discover_options fe_discover_default_options(void)
 {
-    fe_discover_options o = {0.05, 8, NULL, 0, FE_DISCOVER_NOISE_AR, 4};
+    fe_discover_options o = {0.05, 8, NULL, 0, FE_DISCOVER_NOISE_AR, 4, 0};
     return o;
 }
 
@@ -2549,10 +2549,10 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     return rc;
 }
 
-/* Rank every group not in the model against it (the model fitted by
-   fe__fit_step just before, so that w holds its matrices). */
+/* Rank every group g0 <= g < g1 not in the model against it (the model
+   fitted by fe__fit_step just before, so that w holds its matrices). */
 static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
-                           const fe_discover_group *groups, size_t ngroups,
+                           const fe_discover_group *groups, size_t g0, size_t g1,
                            const fe_discover_options *o, const fe_discover_result *res,
                            const size_t *cols, size_t ncols, const double *beta,
                            const fe_discover_fit *cur, const fe_discover_noise *nz,
@@ -2568,7 +2568,7 @@ static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
         fe__residual_weights(dim, cols, ncols, beta, w->uv);
         rsst = fe__quad(w->gt, dim, w->uv);
     }
-    for (size_t g = 0; g < ngroups; g++) {
+    for (size_t g = g0; g < g1; g++) {
         if (fe__in_model(res->added, res->steps, o->base, o->nbase, g))
             continue;
         if (ar)
@@ -2596,6 +2596,7 @@ int fe_discover_select(const fe_discover_acc *a,
 
     if (a == NULL || groups == NULL || res == NULL || ngroups == 0
         || ngroups > FE_DISCOVER_MAX_GROUPS || (o.nbase > 0 && o.base == NULL)
+        || o.nprobes >= ngroups
         || (o.noise != FE_DISCOVER_NOISE_AR && o.noise != FE_DISCOVER_NOISE_BATCH))
         return FE_EINVAL;
     for (size_t i = 0; i < ngroups; i++)
@@ -2603,7 +2604,7 @@ int fe_discover_select(const fe_discover_acc *a,
             || groups[i].first + groups[i].count > a->m)
             return FE_EINVAL;
     for (size_t i = 0; i < o.nbase; i++)
-        if (o.base[i] >= ngroups
+        if (o.base[i] >= ngroups - o.nprobes
             || groups[o.base[i]].first + groups[o.base[i]].count > a->base_cols)
             return FE_EINVAL;
     if (a->base_cols < a->m && o.max_steps > 0)
@@ -2634,8 +2635,8 @@ int fe_discover_select(const fe_discover_acc *a,
     for (size_t step = 0;; step++) {
         fe_discover_rank *rk = res->ranking[step];
         size_t nr, in_play = 0, best = (size_t)-1;
-        nr = fe__rank_all(a, &w, ar, groups, ngroups, &o, res, cols, ncols, beta, &cur,
-                          &res->path[res->steps].noise, rk, &rc);
+        nr = fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, res, cols, ncols,
+                          beta, &cur, &res->path[res->steps].noise, rk, &rc);
         if (rc != FE_OK)
             return rc;
         res->nranked[step] = nr;
@@ -2674,6 +2675,25 @@ int fe_discover_select(const fe_discover_acc *a,
                           &res->path[res->steps]);
         if (rc != FE_OK)
             return rc;
+    }
+    res->probe_p = NAN;
+    if (o.nprobes > 0) {
+        fe_discover_rank pr[FE_DISCOVER_MAX_GROUPS];
+        size_t np = fe__rank_all(a, &w, ar, groups, ngroups - o.nprobes, ngroups, &o, res, cols,
+                                 ncols, beta, &cur, &res->path[res->steps].noise, pr, &rc);
+        if (rc != FE_OK)
+            return rc;
+        for (size_t i = 0; i < np; i++) {
+            if (pr[i].redundant)
+                continue;
+            if (res->probes_tested == 0 || pr[i].p_value < res->probe.p_value)
+                res->probe = pr[i];
+            res->probes_tested++;
+        }
+        if (res->probes_tested > 0) {
+            double p = res->probe.p_value * (double)res->probes_tested;
+            res->probe_p = p < 1.0 ? p : 1.0;
+        }
     }
     {
         const fe_discover_step *last = &res->path[res->steps];

@@ -448,6 +448,9 @@ static const struct usage_case usage_cases[] = {
     {"discover --sphere /nonexistent/a.csv", 4, "cannot open"},
     {"synth --help", 0, "usage: foldest synth"},
     {"synth --effect quadratic_drag --seed x --real r --sim s", 2, "--seed"},
+    {"synth --effect drift --rho 1 --real r --sim s", 2, "--rho: 1 is not in [0, 1)"},
+    {"synth --effect drift --rho -0.1 --real r --sim s", 2, "--rho: -0.1 is not in [0, 1)"},
+    {"synth --effect drift --rho x --real r --sim s", 2, "--rho: 'x' is not a number"},
     /* Conventions of the shell (issue 19, item 8): getopt_long everywhere. */
     {"-V", 0, "foldest 0."},
     {"stats -V", 0, "foldest 0."},

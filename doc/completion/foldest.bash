@@ -23,7 +23,7 @@ _foldest()
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
                         --alpha --order --report --json --sphere --columns --term --terms
                         --only --exclude" ;;
-        synth) opts="--effect --real --sim --seed --rows --order" ;;
+        synth) opts="--effect --real --sim --seed --rows --order --rho" ;;
         *) return 0 ;;
     esac
     case "$prev" in

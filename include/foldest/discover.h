@@ -256,10 +256,13 @@ typedef struct fe_discover_options {
     int noise;                  /* FE_DISCOVER_NOISE_AR (default) or _BATCH */
     size_t max_order;           /* highest AR order tried: 4, at most
                                    FE_DISCOVER_EDGE (and lags - 1) */
+    size_t nprobes;             /* the last nprobes groups are probes
+                                   (fe_catalog_add_probes): tested against
+                                   the final model, never added: 0 */
 } fe_discover_options;
 
 /* fe_discover_default_options: alpha 0.05, 8 steps, no base terms, the AR
-   noise model up to order 4. */
+   noise model up to order 4, no probes. */
 fe_discover_options fe_discover_default_options(void);
 
 /* The noise model of a fitted model's residual e_t. */
@@ -380,6 +383,13 @@ typedef struct fe_discover_result {
     fe_discover_fit baseline, final;
     fe_discover_noise noise;                    /* of the final model */
     fe_discover_step path[FE_DISCOVER_MAX_STEPS + 1];  /* steps + 1 */
+    /* The probes (options.nprobes), each scored against the final model
+       as a candidate would be: how many were tested (not redundant), the
+       one with the smallest p-value, and that p-value times the number
+       tested (Bonferroni, at most 1; NaN when none was tested). */
+    size_t probes_tested;
+    fe_discover_rank probe;
+    double probe_p;
 } fe_discover_result;
 
 /* fe_discover_workspace_doubles: scratch needed by fe_discover_select. */
