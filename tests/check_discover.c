@@ -1366,6 +1366,68 @@ START_TEST(a_function_of_the_state_outside_the_terms_is_probed)
 }
 END_TEST
 
+START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
+{
+    /* r = x1 + x2 + noise, and a candidate x3 = x1 + x2 + a little of its
+       own: forward selection takes x3 first (it explains most), then x1
+       and x2, after which x3 explains nothing.  It is set aside: the
+       result is the selection run without it (the same as a selection
+       never offered x3), and its recorded test is x3 scored against the
+       base and x1, x2. */
+    enum { N = 2000, K = 20, M = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_acc a;
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"x1", 1, 1}, {"x2", 2, 1}, {"x3", 3, 1}};
+    size_t base[3] = {0, 1, 2};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r), *q = malloc(sizeof *q);
+    fe_rng g = fe_rng_seed(17);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M];
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&g);
+        phi[2] = fe_rng_normal(&g);
+        phi[3] = phi[1] + phi[2] + 0.3 * fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(&a, phi, phi[1] + phi[2] + 0.5 * fe_rng_normal(&g)),
+                         FE_OK);
+    }
+    o.base = base;
+    o.nbase = 1;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->naside, 1);
+    ck_assert_uint_eq(r->aside[0], 3);
+    ck_assert_uint_eq(r->steps, 2);
+    ck_assert(r->added[0] != 3 && r->added[1] != 3);
+    for (size_t i = 0; i < r->nranked[0]; i++)
+        ck_assert_uint_ne(r->ranking[0][i].group, 3);
+    /* The selection never offered x3. */
+    ck_assert_int_eq(fe_discover_select(&a, groups, M - 1, &o, q, w, nw), FE_OK);
+    ck_assert_uint_eq(q->naside, 0);
+    ck_assert_uint_eq(q->steps, r->steps);
+    ck_assert_uint_eq(q->ncols, r->ncols);
+    for (size_t j = 0; j < r->ncols; j++) {
+        ck_assert_uint_eq(q->cols[j], r->cols[j]);
+        FE_ASSERT_REL(q->coef[j], r->coef[j], 1e-12);
+        FE_ASSERT_REL(q->stderr_[j], r->stderr_[j], 1e-12);
+    }
+    /* x3's test against the base and x1, x2. */
+    o.nbase = 3;
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+    ck_assert_uint_eq(q->nranked[0], 1);
+    ck_assert_uint_eq(q->ranking[0][0].group, 3);
+    FE_ASSERT_REL(r->aside_rank[0].p_value, q->ranking[0][0].p_value, 1e-12);
+    FE_ASSERT_REL(r->aside_rank[0].statistic, q->ranking[0][0].statistic, 1e-12);
+    ck_assert(r->aside_rank[0].p_value >= o.alpha / 2.0 || r->aside_rank[0].delta_bic >= 0.0);
+    free(r);
+    free(q);
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(concealed_effects_are_found_and_nulls_are_not)
 {
     size_t ncases, seeds = fe_test_quick() ? 2 : 20;
@@ -1449,6 +1511,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, lags_are_an_option_of_an_empty_accumulation);
     tcase_add_test(t, probes_are_scored_against_the_final_model_and_never_added);
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
+    tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

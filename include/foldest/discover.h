@@ -19,6 +19,8 @@ enum {
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
+    FE_DISCOVER_MAX_ASIDE = 4,      /* terms set aside, and selections
+                                       run again without them */
     FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P a full
                                        accumulation can keep */
     FE_DISCOVER_DEFAULT_LAGS = 8,   /* ... and keeps unless told otherwise */
@@ -390,6 +392,13 @@ typedef struct fe_discover_result {
     size_t probes_tested;
     fe_discover_rank probe;
     double probe_p;
+    /* Terms set aside: forward selection added each, and once the terms
+       added after it were in, it no longer passed the test a candidate must
+       pass (aside_rank: its test against the model without it); selection
+       then ran again without it.  In the order they were set aside. */
+    size_t naside;
+    size_t aside[FE_DISCOVER_MAX_ASIDE];
+    fe_discover_rank aside_rank[FE_DISCOVER_MAX_ASIDE];
 } fe_discover_result;
 
 /* fe_discover_workspace_doubles: scratch needed by fe_discover_select. */

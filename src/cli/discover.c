@@ -1181,7 +1181,15 @@ static void fe__json_path(FILE *f, const fe__outcome *o)
 static void fe__print_json(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
-    fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
+    fprintf(f, "{\"verdict\": \"%s\", \"set_aside\": [", o->verdict);
+    for (size_t k = 0; k < r->naside; k++) {
+        fprintf(f, "%s{\"name\": \"%s\", \"statistic\": ", k ? ", " : "",
+                o->c->terms[r->aside[k]].name);
+        fe__json_number(f, r->aside_rank[k].statistic);
+        fe__json_pair(f, "p_value", r->aside_rank[k].p_value);
+        fprintf(f, "}");
+    }
+    fprintf(f, "], ");
     if (r->probes_tested > 0) {
         const fe_term *t = &o->c->terms[r->probe.group];
         fprintf(f, "\"probes\": {\"tested\": %zu, \"variable\": \"%s\", \"bin\": [",
@@ -1459,6 +1467,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             fprintf(f, "\n");
         }
     }
+    for (size_t k = 0; k < r->naside; k++)
+        fprintf(f, "  set aside: %s, added first as a stand-in; with the terms above in, its "
+                   "statistic is %.2f, p = %.2g, and selection ran again without it\n",
+                o->c->terms[r->aside[k]].name, r->aside_rank[k].statistic,
+                r->aside_rank[k].p_value);
     if (r->steps > 0)
         fe__story_path(f, o);
     if (r->steps > 0 && o->npairs > 1 && o->per_coef != NULL) {
