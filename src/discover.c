@@ -2593,7 +2593,7 @@ int fe_discover_select(const fe_discover_acc *a,
     fe_discover_options o = options ? *options : fe_discover_default_options();
     fe__ws w;
     size_t cols[FE_DISCOVER_MAX_COLUMNS], ncols;
-    double beta[FE_DISCOVER_MAX_COLUMNS];
+    double beta[FE_DISCOVER_MAX_COLUMNS] = {0};
     fe_discover_fit cur;
     int rc, ar;
 
@@ -2699,7 +2699,7 @@ int fe_discover_select(const fe_discover_acc *a,
             for (size_t k = 0; k < res->steps && res->steps > 1 && res->naside < FE_DISCOVER_MAX_ASIDE;
                  k++) {
                 size_t others[FE_DISCOVER_MAX_STEPS], n = 0, c2[FE_DISCOVER_MAX_COLUMNS], nc2;
-                double b2[FE_DISCOVER_MAX_COLUMNS];
+                double b2[FE_DISCOVER_MAX_COLUMNS] = {0};
                 fe_discover_fit f2;
                 fe_discover_step s2;
                 fe_discover_rank rk;
