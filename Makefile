@@ -141,9 +141,15 @@ bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
 # ---------------------------------------------------------------- embedded
 # The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4,
 # alone and linked into a program that only steps (with libgcc's soft
-# double), and report the code size and the size of its state.
+# double), and report the code size and the size of its state.  Then the
+# single-precision step for a Cortex-M4F (hardware float): linked alone, its
+# flash (everything the linker keeps) and its state must stay within
+# F32_FLASH and F32_STATE bytes (issue 15), with no soft-double routine.
 ARM   := arm-none-eabi
 ARMCC  = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -ffreestanding $(WARN) -Iinclude
+ARMCCF = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -ffreestanding $(WARN) -Iinclude
+F32_FLASH := 1536
+F32_STATE := 300
 # Without the cross compiler, say what will be installed and how big it is
 # (apt's own figure: about 436 MB for gcc-arm-none-eabi on Debian 12) before
 # installing it as root; otherwise print the command.
@@ -167,6 +173,22 @@ size:
 	@set -- $$($(ARM)-size $(B)/arm/step.elf | tail -1); \
 	  printf 'the step with its soft-double routines: %d bytes of flash; the state: %d bytes of RAM\n' $$1 $$3
 	@echo "quadric.o needs only the compiler's runtime:" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
+	@printf '%s\n' '#include <stddef.h>' '#include "foldest/quadric.h"' \
+	  'fe_quadric_f32 fe_state;' 'int fe_probe(const float *x);' \
+	  'int fe_probe(const float *x) { return fe_quadric_f32_add(&fe_state, x); }' \
+	  'void *memcpy(void *d, const void *s, size_t n) { char *a = d; const char *b = s; while (n--) *a++ = *b++; return d; }' \
+	  'void *memset(void *d, int c, size_t n) { char *a = d; while (n--) *a++ = (char)c; return d; }' > $(B)/arm/probe_f32.c
+	$(ARMCCF) -ffunction-sections -fdata-sections -nostdlib -Wl,--gc-sections -Wl,-e,fe_probe \
+	  src/quadric.c $(B)/arm/probe_f32.c -lgcc -o $(B)/arm/step_f32.elf
+	@$(ARM)-size $(B)/arm/step_f32.elf
+	@$(ARM)-nm -S -t d --size-sort $(B)/arm/step_f32.elf | awk '{printf "  %-26s %5d bytes\n", $$4, $$2}'
+	@flash=$$($(ARM)-size $(B)/arm/step_f32.elf | awk 'NR == 2 {print $$1 + $$2}'); \
+	  state=$$($(ARM)-nm -S -t d $(B)/arm/step_f32.elf | awk '$$4 == "fe_state" {print $$2 + 0}'); \
+	  soft=$$($(ARM)-nm $(B)/arm/step_f32.elf | awk '$$3 ~ /^__aeabi_d|^__.*df/ {print $$3}'); \
+	  printf 'the single-precision step (Cortex-M4F): %d bytes of flash (limit %d); the state: %d bytes (limit %d)\n' \
+	    $$flash $(F32_FLASH) $$state $(F32_STATE); \
+	  if [ -n "$$soft" ]; then echo "size: the float step pulls in soft double: $$soft"; exit 1; fi; \
+	  if [ $$flash -gt $(F32_FLASH) ] || [ $$state -gt $(F32_STATE) ]; then echo "size: over the limit"; exit 1; fi
 
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
