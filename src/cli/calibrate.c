@@ -630,6 +630,17 @@ static void fe__calibrate_json_array(const double *v, int n)
     printf("]");
 }
 
+/* `, "key": [[a, b, c], [d, e, f], [g, h, i]]`, a row-major 3 x 3 matrix. */
+static void fe__calibrate_json_matrix(const char *key, const double *m)
+{
+    printf(", \"%s\": [", key);
+    for (int i = 0; i < 3; i++) {
+        printf("%s", i ? ", " : "");
+        fe__calibrate_json_array(m + 3 * i, 3);
+    }
+    printf("]");
+}
+
 /* `, "key": number`, the number as every command writes it (cli.org). */
 static void fe__calibrate_json_key(const char *key, double x)
 {
@@ -655,18 +666,8 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         printf(", \"offset_se_iid\": ");
         fe__calibrate_json_array(f->se_iid, 3);
         printf(", \"se_blocks\": %d", f->se_blocks);
-        printf(", \"matrix_se\": [");
-        for (int i = 0; i < 3; i++) {
-            printf("%s", i ? ", " : "");
-            fe__calibrate_json_array(f->matrix_se + 3 * i, 3);
-        }
-        printf("]");
-        printf(", \"matrix\": [");
-        for (int i = 0; i < 3; i++) {
-            printf("%s", i ? ", " : "");
-            fe__calibrate_json_array(f->matrix + 3 * i, 3);
-        }
-        printf("]");
+        fe__calibrate_json_matrix("matrix_se", f->matrix_se);
+        fe__calibrate_json_matrix("matrix", f->matrix);
         fe__calibrate_json_key("radius", f->radius);
         printf(", \"axes\": ");
         fe__calibrate_json_array(f->axes, 3);
@@ -677,12 +678,7 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         fe__calibrate_json_key("rms_percent", f->rms_percent);
         if (field > 0.0) {
             fe__calibrate_json_key("field", sc->field);
-            printf(", \"field_matrix\": [");
-            for (int i = 0; i < 3; i++) {
-                printf("%s", i ? ", " : "");
-                fe__calibrate_json_array(sc->matrix + 3 * i, 3);
-            }
-            printf("]");
+            fe__calibrate_json_matrix("field_matrix", sc->matrix);
             fe__calibrate_json_key("gain", sc->gain);
         }
     } else {
