@@ -135,6 +135,25 @@ static const fe_cli_option fe__calibrate_options[] = {
     {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {"--robust", 0},
     {"--robust-k", 1}, {"--report", 1}, {NULL, 0}};
 
+/* The number after option `name`: finite, above 0 (or at least 0 when
+   zero_ok); FE_CLI_OK, or FE_CLI_USAGE after saying why. */
+static int fe__calibrate_number(const char *name, const char *text, int zero_ok, double *out)
+{
+    char err[512];
+    double v;
+    if (fe_cli_parse_double(name, text, &v, err, sizeof err) != FE_CLI_OK) {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
+        return FE_CLI_USAGE;
+    }
+    if (!isfinite(v) || !(zero_ok ? v >= 0.0 : v > 0.0)) {
+        fprintf(stderr, "foldest calibrate: %s: a finite number, %s\n", name,
+                zero_ok ? "at least 0" : "above 0");
+        return FE_CLI_USAGE;
+    }
+    *out = v;
+    return FE_CLI_OK;
+}
+
 static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
 {
     char err[512];
@@ -163,13 +182,8 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                 return FE_CLI_USAGE;
             }
         } else if (strcmp(argv[i], "--field") == 0 && i + 1 < argc) {
-            int bad = fe_cli_parse_double("--field", argv[++i], &a->field, err, sizeof err)
-                      != FE_CLI_OK;
-            if (bad || !(a->field > 0.0) || !isfinite(a->field)) {
-                fprintf(stderr, "foldest calibrate: %s\n",
-                        bad ? err : "--field: the field must be positive");
+            if (fe__calibrate_number("--field", argv[++i], 0, &a->field) != FE_CLI_OK)
                 return FE_CLI_USAGE;
-            }
         } else if (strcmp(argv[i], "--export") == 0 && i + 1 < argc) {
             const char *fmt = argv[++i];
             if (strcmp(fmt, "ardupilot") == 0)
@@ -188,13 +202,8 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
         } else if (strcmp(argv[i], "--robust") == 0) {
             a->robust = 1;
         } else if (strcmp(argv[i], "--robust-k") == 0 && i + 1 < argc) {
-            int bad = fe_cli_parse_double("--robust-k", argv[++i], &a->robust_k, err, sizeof err)
-                      != FE_CLI_OK;
-            if (bad || !(a->robust_k > 0.0) || !isfinite(a->robust_k)) {
-                fprintf(stderr, "foldest calibrate: %s\n",
-                        bad ? err : "--robust-k: a positive number");
+            if (fe__calibrate_number("--robust-k", argv[++i], 0, &a->robust_k) != FE_CLI_OK)
                 return FE_CLI_USAGE;
-            }
         } else if (strcmp(argv[i], "--static") == 0) {
             a->still = 1;
         } else if (strcmp(argv[i], "--gyro") == 0 && i + 1 < argc) {
@@ -212,24 +221,15 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
                    && i + 1 < argc) {
             const char *name = argv[i];
             double v;
-            int bad = fe_cli_parse_double(name, argv[++i], &v, err, sizeof err) != FE_CLI_OK;
-            if (bad || !(v >= 0.0) || !isfinite(v)) {
-                fprintf(stderr, "foldest calibrate: %s%s\n", bad ? err : name,
-                        bad ? "" : ": a finite number, at least 0");
+            if (fe__calibrate_number(name, argv[++i], 1, &v) != FE_CLI_OK)
                 return FE_CLI_USAGE;
-            }
             if (name[2] == 's')
                 a->still_opt.max_rel_sd = v;
             else
                 a->still_opt.max_rate = v;
         } else if (strcmp(argv[i], "--mgauss") == 0 && i + 1 < argc) {
-            int bad = fe_cli_parse_double("--mgauss", argv[++i], &a->mgauss, err, sizeof err)
-                      != FE_CLI_OK;
-            if (bad || !(a->mgauss > 0.0) || !isfinite(a->mgauss)) {
-                fprintf(stderr, "foldest calibrate: %s\n",
-                        bad ? err : "--mgauss: the factor must be positive");
+            if (fe__calibrate_number("--mgauss", argv[++i], 0, &a->mgauss) != FE_CLI_OK)
                 return FE_CLI_USAGE;
-            }
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
             a->columns = argv[++i];
         } else if (strcmp(argv[i], "--apply") == 0 && i + 1 < argc) {
@@ -630,6 +630,17 @@ static void fe__calibrate_json_array(const double *v, int n)
     printf("]");
 }
 
+/* `, "key": [[a, b, c], [d, e, f], [g, h, i]]`, a row-major 3 x 3 matrix. */
+static void fe__calibrate_json_matrix(const char *key, const double *m)
+{
+    printf(", \"%s\": [", key);
+    for (int i = 0; i < 3; i++) {
+        printf("%s", i ? ", " : "");
+        fe__calibrate_json_array(m + 3 * i, 3);
+    }
+    printf("]");
+}
+
 /* `, "key": number`, the number as every command writes it (cli.org). */
 static void fe__calibrate_json_key(const char *key, double x)
 {
@@ -655,18 +666,8 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         printf(", \"offset_se_iid\": ");
         fe__calibrate_json_array(f->se_iid, 3);
         printf(", \"se_blocks\": %d", f->se_blocks);
-        printf(", \"matrix_se\": [");
-        for (int i = 0; i < 3; i++) {
-            printf("%s", i ? ", " : "");
-            fe__calibrate_json_array(f->matrix_se + 3 * i, 3);
-        }
-        printf("]");
-        printf(", \"matrix\": [");
-        for (int i = 0; i < 3; i++) {
-            printf("%s", i ? ", " : "");
-            fe__calibrate_json_array(f->matrix + 3 * i, 3);
-        }
-        printf("]");
+        fe__calibrate_json_matrix("matrix_se", f->matrix_se);
+        fe__calibrate_json_matrix("matrix", f->matrix);
         fe__calibrate_json_key("radius", f->radius);
         printf(", \"axes\": ");
         fe__calibrate_json_array(f->axes, 3);
@@ -677,12 +678,7 @@ static void fe__calibrate_json(const fe_cli_table *t, const fe_sphere_fit *f,
         fe__calibrate_json_key("rms_percent", f->rms_percent);
         if (field > 0.0) {
             fe__calibrate_json_key("field", sc->field);
-            printf(", \"field_matrix\": [");
-            for (int i = 0; i < 3; i++) {
-                printf("%s", i ? ", " : "");
-                fe__calibrate_json_array(sc->matrix + 3 * i, 3);
-            }
-            printf("]");
+            fe__calibrate_json_matrix("field_matrix", sc->matrix);
             fe__calibrate_json_key("gain", sc->gain);
         }
     } else {
