@@ -58,7 +58,7 @@ export FOLDEST_DATA ?= $(abspath ../shared/data)
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
-        check-install check-tangle tangle doc check-doc demo run-examples bench size install uninstall clean \
+        check-install check-tangle tangle doc figures check-doc demo run-examples bench size install uninstall clean \
         check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
 
 all: lib cli examples
@@ -141,9 +141,15 @@ bench-mpi: $(patsubst bench/mpi/%.c,$(B)/mpi-bench/%,$(wildcard bench/mpi/*.c))
 # ---------------------------------------------------------------- embedded
 # The moment step (src/quadric.c) is freestanding: build it for a Cortex-M4,
 # alone and linked into a program that only steps (with libgcc's soft
-# double), and report the code size and the size of its state.
+# double), and report the code size and the size of its state.  Then the
+# single-precision step for a Cortex-M4F (hardware float): linked alone, its
+# flash (everything the linker keeps) and its state must stay within
+# F32_FLASH and F32_STATE bytes (issue 15), with no soft-double routine.
 ARM   := arm-none-eabi
 ARMCC  = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -Os -ffreestanding $(WARN) -Iinclude
+ARMCCF = $(ARM)-gcc -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -Os -ffreestanding $(WARN) -Iinclude
+F32_FLASH := 1536
+F32_STATE := 300
 # Without the cross compiler, say what will be installed and how big it is
 # (apt's own figure: about 436 MB for gcc-arm-none-eabi on Debian 12) before
 # installing it as root; otherwise print the command.
@@ -167,6 +173,22 @@ size:
 	@set -- $$($(ARM)-size $(B)/arm/step.elf | tail -1); \
 	  printf 'the step with its soft-double routines: %d bytes of flash; the state: %d bytes of RAM\n' $$1 $$3
 	@echo "quadric.o needs only the compiler's runtime:" $$($(ARM)-nm -u $(B)/arm/quadric.o | awk '{print $$2}')
+	@printf '%s\n' '#include <stddef.h>' '#include "foldest/quadric.h"' \
+	  'fe_quadric_f32 fe_state;' 'int fe_probe(const float *x);' \
+	  'int fe_probe(const float *x) { return fe_quadric_f32_add(&fe_state, x); }' \
+	  'void *memcpy(void *d, const void *s, size_t n) { char *a = d; const char *b = s; while (n--) *a++ = *b++; return d; }' \
+	  'void *memset(void *d, int c, size_t n) { char *a = d; while (n--) *a++ = (char)c; return d; }' > $(B)/arm/probe_f32.c
+	$(ARMCCF) -ffunction-sections -fdata-sections -nostdlib -Wl,--gc-sections -Wl,-e,fe_probe \
+	  src/quadric.c $(B)/arm/probe_f32.c -lgcc -o $(B)/arm/step_f32.elf
+	@$(ARM)-size $(B)/arm/step_f32.elf
+	@$(ARM)-nm -S -t d --size-sort $(B)/arm/step_f32.elf | awk '{printf "  %-26s %5d bytes\n", $$4, $$2}'
+	@flash=$$($(ARM)-size $(B)/arm/step_f32.elf | awk 'NR == 2 {print $$1 + $$2}'); \
+	  state=$$($(ARM)-nm -S -t d $(B)/arm/step_f32.elf | awk '$$4 == "fe_state" {print $$2 + 0}'); \
+	  soft=$$($(ARM)-nm $(B)/arm/step_f32.elf | awk '$$3 ~ /^__aeabi_d|^__.*df/ {print $$3}'); \
+	  printf 'the single-precision step (Cortex-M4F): %d bytes of flash (limit %d); the state: %d bytes (limit %d)\n' \
+	    $$flash $(F32_FLASH) $$state $(F32_STATE); \
+	  if [ -n "$$soft" ]; then echo "size: the float step pulls in soft double: $$soft"; exit 1; fi; \
+	  if [ $$flash -gt $(F32_FLASH) ] || [ $$state -gt $(F32_STATE) ]; then echo "size: over the limit"; exit 1; fi
 
 # ---------------------------------------------------------------- tests
 # The runner adds every suite it finds: tests/check_<module>.c defines
@@ -392,12 +414,32 @@ check-tangle: tangle-scratch
 	  [ -f "$(TANGLE_TMP)/$$f" ] || { echo "check-tangle: $$f is not produced by any literate document"; status=1; }; \
 	done; \
 	for f in $$(find include src tests examples bench -path tests/fuzz/corpus -prune -o -type f \
-	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el; do \
+	              \( -name '*.[ch]' -o -name '*.cpp' -o -name '*.sh' \) -print | sort) Makefile .ci/run .ci/deps literate/tangle.el \
+	              $(wildcard literate/figures/*.py); do \
 	  head -2 "$$f" | grep -q 'SPDX-License-Identifier: MIT' || { echo "check-tangle: $$f has no SPDX line at its top"; status=1; }; \
 	done; \
 	[ $$status = 0 ] && echo "check-tangle: include/ and src/ match literate/*.org; every source file carries its SPDX line"; exit $$status
 
-doc: $(B)/.deps
+# The book's figures, drawn by the project's own programs when the book is
+# woven: literate/figures/*.py run foldest on data they generate (and on
+# ../shared/data when it is there), count, and draw with gnuplot into
+# $(B)/doc/figures, beside a .dat of the numbers and the .gp that draws them.
+# The discovery figure (160 analyses, about 30 s) is redrawn when its script
+# or the command changed, `rm -rf $(B)/doc/figures && make figures` redraws
+# it anyway; the sphere figures (about a second) are redrawn every time, so
+# that they follow ../shared/data as it comes and goes.
+FIG          := $(B)/doc/figures
+FIGURES      := $(FIG)/discover-noise.svg $(FIG)/sphere-synthetic.svg
+figures: $(FIGURES)
+$(FIG)/discover-noise.svg: literate/figures/discover_noise.py $(CLI)
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+$(FIG)/sphere-synthetic.svg: literate/figures/sphere_calibration.py $(CLI) FORCE
+	@mkdir -p $(@D)
+	@FOLDEST=$(abspath $(CLI)) nice python3 $< $(@D)
+FORCE:
+
+doc: $(B)/.deps figures
 	@mkdir -p $(B)/doc
 	@emacs --batch -Q -l literate/tangle.el -f fe-weave $(B)/doc $(ORG) >$(B)/doc/weave.log 2>&1 \
 	  || { cat $(B)/doc/weave.log; echo "doc: weaving failed"; exit 1; }

@@ -54,25 +54,33 @@ static double fe__input(const fe_sample *s, const fe_catalog_scale *c, void *u)
 { (void)c; (void)u; return s->input; }
 
 static const fe_term fe__builtin[] = {
-    {"bias", "constant sensor or actuator offset", fe__bias, 0, 0, NULL},
-    {"drift", "offset drifting with time", fe__drift, 0, 0, NULL},
-    {"gain", "scale-factor error", fe__gain, 0, 0, NULL},
-    {"delay", "time lag between simulation and recording", fe__delay, 0, 0, NULL},
-    {"viscous_friction", "force proportional to velocity (viscous damping, Stokes drag)",
-     fe__viscous, 0, FE_ROLE_VELOCITY, NULL},
-    {"quadratic_drag", "aerodynamic (turbulent) drag", fe__quadratic, 0, FE_ROLE_VELOCITY,
-     NULL},
-    {"coulomb_friction", "dry friction", fe__coulomb, 0, FE_ROLE_VELOCITY, NULL},
-    {"linear_stiffness", "missing spring or restoring force", fe__linear, 0, FE_ROLE_POSITION,
-     NULL},
-    {"cubic_stiffness", "hardening or softening spring", fe__cubic, 0, FE_ROLE_POSITION, NULL},
-    {"thermal_sensitivity", "temperature coefficient", fe__thermal, 0, FE_ROLE_TEMPERATURE,
-     NULL},
-    {"newton_cooling", "convective heat loss", fe__newton, 0,
-     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT, NULL},
-    {"radiative_cooling", "thermal radiation", fe__radiative, 0,
-     FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT, NULL},
-    {"input_gain", "actuator gain error", fe__input, 0, FE_ROLE_INPUT, NULL},
+    {.name = "bias", .description = "constant sensor or actuator offset",
+     .eval = fe__bias, .needs = 0},
+    {.name = "drift", .description = "offset drifting with time",
+     .eval = fe__drift, .needs = 0},
+    {.name = "gain", .description = "scale-factor error",
+     .eval = fe__gain, .needs = 0},
+    {.name = "delay", .description = "time lag between simulation and recording",
+     .eval = fe__delay, .needs = 0},
+    {.name = "viscous_friction",
+     .description = "force proportional to velocity (viscous damping, Stokes drag)",
+     .eval = fe__viscous, .needs = FE_ROLE_VELOCITY},
+    {.name = "quadratic_drag", .description = "aerodynamic (turbulent) drag",
+     .eval = fe__quadratic, .needs = FE_ROLE_VELOCITY},
+    {.name = "coulomb_friction", .description = "dry friction",
+     .eval = fe__coulomb, .needs = FE_ROLE_VELOCITY},
+    {.name = "linear_stiffness", .description = "missing spring or restoring force",
+     .eval = fe__linear, .needs = FE_ROLE_POSITION},
+    {.name = "cubic_stiffness", .description = "hardening or softening spring",
+     .eval = fe__cubic, .needs = FE_ROLE_POSITION},
+    {.name = "thermal_sensitivity", .description = "temperature coefficient",
+     .eval = fe__thermal, .needs = FE_ROLE_TEMPERATURE},
+    {.name = "newton_cooling", .description = "convective heat loss",
+     .eval = fe__newton, .needs = FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
+    {.name = "radiative_cooling", .description = "thermal radiation",
+     .eval = fe__radiative, .needs = FE_ROLE_TEMPERATURE | FE_ROLE_AMBIENT},
+    {.name = "input_gain", .description = "actuator gain error",
+     .eval = fe__input, .needs = FE_ROLE_INPUT},
 };
 
 const fe_term *fe_catalog_builtin_terms(size_t *count)
@@ -82,6 +90,37 @@ const fe_term *fe_catalog_builtin_terms(size_t *count)
     return fe__builtin;
 }
 /* Evaluate the built-in terms ends here */
+/* [[file:../literate/catalog.org::Probe the state][Probe the state]] */
+static const char *const fe__probe_names[FE_CATALOG_VARS] = {
+    NULL, NULL, NULL, "probe_position", "probe_velocity", "probe_temperature",
+    "probe_ambient", "probe_input"};
+
+static double fe__probe(const fe_term *k, const double *row)
+{
+    double x = row[k->var];
+    return x >= k->lo && x < k->hi ? 1.0 : 0.0;
+}
+
+int fe_catalog_add_probes(fe_catalog *c, int var, double lo, double hi, size_t bins)
+{
+    if (c == NULL || var < FE_CATALOG_VAR_POSITION || var >= FE_CATALOG_VARS || bins < 2
+        || bins > FE_CATALOG_MAX_BINS || !isfinite(lo) || !isfinite(hi) || !(lo < hi))
+        return FE_EINVAL;
+    if (c->count + bins - 1 > FE_DISCOVER_MAX_GROUPS)
+        return FE_ESIZE;
+    for (size_t k = 0; k + 1 < bins; k++) {
+        fe_term *t = &c->terms[c->count++];
+        memset(t, 0, sizeof *t);
+        t->name = fe__probe_names[var];
+        t->description = "a probe of the state: the indicator of one bin";
+        t->probe = 1;
+        t->var = var;
+        t->lo = k == 0 ? -INFINITY : lo + (hi - lo) * (double)k / (double)bins;
+        t->hi = lo + (hi - lo) * (double)(k + 1) / (double)bins;
+    }
+    return FE_OK;
+}
+/* Probe the state ends here */
 /* [[file:../literate/catalog.org::Build and evaluate a catalog][Build and evaluate a catalog]] */
 int fe_catalog_scale_add(fe_catalog_scale *scale, const fe_sample *s)
 {
@@ -116,7 +155,7 @@ int fe_catalog_init(fe_catalog *c, unsigned roles, const fe_catalog_scale *scale
 long fe_catalog_find(const fe_catalog *c, const char *name)
 {
     for (size_t i = 0; c != NULL && name != NULL && i < c->count; i++)
-        if (strcmp(c->terms[i].name, name) == 0)
+        if (!c->terms[i].probe && strcmp(c->terms[i].name, name) == 0)
             return (long)i;
     return -1;
 }
@@ -163,6 +202,8 @@ int fe_catalog_eval(const fe_catalog *c, const fe_sample *s, double *phi)
             rc = fe_expr_eval(k->expr, row, &phi[j]);
             if (rc != FE_OK)
                 return rc;
+        } else if (k->probe) {
+            phi[j] = fe__probe(k, row);
         } else {
             phi[j] = k->eval(s, &c->scale, k->user);
         }
@@ -253,10 +294,15 @@ int fe_catalog_eval_rows(const fe_catalog *c, const double *rows, size_t ldv, si
     for (size_t j = 0; j < c->count; j++) {
         if (c->terms[j].expr != NULL && c->terms[j].expr->nvars > ldv)
             return FE_EINVAL;
-        if (c->terms[j].expr == NULL && c->terms[j].eval == NULL)
+        if (c->terms[j].expr == NULL && c->terms[j].eval == NULL && !c->terms[j].probe)
             return FE_EINVAL;
-        callbacks |= c->terms[j].expr == NULL;
+        callbacks |= c->terms[j].expr == NULL && !c->terms[j].probe;
     }
+    /* The probes, straight from the rows. */
+    for (size_t j = 0; j < c->count; j++)
+        if (c->terms[j].probe)
+            for (size_t t = 0; t < n; t++)
+                phi[t * ldphi + j] = fe__probe(&c->terms[j], rows + t * ldv);
     /* The expression terms: a column each, then scattered into phi. */
     for (size_t j = 0; j < c->count; j++) {
         int rc;
@@ -273,7 +319,7 @@ int fe_catalog_eval_rows(const fe_catalog *c, const double *rows, size_t ldv, si
         fe_sample s;
         fe__row_sample(rows + t * ldv, &s);
         for (size_t j = 0; j < c->count; j++)
-            if (c->terms[j].expr == NULL)
+            if (c->terms[j].expr == NULL && !c->terms[j].probe)
                 phi[t * ldphi + j] = c->terms[j].eval(&s, &c->scale, c->terms[j].user);
     }
     for (size_t t = 0; t < n; t++)

@@ -2470,7 +2470,7 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
 /* [[file:../literate/discover.org::Select terms by forward selection][Select terms by forward selection]] */
 fe_discover_options fe_discover_default_options(void)
 {
-    fe_discover_options o = {0.05, 8, NULL, 0, FE_DISCOVER_NOISE_AR, 4};
+    fe_discover_options o = {0.05, 8, NULL, 0, FE_DISCOVER_NOISE_AR, 4, 0};
     return o;
 }
 
@@ -2549,11 +2549,13 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     return rc;
 }
 
-/* Rank every group not in the model against it (the model fitted by
-   fe__fit_step just before, so that w holds its matrices). */
+/* Rank every group g0 <= g < g1 not in the model (the base and `added`)
+   nor set aside against it (the model fitted by fe__fit_step just before,
+   so that w holds its matrices). */
 static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
-                           const fe_discover_group *groups, size_t ngroups,
-                           const fe_discover_options *o, const fe_discover_result *res,
+                           const fe_discover_group *groups, size_t g0, size_t g1,
+                           const fe_discover_options *o, const size_t *added, size_t nadded,
+                           const size_t *aside, size_t naside,
                            const size_t *cols, size_t ncols, const double *beta,
                            const fe_discover_fit *cur, const fe_discover_noise *nz,
                            fe_discover_rank *rk, int *rc)
@@ -2568,8 +2570,9 @@ static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
         fe__residual_weights(dim, cols, ncols, beta, w->uv);
         rsst = fe__quad(w->gt, dim, w->uv);
     }
-    for (size_t g = 0; g < ngroups; g++) {
-        if (fe__in_model(res->added, res->steps, o->base, o->nbase, g))
+    for (size_t g = g0; g < g1; g++) {
+        if (fe__in_model(added, nadded, o->base, o->nbase, g)
+            || fe__in_model(aside, naside, NULL, 0, g))
             continue;
         if (ar)
             fe__gls_score(a, w, &mo, beta, &groups[g], cur, nz, rsst, &rk[nr]);
@@ -2590,12 +2593,13 @@ int fe_discover_select(const fe_discover_acc *a,
     fe_discover_options o = options ? *options : fe_discover_default_options();
     fe__ws w;
     size_t cols[FE_DISCOVER_MAX_COLUMNS], ncols;
-    double beta[FE_DISCOVER_MAX_COLUMNS];
+    double beta[FE_DISCOVER_MAX_COLUMNS] = {0};
     fe_discover_fit cur;
     int rc, ar;
 
     if (a == NULL || groups == NULL || res == NULL || ngroups == 0
         || ngroups > FE_DISCOVER_MAX_GROUPS || (o.nbase > 0 && o.base == NULL)
+        || o.nprobes >= ngroups
         || (o.noise != FE_DISCOVER_NOISE_AR && o.noise != FE_DISCOVER_NOISE_BATCH))
         return FE_EINVAL;
     for (size_t i = 0; i < ngroups; i++)
@@ -2603,7 +2607,7 @@ int fe_discover_select(const fe_discover_acc *a,
             || groups[i].first + groups[i].count > a->m)
             return FE_EINVAL;
     for (size_t i = 0; i < o.nbase; i++)
-        if (o.base[i] >= ngroups
+        if (o.base[i] >= ngroups - o.nprobes
             || groups[o.base[i]].first + groups[o.base[i]].count > a->base_cols)
             return FE_EINVAL;
     if (a->base_cols < a->m && o.max_steps > 0)
@@ -2624,56 +2628,128 @@ int fe_discover_select(const fe_discover_acc *a,
             return FE_ETOOFEW;
     memset(res, 0, sizeof *res);
     fe__total_gram(a, w.g);
-
-    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, 0, cols);
-    res->path[0].added = (size_t)-1;
-    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &res->baseline, &res->path[0]);
-    if (rc != FE_OK)
-        return rc;
-    cur = res->baseline;
-    for (size_t step = 0;; step++) {
-        fe_discover_rank *rk = res->ranking[step];
-        size_t nr, in_play = 0, best = (size_t)-1;
-        nr = fe__rank_all(a, &w, ar, groups, ngroups, &o, res, cols, ncols, beta, &cur,
-                          &res->path[res->steps].noise, rk, &rc);
+    for (;;) {
+        {
+            size_t naside = res->naside, aside[FE_DISCOVER_MAX_ASIDE];
+            fe_discover_rank aside_rank[FE_DISCOVER_MAX_ASIDE];
+            memcpy(aside, res->aside, sizeof aside);
+            memcpy(aside_rank, res->aside_rank, sizeof aside_rank);
+            memset(res, 0, sizeof *res);            /* a new run keeps only the set-aside */
+            res->naside = naside;
+            memcpy(res->aside, aside, sizeof aside);
+            memcpy(res->aside_rank, aside_rank, sizeof aside_rank);
+        }
+        ncols = fe__model_columns(groups, o.base, o.nbase, res->added, 0, cols);
+        res->path[0].added = (size_t)-1;
+        rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &res->baseline, &res->path[0]);
         if (rc != FE_OK)
             return rc;
-        res->nranked[step] = nr;
-        for (size_t i = 0; i < nr; i++)
-            in_play += !rk[i].redundant;
-        for (size_t i = 0; i < nr; i++) {
-            if (rk[i].redundant || !(rk[i].p_value < o.alpha / (double)in_play)
-                || !(rk[i].delta_bic < 0.0))
-                continue;
-            if (best == (size_t)-1 || rk[i].delta_bic < rk[best].delta_bic)
-                best = i;
-        }
-        if (step > 0) {
-            size_t prev = step - 1;
-            const fe_discover_rank *before = res->ranking[prev];
-            for (size_t i = 0; i < res->nranked[prev]; i++) {
-                size_t g = before[i].group;
-                if (g == res->added[prev] || before[i].redundant)
+        cur = res->baseline;
+        for (size_t step = 0;; step++) {
+            fe_discover_rank *rk = res->ranking[step];
+            size_t nr, in_play = 0, best = (size_t)-1;
+            nr = fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, res->added,
+                              res->steps, res->aside, res->naside, cols, ncols, beta, &cur,
+                              &res->path[res->steps].noise, rk, &rc);
+            if (rc != FE_OK)
+                return rc;
+            res->nranked[step] = nr;
+            for (size_t i = 0; i < nr; i++)
+                in_play += !rk[i].redundant;
+            for (size_t i = 0; i < nr; i++) {
+                if (rk[i].redundant || !(rk[i].p_value < o.alpha / (double)in_play)
+                    || !(rk[i].delta_bic < 0.0))
                     continue;
-                if (before[i].delta_bic - res->added_rank[prev].delta_bic >= 6.0)
-                    continue;
-                for (size_t j = 0; j < nr; j++)
-                    if (rk[j].group == g
-                        && (rk[j].redundant || rk[j].rss_drop <= 0.1 * before[i].rss_drop))
-                        res->alike[prev][res->nalike[prev]++] = g;
+                if (best == (size_t)-1 || rk[i].delta_bic < rk[best].delta_bic)
+                    best = i;
             }
+            if (step > 0) {
+                size_t prev = step - 1;
+                const fe_discover_rank *before = res->ranking[prev];
+                for (size_t i = 0; i < res->nranked[prev]; i++) {
+                    size_t g = before[i].group;
+                    if (g == res->added[prev] || before[i].redundant)
+                        continue;
+                    if (before[i].delta_bic - res->added_rank[prev].delta_bic >= 6.0)
+                        continue;
+                    for (size_t j = 0; j < nr; j++)
+                        if (rk[j].group == g
+                            && (rk[j].redundant || rk[j].rss_drop <= 0.1 * before[i].rss_drop))
+                            res->alike[prev][res->nalike[prev]++] = g;
+                }
+            }
+            if (best == (size_t)-1 || step >= o.max_steps)
+                break;
+            res->added[res->steps] = rk[best].group;
+            res->added_rank[res->steps] = rk[best];
+            res->steps++;
+            ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
+            res->path[res->steps].added = rk[best].group;
+            rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur,
+                              &res->path[res->steps]);
+            if (rc != FE_OK)
+                return rc;
         }
-        if (best == (size_t)-1 || step >= o.max_steps)
-            break;
-        res->added[res->steps] = rk[best].group;
-        res->added_rank[res->steps] = rk[best];
-        res->steps++;
-        ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
-        res->path[res->steps].added = rk[best].group;
-        rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur,
-                          &res->path[res->steps]);
+        {
+            size_t worst = (size_t)-1, in_play = 1;
+            fe_discover_rank worst_rank;
+            memset(&worst_rank, 0, sizeof worst_rank);
+            for (size_t i = 0; i < res->nranked[res->steps]; i++)
+                in_play += !res->ranking[res->steps][i].redundant;
+            for (size_t k = 0; k < res->steps && res->steps > 1 && res->naside < FE_DISCOVER_MAX_ASIDE;
+                 k++) {
+                size_t others[FE_DISCOVER_MAX_STEPS], n = 0, c2[FE_DISCOVER_MAX_COLUMNS], nc2;
+                double b2[FE_DISCOVER_MAX_COLUMNS] = {0};
+                fe_discover_fit f2;
+                fe_discover_step s2;
+                fe_discover_rank rk;
+                for (size_t j = 0; j < res->steps; j++)
+                    if (j != k)
+                        others[n++] = res->added[j];
+                nc2 = fe__model_columns(groups, o.base, o.nbase, others, n, c2);
+                rc = fe__fit_step(a, &w, ar, o.max_order, c2, nc2, b2, &f2, &s2);
+                if (rc != FE_OK)
+                    return rc;
+                if (fe__rank_all(a, &w, ar, groups, res->added[k], res->added[k] + 1, &o, others, n,
+                                 NULL, 0, c2, nc2, b2, &f2, &s2.noise, &rk, &rc) != 1)
+                    return rc != FE_OK ? rc : FE_EINVAL;
+                if ((rk.redundant || !(rk.p_value < o.alpha / (double)in_play) || !(rk.delta_bic < 0.0))
+                    && (worst == (size_t)-1 || rk.p_value > worst_rank.p_value)) {
+                    worst = k;
+                    worst_rank = rk;
+                }
+            }
+            if (worst == (size_t)-1) {
+                if (res->steps > 1 && res->naside < FE_DISCOVER_MAX_ASIDE) {
+                    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, NULL);
+                    if (rc != FE_OK)
+                        return rc;
+                }
+                break;
+            }
+            res->aside[res->naside] = res->added[worst];
+            res->aside_rank[res->naside++] = worst_rank;
+        }
+    }
+    res->probe_p = NAN;
+    if (o.nprobes > 0) {
+        fe_discover_rank pr[FE_DISCOVER_MAX_GROUPS];
+        size_t np = fe__rank_all(a, &w, ar, groups, ngroups - o.nprobes, ngroups, &o, res->added,
+                                 res->steps, res->aside, res->naside, cols, ncols, beta, &cur,
+                                 &res->path[res->steps].noise, pr, &rc);
         if (rc != FE_OK)
             return rc;
+        for (size_t i = 0; i < np; i++) {
+            if (pr[i].redundant)
+                continue;
+            if (res->probes_tested == 0 || pr[i].p_value < res->probe.p_value)
+                res->probe = pr[i];
+            res->probes_tested++;
+        }
+        if (res->probes_tested > 0) {
+            double p = res->probe.p_value * (double)res->probes_tested;
+            res->probe_p = p < 1.0 ? p : 1.0;
+        }
     }
     {
         const fe_discover_step *last = &res->path[res->steps];

@@ -778,6 +778,8 @@ fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_ma
     if (fe_residual_map_largest_after(m, fe_discover_row_worth(&r->noise, r->final.n))
         > fe__bound(alpha, m->blocks + m->nregions))
         return FE_VERDICT_OUT_OF_LINE;
+    if (r->probes_tested > 0 && r->probe_p < alpha)
+        return FE_VERDICT_STATE_LEFT;
     return FE_VERDICT_EXPLAINED;
 }
 
@@ -799,6 +801,10 @@ const char *fe_verdict_why(fe_verdict v)
     case FE_VERDICT_OUT_OF_LINE:
         return "terms were found, but a time window or state region stays out of line "
                "after them";
+    case FE_VERDICT_STATE_LEFT:
+        return "terms were found, but a function of the state that none of them describes "
+               "still explains part of the residual (a probe of the state stands out): the "
+               "catalog lacks the physics, and the terms found stand in for it";
     case FE_VERDICT_DIVERGES:
         return "the residual left stays correlated (lag one 0.98 or more) at ten times its "
                "high-frequency floor or more: the trajectories diverge, as they do when the "

@@ -710,3 +710,263 @@ fe_accumulator fe_quadric_accumulator(const double *centre)
     return f;
 }
 /* Moments as an accumulator ends here */
+/* [[file:../literate/quadric.org::Fold in blocks of consecutive samples][Fold in blocks of consecutive samples]] */
+int fe_quadric_blocks_init(fe_quadric_blocks *qb)
+{
+    if (qb == NULL)
+        return FE_EINVAL;
+    *qb = (fe_quadric_blocks){.all = FE_QUADRIC_EMPTY, .block_len = 1};
+    return FE_OK;
+}
+
+/* Merge neighbours pairwise: blocks 2k and 2k+1 become block k. */
+static int fe__quadric_blocks_halve(fe_quadric_blocks *qb)
+{
+    uint32_t n = qb->nblocks, k;
+    for (k = 0; 2 * k < n; k++) {
+        fe_quadric pair = qb->block[2 * k];
+        if (2 * k + 1 < n) {
+            int rc = fe_quadric_merge(&pair, &qb->block[2 * k + 1]);
+            if (rc != FE_OK)
+                return rc;
+        }
+        qb->block[k] = pair;
+    }
+    for (uint32_t j = k; j < n; j++)
+        qb->block[j] = (fe_quadric)FE_QUADRIC_EMPTY;
+    qb->nblocks = k;
+    qb->block_len = (qb->block_len ? qb->block_len : 1) * 2;
+    return FE_OK;
+}
+
+int fe_quadric_blocks_add(fe_quadric_blocks *qb, const double x[3])
+{
+    fe_quadric cur = FE_QUADRIC_EMPTY, all;
+    uint64_t len;
+    int fresh, rc;
+    if (qb == NULL || x == NULL)
+        return FE_EINVAL;
+    len = qb->block_len ? qb->block_len : 1;
+    fresh = qb->nblocks == 0 || qb->block[qb->nblocks - 1].m[0] >= (double)len;
+    if (!fresh)
+        cur = qb->block[qb->nblocks - 1];
+    rc = fe_quadric_add(&cur, x);
+    if (rc != FE_OK)
+        return rc;
+    all = qb->all;
+    rc = fe_quadric_add(&all, x);
+    if (rc != FE_OK)
+        return rc;
+    if (fresh && qb->nblocks == FE_QUADRIC_BLOCKS) {
+        fe_quadric_blocks keep = *qb;
+        rc = fe__quadric_blocks_halve(qb);
+        if (rc != FE_OK) {
+            *qb = keep;
+            return rc;
+        }
+    }
+    qb->all = all;
+    if (fresh)
+        qb->nblocks++;
+    qb->block[qb->nblocks - 1] = cur;
+    return FE_OK;
+}
+
+int fe_quadric_blocks_merge(fe_quadric_blocks *a, const fe_quadric_blocks *b)
+{
+    fe_quadric_blocks x, y;
+    int rc;
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    if (b->nblocks == 0)
+        return FE_OK;
+    x = *a;
+    y = *b;
+    if (x.block_len == 0)
+        x.block_len = 1;
+    if (y.block_len == 0)
+        y.block_len = 1;
+    rc = fe_quadric_merge(&x.all, &y.all);
+    while (rc == FE_OK && x.nblocks > 0 && x.block_len < y.block_len)
+        rc = fe__quadric_blocks_halve(&x);
+    while (rc == FE_OK && x.nblocks > 0 && y.block_len < x.block_len)
+        rc = fe__quadric_blocks_halve(&y);
+    if (x.nblocks == 0)
+        x.block_len = y.block_len;
+    while (rc == FE_OK && x.nblocks + y.nblocks > FE_QUADRIC_BLOCKS) {
+        rc = fe__quadric_blocks_halve(&x);
+        if (rc == FE_OK)
+            rc = fe__quadric_blocks_halve(&y);
+    }
+    if (rc != FE_OK)
+        return rc;
+    for (uint32_t k = 0; k < y.nblocks; k++)
+        x.block[x.nblocks + k] = y.block[k];
+    x.nblocks += y.nblocks;
+    *a = x;
+    return FE_OK;
+}
+/* Fold in blocks of consecutive samples ends here */
+/* [[file:../literate/quadric.org::Compute the monomials of one sample in float][Compute the monomials of one sample in float]] */
+static int fe__finite_f32(float x)
+{
+    return x - x == 0.0f;
+}
+
+/* 4 * parent + axis of each monomial: u^alpha_k = u^alpha_parent * u_axis. */
+static const unsigned char fe__quadric_parent[FE_QUADRIC_MOMENTS] = {
+    0,
+    0 * 4 + 0, 0 * 4 + 1, 0 * 4 + 2,
+    1 * 4 + 0, 1 * 4 + 1, 1 * 4 + 2, 2 * 4 + 1, 2 * 4 + 2, 3 * 4 + 2,
+    4 * 4 + 0, 4 * 4 + 1, 4 * 4 + 2, 5 * 4 + 1, 5 * 4 + 2, 6 * 4 + 2,
+    7 * 4 + 1, 7 * 4 + 2, 8 * 4 + 2, 9 * 4 + 2,
+    10 * 4 + 0, 10 * 4 + 1, 10 * 4 + 2, 11 * 4 + 1, 11 * 4 + 2, 12 * 4 + 2,
+    13 * 4 + 1, 13 * 4 + 2, 14 * 4 + 2, 15 * 4 + 2, 16 * 4 + 1, 16 * 4 + 2,
+    17 * 4 + 2, 18 * 4 + 2, 19 * 4 + 2
+};
+
+static void fe__quadric_monomials_f32(const float d[3], float p[35])
+{
+    p[0] = 1.0f;
+    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++)
+        p[k] = p[fe__quadric_parent[k] >> 2] * d[fe__quadric_parent[k] & 3];
+}
+/* Compute the monomials of one sample in float ends here */
+/* [[file:../literate/quadric.org::Move float moments to another reference][Move float moments to another reference]] */
+static int fe__quadric_at(int a, int b, int c)
+{
+    int d = a + b + c;
+    return d * (d + 1) * (d + 2) / 6 + (d - a) * (d - a + 1) / 2 + (d - a - b);
+}
+
+static int fe__quadric_shift_f32(const float m[35], const float delta[3],
+                                 float out[35])
+{
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        out[k] = m[k];
+    for (int j = 0; j < 3; j++)
+        for (int i = 1; i <= 4; i++)
+            for (int k = FE_QUADRIC_MOMENTS - 1; k > 0; k--) {
+                int e[3] = {fe__quadric_exp[k][0], fe__quadric_exp[k][1],
+                            fe__quadric_exp[k][2]};
+                if (e[j] < i)
+                    continue;
+                e[j]--;
+                out[k] += delta[j] * out[fe__quadric_at(e[0], e[1], e[2])];
+            }
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        if (!fe__finite_f32(out[k]))
+            return FE_ENONFINITE;
+    return FE_OK;
+}
+
+int fe_quadric_f32_recentre(fe_quadric_f32 *q, const float ref[3])
+{
+    float delta[3], out[FE_QUADRIC_MOMENTS];
+    int rc;
+    if (q == NULL || ref == NULL)
+        return FE_EINVAL;
+    if (!fe__finite_f32(ref[0]) || !fe__finite_f32(ref[1])
+        || !fe__finite_f32(ref[2]))
+        return FE_ENONFINITE;
+    for (int j = 0; j < 3; j++)
+        delta[j] = q->ref[j] - ref[j];
+    rc = fe__quadric_shift_f32(q->m, delta, out);
+    if (rc != FE_OK)
+        return rc;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        q->m[k] = out[k];
+    for (int j = 0; j < 3; j++)
+        q->ref[j] = ref[j];
+    q->flags |= FE_QUADRIC_HAS_REF;
+    return FE_OK;
+}
+/* Move float moments to another reference ends here */
+/* [[file:../literate/quadric.org::Fold one sample in float][Fold one sample in float]] */
+int fe_quadric_f32_init(fe_quadric_f32 *q, const float *centre)
+{
+    fe_quadric_f32 e = FE_QUADRIC_F32_EMPTY;
+    if (q == NULL)
+        return FE_EINVAL;
+    if (centre != NULL) {
+        for (int j = 0; j < 3; j++) {
+            if (!fe__finite_f32(centre[j]))
+                return FE_ENONFINITE;
+            e.ref[j] = centre[j];
+        }
+        e.flags = FE_QUADRIC_HAS_REF;
+    }
+    *q = e;
+    return FE_OK;
+}
+
+int fe_quadric_f32_add(fe_quadric_f32 *q, const float x[3])
+{
+    float ref[3], d[3], p[FE_QUADRIC_MOMENTS], m[FE_QUADRIC_MOMENTS];
+    int first;
+
+    if (q == NULL || x == NULL)
+        return FE_EINVAL;
+    if (!fe__finite_f32(x[0]) || !fe__finite_f32(x[1]) || !fe__finite_f32(x[2]))
+        return FE_ENONFINITE;
+    if (q->n == UINT32_MAX)
+        return FE_ESIZE;
+    for (int j = 0; j < 3; j++)
+        ref[j] = (q->flags & FE_QUADRIC_HAS_REF) ? q->ref[j] : x[j];
+    for (int j = 0; j < 3; j++)
+        d[j] = x[j] - ref[j];
+    fe__quadric_monomials_f32(d, p);
+    m[0] = (float)(q->n + 1);
+    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++) {
+        m[k] = q->m[k] + p[k];
+        if (!fe__finite_f32(m[k]))
+            return FE_ENONFINITE;
+    }
+    first = q->n == 0;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        q->m[k] = m[k];
+    for (int j = 0; j < 3; j++) {
+        q->ref[j] = ref[j];
+        if (first || x[j] < q->lo[j])
+            q->lo[j] = x[j];
+        if (first || x[j] > q->hi[j])
+            q->hi[j] = x[j];
+    }
+    q->n++;
+    q->flags |= FE_QUADRIC_HAS_REF;
+    /* Move the reference to the mean when it has drifted */
+    {
+        float mean[3], size = 0.0f, drift = 0.0f;
+        for (int j = 0; j < 3; j++) {
+            float h = 0.5f * (q->hi[j] - q->lo[j]), d;
+            mean[j] = q->ref[j] + q->m[1 + j] / q->m[0];
+            d = mean[j] - q->ref[j];
+            d = d < 0.0f ? -d : d;
+            size = h > size ? h : size;
+            drift = d > drift ? d : drift;
+        }
+        if (10.0f * drift > size && fe_quadric_f32_recentre(q, mean) == FE_OK)
+            q->recentres++;
+    }
+    return FE_OK;
+}
+/* Fold one sample in float ends here */
+/* [[file:../literate/quadric.org::Widen a float accumulation][Widen a float accumulation]] */
+int fe_quadric_from_f32(fe_quadric *q, const fe_quadric_f32 *f)
+{
+    fe_quadric e = FE_QUADRIC_EMPTY;
+    if (q == NULL || f == NULL)
+        return FE_EINVAL;
+    e.m[0] = (double)f->n;
+    for (int k = 1; k < FE_QUADRIC_MOMENTS; k++)
+        e.m[k] = (double)f->m[k];
+    for (int j = 0; j < 3; j++) {
+        e.ref[j] = (double)f->ref[j];
+        e.lo[j] = (double)f->lo[j];
+        e.hi[j] = (double)f->hi[j];
+    }
+    e.flags = f->flags & FE_QUADRIC_HAS_REF;
+    *q = e;
+    return FE_OK;
+}
+/* Widen a float accumulation ends here */

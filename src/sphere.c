@@ -421,6 +421,30 @@ static int fe__sphere_eig3(const double S[9], double w[3], double *V)
 }
 /* Compute the eigenvalues of a symmetric 3x3 matrix ends here */
 /* [[file:../literate/sphere.org::Set up the frame and check the data][Set up the frame and check the data]] */
+/* The moments mu of q in the frame u = (x - c) / sigma, and Phi from
+   them: entry (k, l) is the moment of alpha_k + alpha_l. */
+static int fe__sphere_phi(const fe_quadric *q, const double c[3], double sigma,
+                          double phi[100], double mu[FE_QUADRIC_MOMENTS])
+{
+    fe_quadric moved = *q;
+    int rc = fe_quadric_recentre(&moved, c);
+    if (rc != FE_OK)
+        return rc;
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
+        int e[3];
+        fe_quadric_exponents(k, e);
+        mu[k] = moved.m[k] / pow(sigma, e[0] + e[1] + e[2]);
+    }
+    for (int k = 0; k < 10; k++)
+        for (int l = 0; l < 10; l++) {
+            int ek[3], el[3];
+            fe_quadric_exponents(k, ek);
+            fe_quadric_exponents(l, el);
+            phi[k * 10 + l] = mu[fe_quadric_index(ek[0] + el[0], ek[1] + el[1], ek[2] + el[2])];
+        }
+    return FE_OK;
+}
+
 /* Fill the frame of pr from q, the measured figures of fit, and the
    initial beta; refuse data that cannot determine the model. */
 static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
@@ -428,7 +452,6 @@ static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
                             fe__sphere_problem *pr, fe_sphere_fit *fit,
                             double *beta)
 {
-    fe_quadric moved;
     double h[3], mu[FE_QUADRIC_MOMENTS], C[9], w[3], n;
     int rc;
 
@@ -465,24 +488,9 @@ static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
         fit->refusal = FE_SPHERE_DEGENERATE;
         return FE_EUNDETERMINED;
     }
-    moved = *q;
-    rc = fe_quadric_recentre(&moved, pr->c);
+    rc = fe__sphere_phi(q, pr->c, pr->sigma, pr->phi, mu);
     if (rc != FE_OK)
         return rc;
-    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
-        int e[3];
-        fe_quadric_exponents(k, e);
-        mu[k] = moved.m[k] / pow(pr->sigma, e[0] + e[1] + e[2]);
-    }
-    /* Phi from the moments: entry (k, l) is the moment of alpha_k + alpha_l. */
-    for (int k = 0; k < 10; k++)
-        for (int l = 0; l < 10; l++) {
-            int ek[3], el[3];
-            fe_quadric_exponents(k, ek);
-            fe_quadric_exponents(l, el);
-            pr->phi[k * 10 + l] =
-                mu[fe_quadric_index(ek[0] + el[0], ek[1] + el[1], ek[2] + el[2])];
-        }
     /* Planarity: covariance eigenvalues. */
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -515,6 +523,76 @@ static int fe__sphere_setup(const fe_quadric *q, fe_sphere_model model,
     return FE_OK;
 }
 /* Set up the frame and check the data ends here */
+/* [[file:../literate/sphere.org::Carry the errors to the matrix][Carry the errors to the matrix]] */
+static int fe__sphere_eig3(const double S[9], double w[3], double *V);
+
+/* M = the symmetric square root of the matrix with entries a[6]. */
+static int fe__sphere_sqrtm(const double a[6], double M[9])
+{
+    static const int e[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+    double S[9], w[3], V[9];
+    int rc;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            S[i * 3 + j] = a[e[i][j]];
+    rc = fe__sphere_eig3(S, w, V);
+    if (rc != FE_OK)
+        return rc;
+    if (!(w[0] > 0.0))
+        return FE_ENOTPD;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double m = 0.0;
+            for (int k = 0; k < 3; k++)
+                m += V[k * 3 + i] * sqrt(w[k]) * V[k * 3 + j];
+            M[i * 3 + j] = m;
+        }
+    return FE_OK;
+}
+
+static int fe__sphere_matrix_se(fe_sphere_fit *fit)
+{
+    int p = fit->nparams;
+    memset(fit->matrix_se, 0, sizeof fit->matrix_se);
+    if (fit->model != FE_FIT_ELLIPSOID) {
+        for (int j = 0; j < 3; j++) {
+            int k = fit->model == FE_FIT_SPHERE ? 3 : 3 + j;
+            double s = fit->params[k];
+            fit->matrix_se[4 * j] = sqrt(fit->cov[k * p + k]) / (s * s);
+        }
+        return FE_OK;
+    }
+    {
+        double D[9][6], h = 0.0;
+        for (int e = 0; e < 6; e++)
+            h = fmax(h, fabs(fit->params[3 + e]));
+        h *= 1e-6;
+        /* Derivatives of the nine entries by the six parameters. */
+        for (int e = 0; e < 6; e++) {
+            double a[6], Mp[9], Mm[9];
+            int rc;
+            memcpy(a, fit->params + 3, sizeof a);
+            a[e] += h;
+            rc = fe__sphere_sqrtm(a, Mp);
+            a[e] -= 2.0 * h;
+            if (rc == FE_OK)
+                rc = fe__sphere_sqrtm(a, Mm);
+            if (rc != FE_OK)
+                return rc;
+            for (int k = 0; k < 9; k++)
+                D[k][e] = (Mp[k] - Mm[k]) / (2.0 * h);
+        }
+        for (int k = 0; k < 9; k++) {
+            double v = 0.0;
+            for (int e = 0; e < 6; e++)
+                for (int f = 0; f < 6; f++)
+                    v += D[k][e] * fit->cov[(3 + e) * p + 3 + f] * D[k][f];
+            fit->matrix_se[k] = sqrt(fmax(v, 0.0));
+        }
+    }
+    return FE_OK;
+}
+/* Carry the errors to the matrix ends here */
 /* [[file:../literate/sphere.org::Express the fit in the sensor's units][Express the fit in the sensor's units]] */
 static int fe__sphere_finish(const fe__sphere_problem *pr, const fe_quadric *q,
                              const fe_sphere_options *opt, const double *beta,
@@ -597,8 +675,11 @@ static int fe__sphere_finish(const fe__sphere_problem *pr, const fe_quadric *q,
             for (int l = 0; l < p; l++)
                 fit->cov[k * p + l] = s2 * scale[k] * scale[l] * inv[k * p + l];
         for (int k = 0; k < p; k++)
-            fit->se[k] = sqrt(fit->cov[k * p + k]);
+            fit->se[k] = fit->se_iid[k] = sqrt(fit->cov[k * p + k]);
     }
+    rc = fe__sphere_matrix_se(fit);
+    if (rc != FE_OK)
+        return rc;
     if (worst < opt->min_extent) {
         fit->refusal = FE_SPHERE_HEMISPHERE;
         return FE_EUNDETERMINED;
@@ -871,3 +952,300 @@ void fe_sphere_apply(const fe_sphere_fit *fit, const double x[3], double y[3])
         y[i] = out[i];
 }
 /* Evaluate and apply a calibration ends here */
+/* [[file:../literate/sphere.org::Scale a calibration to a known field][Scale a calibration to a known field]] */
+int fe_sphere_scale(const fe_sphere_fit *fit, double field, fe_sphere_scaled *out)
+{
+    double f;
+    if (fit == NULL || out == NULL || !(field >= 0.0) || !isfinite(field)
+        || !(fit->radius > 0.0) || !isfinite(fit->radius))
+        return FE_EINVAL;
+    f = field > 0.0 ? field : fit->radius;
+    out->field = f;
+    memcpy(out->offset, fit->offset, sizeof out->offset);
+    for (int k = 0; k < 9; k++)
+        out->matrix[k] = f * fit->matrix[k];
+    out->gain = fit->radius / f;
+    return FE_OK;
+}
+
+void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3], double y[3])
+{
+    double u[3];
+    for (int j = 0; j < 3; j++)
+        u[j] = x[j] - s->offset[j];
+    for (int i = 0; i < 3; i++)
+        y[i] = s->matrix[i * 3] * u[0] + s->matrix[i * 3 + 1] * u[1]
+             + s->matrix[i * 3 + 2] * u[2];
+}
+/* Scale a calibration to a known field ends here */
+/* [[file:../literate/sphere.org::Express a calibration as ArduPilot's parameters][Express a calibration as ArduPilot's parameters]] */
+int fe_sphere_to_ardupilot(const fe_sphere_fit *fit, double field_mgauss,
+                           double mgauss_per_unit, fe_sphere_ardupilot *out)
+{
+    double K = mgauss_per_unit, w;
+    if (fit == NULL || out == NULL || !(K > 0.0) || !isfinite(K) || !(field_mgauss >= 0.0)
+        || !isfinite(field_mgauss) || !(fit->radius > 0.0) || !isfinite(fit->radius))
+        return FE_EINVAL;
+    w = field_mgauss > 0.0 ? field_mgauss / K : fit->radius;     /* F / K */
+    for (int j = 0; j < 3; j++) {
+        out->ofs[j] = -K * fit->offset[j];
+        out->dia[j] = w * fit->matrix[4 * j];
+    }
+    out->odi[0] = w * fit->matrix[1];
+    out->odi[1] = w * fit->matrix[2];
+    out->odi[2] = w * fit->matrix[5];
+    return FE_OK;
+}
+/* Express a calibration as ArduPilot's parameters ends here */
+/* [[file:../literate/sphere.org::Measure the errors from blocks in time][Measure the errors from blocks in time]] */
+static int fe__sphere_block_errors(const fe_quadric_blocks *qb, fe_sphere_fit *fit)
+{
+    double beta[FE__P], theta[10], T[10 * FE__P], phi[100], mu[FE_QUADRIC_MOMENTS];
+    double H[FE__P * FE__P], Hi[FE__P * FE__P], g[FE_QUADRIC_BLOCKS][FE__P], gsum[FE__P];
+    double Om[FE__P * FE__P], C[FE__P * FE__P], scale[FE__P], sigma = fit->frame_scale;
+    double n = qb->all.m[0], nb[FE_QUADRIC_BLOCKS];
+    int p = fit->nparams, B = 0, rc;
+
+    /* The parameters in the frame of the solve. */
+    memset(beta, 0, sizeof beta);
+    for (int j = 0; j < 3; j++) {
+        beta[j] = (fit->offset[j] - fit->frame_centre[j]) / sigma;
+        scale[j] = sigma;
+    }
+    for (int k = 3; k < p; k++) {
+        int ell = fit->model == FE_FIT_ELLIPSOID;
+        beta[k] = ell ? fit->params[k] * sigma * sigma : fit->params[k] / sigma;
+        scale[k] = ell ? 1.0 / (sigma * sigma) : sigma;
+    }
+    fe__sphere_theta(fit->model, beta, theta, T);
+    /* H = T' Phi T from all samples. */
+    rc = fe__sphere_phi(&qb->all, fit->frame_centre, sigma, phi, mu);
+    if (rc != FE_OK)
+        return rc;
+    for (int k = 0; k < p; k++)
+        for (int l = 0; l < p; l++) {
+            double h = 0.0;
+            for (int a = 0; a < 10; a++)
+                for (int b = 0; b < 10; b++)
+                    h += T[a * FE__P + k] * phi[a * 10 + b] * T[b * FE__P + l];
+            H[k * p + l] = h;
+        }
+    /* The block sums g_b = T' Phi_b theta. */
+    memset(gsum, 0, sizeof gsum);
+    for (uint32_t b = 0; b < qb->nblocks && b < FE_QUADRIC_BLOCKS; b++) {
+        double v[10];
+        if (qb->block[b].m[0] == 0.0)
+            continue;
+        rc = fe__sphere_phi(&qb->block[b], fit->frame_centre, sigma, phi, mu);
+        if (rc != FE_OK)
+            return rc;
+        for (int a = 0; a < 10; a++) {
+            v[a] = 0.0;
+            for (int c = 0; c < 10; c++)
+                v[a] += phi[a * 10 + c] * theta[c];
+        }
+        for (int k = 0; k < p; k++) {
+            g[B][k] = 0.0;
+            for (int a = 0; a < 10; a++)
+                g[B][k] += T[a * FE__P + k] * v[a];
+            gsum[k] += g[B][k];
+        }
+        nb[B++] = qb->block[b].m[0];
+    }
+    if (B < 8)
+        return FE_OK;           /* too few blocks: the independent errors stay */
+    /* Omega: the spread of the centred block sums. */
+    memset(Om, 0, sizeof Om);
+    for (int b = 0; b < B; b++)
+        for (int k = 0; k < p; k++)
+            for (int l = 0; l < p; l++)
+                Om[k * p + l] += (g[b][k] - nb[b] / n * gsum[k]) * (g[b][l] - nb[b] / n * gsum[l]);
+    for (int k = 0; k < p * p; k++)
+        Om[k] *= (double)B / (B - 1);
+    /* H^-1 Omega H^-1, in the sensor's units. */
+    memset(Hi, 0, sizeof Hi);
+    for (int k = 0; k < p; k++)
+        Hi[k * p + k] = 1.0;
+    {
+        double Hc[FE__P * FE__P];
+        memcpy(Hc, H, sizeof Hc);
+        rc = fe__sphere_posv(p, p, Hc, Hi);
+        if (rc != FE_OK)
+            return rc;
+    }
+    for (int k = 0; k < p; k++)
+        for (int l = 0; l < p; l++) {
+            double c = 0.0;
+            for (int a = 0; a < p; a++)
+                for (int b = 0; b < p; b++)
+                    c += Hi[k * p + a] * Om[a * p + b] * Hi[b * p + l];
+            C[k * p + l] = c;
+        }
+    for (int k = 0; k < p; k++)
+        for (int l = 0; l < p; l++)
+            fit->cov[k * p + l] = scale[k] * scale[l] * C[k * p + l];
+    for (int k = 0; k < p; k++)
+        fit->se[k] = sqrt(fmax(fit->cov[k * p + k], 0.0));
+    fit->se_blocks = B;
+    return fe__sphere_matrix_se(fit);
+}
+
+int fe_sphere_fit_blocks(const fe_quadric_blocks *qb, fe_sphere_model model,
+                         const fe_sphere_options *opt, fe_sphere_fit *fit)
+{
+    int rc;
+    if (qb == NULL || fit == NULL)
+        return FE_EINVAL;
+    rc = fe_sphere_fit_moments(&qb->all, model, opt, fit);
+    if (rc != FE_OK || fit->algebraic)
+        return rc;
+    return fe__sphere_block_errors(qb, fit);
+}
+/* Measure the errors from blocks in time ends here */
+/* [[file:../literate/sphere.org::Find the still segments][Find the still segments]] */
+enum { FE__STILL_SLOT = 7 };    /* x, y, z, |x|, |rate|, verdict, spare */
+
+fe_still_options fe_still_default_options(void)
+{
+    fe_still_options o = {50, 0.002, 0.0};
+    return o;
+}
+
+size_t fe_still_workspace(size_t window)
+{
+    return FE__STILL_SLOT * window;
+}
+
+int fe_still_init(fe_still *s, const fe_still_options *opt, double *work, size_t work_len)
+{
+    fe_still_options o = opt != NULL ? *opt : fe_still_default_options();
+    if (s == NULL || work == NULL || o.window < 2 || !(o.max_rel_sd >= 0.0)
+        || !isfinite(o.max_rel_sd) || !(o.max_rate >= 0.0) || !isfinite(o.max_rate))
+        return FE_EINVAL;
+    if (work_len < fe_still_workspace(o.window))
+        return FE_ESIZE;
+    memset(s, 0, sizeof *s);
+    s->opt = o;
+    s->ring = work;
+    return FE_OK;
+}
+
+/* Hand back the oldest sample held. */
+static void fe__still_pop(fe_still *s, double out[3], int *still)
+{
+    const double *slot = s->ring + FE__STILL_SLOT * s->head;
+    for (int j = 0; j < 3; j++)
+        out[j] = slot[j];
+    *still = slot[5] != 0.0;
+    if (*still)
+        s->still++;
+    else
+        s->moving++;
+    s->head = (s->head + 1) % s->opt.window;
+    s->count--;
+}
+
+/* Judge the full window: the sd of |x| against its mean, the largest rate. */
+static void fe__still_judge(fe_still *s)
+{
+    size_t w = s->opt.window;
+    double mean = 0.0, ss = 0.0, worst = 0.0;
+    for (size_t k = 0; k < w; k++)
+        mean += s->ring[FE__STILL_SLOT * k + 3] / (double)w;
+    for (size_t k = 0; k < w; k++) {
+        double d = s->ring[FE__STILL_SLOT * k + 3] - mean;
+        ss += d * d;
+        worst = fmax(worst, s->ring[FE__STILL_SLOT * k + 4]);
+    }
+    if (sqrt(ss / (double)(w - 1)) <= s->opt.max_rel_sd * mean
+        && (s->opt.max_rate == 0.0 || worst <= s->opt.max_rate))
+        for (size_t k = 0; k < w; k++)
+            s->ring[FE__STILL_SLOT * k + 5] = 1.0;
+}
+
+int fe_still_push(fe_still *s, const double x[3], const double *rate, double out[3],
+                  int *still, int *ready)
+{
+    double *slot;
+    if (s == NULL || x == NULL || out == NULL || still == NULL || ready == NULL)
+        return FE_EINVAL;
+    for (int j = 0; j < 3; j++)
+        if (!isfinite(x[j]) || (rate != NULL && !isfinite(rate[j])))
+            return FE_ENONFINITE;
+    *ready = s->count == s->opt.window;
+    if (*ready)
+        fe__still_pop(s, out, still);
+    slot = s->ring + FE__STILL_SLOT * ((s->head + s->count) % s->opt.window);
+    for (int j = 0; j < 3; j++)
+        slot[j] = x[j];
+    slot[3] = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    slot[4] = rate != NULL ? sqrt(rate[0] * rate[0] + rate[1] * rate[1] + rate[2] * rate[2])
+                           : 0.0;
+    slot[5] = 0.0;
+    s->count++;
+    if (s->count == s->opt.window)
+        fe__still_judge(s);
+    return FE_OK;
+}
+
+int fe_still_flush(fe_still *s, double out[3], int *still)
+{
+    if (s == NULL || out == NULL || still == NULL)
+        return FE_EINVAL;
+    if (s->count == 0)
+        return FE_END;
+    fe__still_pop(s, out, still);
+    return FE_OK;
+}
+/* Find the still segments ends here */
+/* [[file:../literate/sphere.org::Measure radial residuals and their robust scale][Measure radial residuals and their robust scale]] */
+double fe_sphere_radial(const fe_sphere_fit *fit, const double x[3])
+{
+    double y[3];
+    fe_sphere_apply(fit, x, y);
+    return sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0;
+}
+
+/* Bin k holds |e| in [10^(k/25 - 7), 10^((k+1)/25 - 7)). */
+int fe_radial_hist_add(fe_radial_hist *h, double e)
+{
+    double a = fabs(e);
+    int k;
+    if (h == NULL)
+        return FE_EINVAL;
+    if (!isfinite(e))
+        return FE_ENONFINITE;
+    k = a > 0.0 ? (int)floor(25.0 * (log10(a) + 7.0)) : 0;
+    k = k < 0 ? 0 : k >= FE_RADIAL_BINS ? FE_RADIAL_BINS - 1 : k;
+    h->count[k] += 1.0;
+    h->n += 1.0;
+    return FE_OK;
+}
+
+int fe_radial_hist_merge(fe_radial_hist *a, const fe_radial_hist *b)
+{
+    if (a == NULL || b == NULL)
+        return FE_EINVAL;
+    for (int k = 0; k < FE_RADIAL_BINS; k++)
+        a->count[k] += b->count[k];
+    a->n += b->n;
+    return FE_OK;
+}
+
+double fe_radial_hist_scale(const fe_radial_hist *h)
+{
+    double half, below = 0.0;
+    if (h == NULL || !(h->n > 0.0))
+        return 0.0;
+    half = 0.5 * h->n;
+    for (int k = 0; k < FE_RADIAL_BINS; k++) {
+        if (below + h->count[k] >= half) {
+            /* Interpolate in log |e| within the bin. */
+            double f = h->count[k] > 0.0 ? (half - below) / h->count[k] : 0.0;
+            return 1.4826 * pow(10.0, ((double)k + f) / 25.0 - 7.0);
+        }
+        below += h->count[k];
+    }
+    return 1.4826 * 10.0;
+}
+/* Measure radial residuals and their robust scale ends here */

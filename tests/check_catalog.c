@@ -175,6 +175,85 @@ START_TEST(expression_terms_through_the_catalog)
 }
 END_TEST
 
+START_TEST(probes_are_bins_of_a_state_variable)
+{
+    /* fe_catalog_add_probes on velocity over [-2, 2] in 4 bins: three
+       probes, [-inf, -1), [-1, 0), [0, 1); the last bin [1, inf) is left
+       out.  Values at the edges (lower edge in, upper edge out), the same
+       through fe_catalog_eval and fe_catalog_eval_rows, invisible to
+       fe_catalog_find, and every refusal at its edge, all or none. */
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    const double v[] = {-5.0, -1.0 - 1e-12, -1.0, -1e-300, 0.0, 0.999, 1.0, 2.0, 7.0};
+    const double want[][3] = {{1, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, 0, 1},
+                              {0, 0, 1}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    const size_t nv = sizeof v / sizeof v[0];
+    double rows[9 * FE_CATALOG_VARS] = {0}, phi[9 * FE_DISCOVER_MAX_GROUPS];
+    double work[512];
+    size_t n0;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_VELOCITY, &scale), FE_OK);
+    n0 = c.count;
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_VELOCITY, -2.0, 2.0, 4), FE_OK);
+    ck_assert_uint_eq(c.count, n0 + 3);
+    ck_assert_int_eq(fe_catalog_find(&c, "probe_velocity"), -1);
+    ck_assert_str_eq(c.terms[n0].name, "probe_velocity");
+    ck_assert(c.terms[n0].probe && c.terms[n0].var == FE_CATALOG_VAR_VELOCITY);
+    ck_assert(isinf(c.terms[n0].lo) && c.terms[n0].lo < 0 && c.terms[n0].hi == -1.0);
+    ck_assert(c.terms[n0 + 2].lo == 0.0 && c.terms[n0 + 2].hi == 1.0);
+    ck_assert_uint_ge(sizeof work / sizeof work[0], fe_catalog_work_doubles(nv));
+    for (size_t i = 0; i < nv; i++) {
+        fe_sample s = {0};
+        double one[FE_DISCOVER_MAX_GROUPS];
+        s.velocity = v[i];
+        rows[i * FE_CATALOG_VARS + FE_CATALOG_VAR_VELOCITY] = v[i];
+        ck_assert_int_eq(fe_catalog_eval(&c, &s, one), FE_OK);
+        for (size_t k = 0; k < 3; k++)
+            ck_assert_msg(one[n0 + k] == want[i][k], "v = %g, probe %zu: %g", v[i], k,
+                          one[n0 + k]);
+    }
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, nv, phi,
+                                          FE_DISCOVER_MAX_GROUPS, work, NULL), FE_OK);
+    for (size_t i = 0; i < nv; i++)
+        for (size_t k = 0; k < 3; k++)
+            ck_assert(phi[i * FE_DISCOVER_MAX_GROUPS + n0 + k] == want[i][k]);
+    /* Refusals, the catalog unchanged by each. */
+    ck_assert_int_eq(fe_catalog_add_probes(NULL, FE_CATALOG_VAR_VELOCITY, 0, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_DSIM, 0, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VARS, 0, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 0, 1, 1), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 0, 1, FE_CATALOG_MAX_BINS + 1),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 1, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 2, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, NAN, 1, 4), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 0, INFINITY, 4), FE_EINVAL);
+    ck_assert_uint_eq(c.count, n0 + 3);
+    /* The edges that are taken: two bins (one probe), and the most bins. */
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_POSITION, 0, 1, 2), FE_OK);
+    ck_assert_uint_eq(c.count, n0 + 4);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_INPUT, 0, 1, FE_CATALOG_MAX_BINS),
+                     FE_OK);
+    ck_assert_uint_eq(c.count, n0 + 4 + FE_CATALOG_MAX_BINS - 1);
+    /* Full: exactly enough room is taken, one probe too many is refused
+       and nothing is added. */
+    {
+        size_t room = FE_DISCOVER_MAX_GROUPS - c.count;
+        ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_AMBIENT, 0, 1, room + 2),
+                         room + 2 > FE_CATALOG_MAX_BINS ? FE_EINVAL : FE_ESIZE);
+        while (c.count + FE_CATALOG_MAX_BINS - 1 <= FE_DISCOVER_MAX_GROUPS)
+            ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_AMBIENT, 0, 1,
+                                                   FE_CATALOG_MAX_BINS), FE_OK);
+        room = FE_DISCOVER_MAX_GROUPS - c.count;
+        ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_AMBIENT, 0, 1, room + 2),
+                         FE_ESIZE);
+        ck_assert_uint_eq(c.count, FE_DISCOVER_MAX_GROUPS - room);
+        ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_AMBIENT, 0, 1, room + 1),
+                         FE_OK);
+        ck_assert_uint_eq(c.count, FE_DISCOVER_MAX_GROUPS);
+    }
+}
+END_TEST
+
 START_TEST(every_coefficient_in_words)
 {
     const struct { const char *name; double coef; const char *words; } w[] = {
@@ -306,6 +385,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, every_builtin_term_is_its_formula);
     tcase_add_test(t, user_terms_and_a_full_catalog);
     tcase_add_test(t, expression_terms_through_the_catalog);
+    tcase_add_test(t, probes_are_bins_of_a_state_variable);
     tcase_add_test(t, every_coefficient_in_words);
     tcase_add_test(t, three_axis_terms_are_their_formulas);
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);

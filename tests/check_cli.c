@@ -275,6 +275,11 @@ START_TEST(json_outputs_follow_their_schemas)
         snprintf(cmd, sizeof cmd, "%s calibrate --model %s --columns mx,my,mz --json %s", F, model[m], path);
         json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
     }
+    /* With a known field, still segments and outliers rejected. */
+    snprintf(cmd, sizeof cmd, "%s calibrate --columns mx,my,mz --field 48 --static --still-sd 0.05"
+             " --robust --json %s", F, path);
+    json_valid(cmd, 0, "calibrate.schema.json", out, sizeof out);
+    ck_assert_msg(strstr(out, "\"robust_rejected\": ") != NULL, "%s", out);
     snprintf(path, sizeof path, "%s/plane.csv", dir);
     write_text(path, "x,y,z\n1,0,0\n0,1,0\n-1,0,0\n0,-1,0\n0.7,0.7,0\n-0.7,0.7,0\n0.7,-0.7,0\n-0.7,-0.7,0\n"
                      "0.6,0.8,0\n0.8,0.6,0\n-0.6,0.8,0\n0.8,-0.6,0\n");
@@ -443,6 +448,9 @@ static const struct usage_case usage_cases[] = {
     {"discover --sphere /nonexistent/a.csv", 4, "cannot open"},
     {"synth --help", 0, "usage: foldest synth"},
     {"synth --effect quadratic_drag --seed x --real r --sim s", 2, "--seed"},
+    {"synth --effect drift --rho 1 --real r --sim s", 2, "--rho: 1 is not in [0, 1)"},
+    {"synth --effect drift --rho -0.1 --real r --sim s", 2, "--rho: -0.1 is not in [0, 1)"},
+    {"synth --effect drift --rho x --real r --sim s", 2, "--rho: 'x' is not a number"},
     /* Conventions of the shell (issue 19, item 8): getopt_long everywhere. */
     {"-V", 0, "foldest 0."},
     {"stats -V", 0, "foldest 0."},

@@ -274,6 +274,7 @@ Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
     TCase *t = tcase_create("core");
+    tcase_set_timeout(t, 60);   /* about 1 s (the strtod comparison); more on a busy machine or under ASan */
     tcase_add_test(t, lines_lf_crlf_and_last_without_newline);
     tcase_add_test(t, too_long_line_is_reported_then_skipped);
     tcase_add_test(t, binary_input_is_refused);

@@ -19,18 +19,34 @@ typedef struct {
     size_t base[4], nbase;
 } synth_case;
 
-static void fold_case(synth_case *sc, const char *effect, uint64_t seed, size_t rows,
-                      size_t K, double holdout)
+/* As fold_case below, with `bins` bins of the position and velocity
+   appended as probes (none for bins 0), over their ranges in the case. */
+static void fold_case_probed(synth_case *sc, const char *effect, uint64_t seed, size_t rows,
+                             size_t K, double holdout, size_t bins)
 {
     fe_synth_spec spec = fe_synth_default_spec(effect, seed);
     fe_sample s;
     double phi[FE_DISCOVER_MAX_COLUMNS];
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     size_t nst;
     int rc = FE_OK;
     if (rows > 0)
         spec.rows = rows;
     ck_assert_int_eq(fe_synth_init(&sc->g, &spec), FE_OK);
     ck_assert_int_eq(fe_catalog_init(&sc->c, sc->g.roles, &sc->g.scale), FE_OK);
+    if (bins > 0) {
+        while (fe_synth_next(&sc->g, &s) == FE_OK) {
+            lo[0] = fmin(lo[0], s.position);
+            hi[0] = fmax(hi[0], s.position);
+            lo[1] = fmin(lo[1], s.velocity);
+            hi[1] = fmax(hi[1], s.velocity);
+        }
+        fe_synth_rewind(&sc->g);
+        ck_assert_int_eq(fe_catalog_add_probes(&sc->c, FE_CATALOG_VAR_POSITION, lo[0], hi[0],
+                                               bins), FE_OK);
+        ck_assert_int_eq(fe_catalog_add_probes(&sc->c, FE_CATALOG_VAR_VELOCITY, lo[1], hi[1],
+                                               bins), FE_OK);
+    }
     nst = fe_discover_acc_doubles(sc->c.count, K);
     sc->storage = malloc(nst * sizeof *sc->storage);
     sc->nwork = fe_discover_workspace_doubles(sc->c.count, K);
@@ -47,6 +63,12 @@ static void fold_case(synth_case *sc, const char *effect, uint64_t seed, size_t 
     ck_assert_int_eq(rc, FE_OK);
     fe_catalog_groups(&sc->c, sc->groups);
     sc->nbase = fe_synth_base(&sc->g, &sc->c, sc->base);
+}
+
+static void fold_case(synth_case *sc, const char *effect, uint64_t seed, size_t rows,
+                      size_t K, double holdout)
+{
+    fold_case_probed(sc, effect, seed, rows, K, holdout, 0);
 }
 
 static void free_case(synth_case *sc)
@@ -1213,6 +1235,199 @@ START_TEST(lags_are_an_option_of_an_empty_accumulation)
 END_TEST
 
 /* The acceptance suite of the discovery issue. */
+START_TEST(probes_are_scored_against_the_final_model_and_never_added)
+{
+    /* Probes (the last nprobes groups) are never added nor ranked as
+       candidates; probe_p is the smallest p-value of the probes ranked as
+       ordinary candidates against the final model taken as the base,
+       times the number of them tested, at most 1; under either noise
+       model.  Without probes, none is tested and probe_p is NaN. */
+    synth_case sc;
+    fe_discover_result *r = malloc(sizeof *r), *q = malloc(sizeof *q);
+    size_t np, first;
+    ck_assert_ptr_nonnull(r);
+    ck_assert_ptr_nonnull(q);
+    fold_case_probed(&sc, "quadratic_drag", 7, 20000, 20, 0.2, 8);
+    np = 14;
+    first = sc.c.count - np;
+    ck_assert(sc.c.terms[first].probe && !sc.c.terms[first - 1].probe);
+    for (int noise = 0; noise < 2; noise++) {
+        fe_discover_options o = fe_discover_default_options(), o2;
+        size_t base[FE_DISCOVER_MAX_GROUPS], tested = 0;
+        double pmin = INFINITY;
+        o.base = sc.base;
+        o.nbase = sc.nbase;
+        o.nprobes = np;
+        o.noise = noise ? FE_DISCOVER_NOISE_BATCH : FE_DISCOVER_NOISE_AR;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work,
+                                            sc.nwork), FE_OK);
+        ck_assert_uint_ge(r->steps, 1);
+        for (size_t k = 0; k < r->steps; k++)
+            ck_assert_uint_lt(r->added[k], first);
+        for (size_t k = 0; k <= r->steps; k++)
+            for (size_t i = 0; i < r->nranked[k]; i++)
+                ck_assert_uint_lt(r->ranking[k][i].group, first);
+        memcpy(base, sc.base, sc.nbase * sizeof *base);
+        memcpy(base + sc.nbase, r->added, r->steps * sizeof *base);
+        o2 = o;
+        o2.base = base;
+        o2.nbase = sc.nbase + r->steps;
+        o2.nprobes = 0;
+        o2.max_steps = 0;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o2, q, sc.work,
+                                            sc.nwork), FE_OK);
+        for (size_t i = 0; i < q->nranked[0]; i++) {
+            const fe_discover_rank *k = &q->ranking[0][i];
+            if (k->group < first || k->redundant)
+                continue;
+            tested++;
+            pmin = fmin(pmin, k->p_value);
+            if (k->group == r->probe.group)
+                FE_ASSERT_REL(r->probe.statistic, k->statistic, 1e-12);
+        }
+        ck_assert_uint_ge(tested, 10);
+        ck_assert_uint_eq(r->probes_tested, tested);
+        ck_assert_uint_ge(r->probe.group, first);
+        FE_ASSERT_REL(r->probe.p_value, pmin, 1e-12);
+        FE_ASSERT_REL(r->probe_p, fmin(1.0, pmin * (double)tested), 1e-12);
+        /* The same selection without the probes in the groups. */
+        o.nprobes = 0;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, first, &o, q, sc.work, sc.nwork),
+                         FE_OK);
+        ck_assert_uint_eq(q->steps, r->steps);
+        ck_assert_uint_eq(q->probes_tested, 0);
+        ck_assert(isnan(q->probe_p));
+        /* Refusals: no candidate left; a base term among the probes. */
+        o.nprobes = sc.c.count;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, q, sc.work,
+                                            sc.nwork), FE_EINVAL);
+        o.nprobes = sc.c.count - 1;             /* one candidate left, no base */
+        o.nbase = 0;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, q, sc.work,
+                                            sc.nwork), FE_OK);
+        o.nprobes = np;
+        base[0] = first;
+        o.base = base;
+        o.nbase = 1;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, q, sc.work,
+                                            sc.nwork), FE_EINVAL);
+        base[0] = first - 1;
+        ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, q, sc.work,
+                                            sc.nwork), FE_OK);
+    }
+    free(r);
+    free(q);
+    free_case(&sc);
+}
+END_TEST
+
+START_TEST(a_function_of_the_state_outside_the_terms_is_probed)
+{
+    /* A bump in the residual where |x| < 1/4, no term for it: the probes
+       of x in 8 bins over [-1, 1] find it (the bump covers two bins), and
+       the one that stands out is one of those two. */
+    enum { N = 4000, K = 20 };
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_discover_group groups[FE_DISCOVER_MAX_GROUPS];
+    size_t base[1], nst, nw;
+    double *st, *w, phi[FE_DISCOVER_MAX_GROUPS];
+    fe_discover_acc a;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_rng g = fe_rng_seed(5);
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION, &scale), FE_OK);
+    ck_assert_int_eq(fe_catalog_add_probes(&c, FE_CATALOG_VAR_POSITION, -1.0, 1.0, 8), FE_OK);
+    nst = fe_discover_acc_doubles(c.count, K);
+    nw = fe_discover_workspace_doubles(c.count, K);
+    st = malloc(nst * sizeof *st);
+    w = malloc(nw * sizeof *w);
+    ck_assert_int_eq(fe_discover_acc_init(&a, c.count, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        fe_sample s = {0};
+        s.t = (double)t;
+        s.position = sin(0.013 * (double)t);
+        ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_OK);
+        ck_assert_int_eq(fe_discover_add(&a, phi, (fabs(s.position) < 0.25 ? 0.5 : 0.0)
+                                                      + 0.1 * fe_rng_normal(&g)), FE_OK);
+    }
+    fe_catalog_groups(&c, groups);
+    base[0] = (size_t)fe_catalog_find(&c, "bias");
+    o.base = base;
+    o.nbase = 1;
+    o.nprobes = 7;
+    ck_assert_int_eq(fe_discover_select(&a, groups, c.count, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->probes_tested, 7);
+    ck_assert_msg(r->probe_p < 1e-6, "probe_p %g", r->probe_p);
+    ck_assert(c.terms[r->probe.group].lo == -0.25 || c.terms[r->probe.group].lo == 0.0);
+    free(r);
+    free(st);
+    free(w);
+}
+END_TEST
+
+START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
+{
+    /* r = x1 + x2 + noise, and a candidate x3 = x1 + x2 + a little of its
+       own: forward selection takes x3 first (it explains most), then x1
+       and x2, after which x3 explains nothing.  It is set aside: the
+       result is the selection run without it (the same as a selection
+       never offered x3), and its recorded test is x3 scored against the
+       base and x1, x2. */
+    enum { N = 2000, K = 20, M = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_acc a;
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"x1", 1, 1}, {"x2", 2, 1}, {"x3", 3, 1}};
+    size_t base[3] = {0, 1, 2};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r), *q = malloc(sizeof *q);
+    fe_rng g = fe_rng_seed(17);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M];
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&g);
+        phi[2] = fe_rng_normal(&g);
+        phi[3] = phi[1] + phi[2] + 0.3 * fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(&a, phi, phi[1] + phi[2] + 0.5 * fe_rng_normal(&g)),
+                         FE_OK);
+    }
+    o.base = base;
+    o.nbase = 1;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->naside, 1);
+    ck_assert_uint_eq(r->aside[0], 3);
+    ck_assert_uint_eq(r->steps, 2);
+    ck_assert(r->added[0] != 3 && r->added[1] != 3);
+    for (size_t i = 0; i < r->nranked[0]; i++)
+        ck_assert_uint_ne(r->ranking[0][i].group, 3);
+    /* The selection never offered x3. */
+    ck_assert_int_eq(fe_discover_select(&a, groups, M - 1, &o, q, w, nw), FE_OK);
+    ck_assert_uint_eq(q->naside, 0);
+    ck_assert_uint_eq(q->steps, r->steps);
+    ck_assert_uint_eq(q->ncols, r->ncols);
+    for (size_t j = 0; j < r->ncols; j++) {
+        ck_assert_uint_eq(q->cols[j], r->cols[j]);
+        FE_ASSERT_REL(q->coef[j], r->coef[j], 1e-12);
+        FE_ASSERT_REL(q->stderr_[j], r->stderr_[j], 1e-12);
+    }
+    /* x3's test against the base and x1, x2. */
+    o.nbase = 3;
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+    ck_assert_uint_eq(q->nranked[0], 1);
+    ck_assert_uint_eq(q->ranking[0][0].group, 3);
+    FE_ASSERT_REL(r->aside_rank[0].p_value, q->ranking[0][0].p_value, 1e-12);
+    FE_ASSERT_REL(r->aside_rank[0].statistic, q->ranking[0][0].statistic, 1e-12);
+    ck_assert(r->aside_rank[0].p_value >= o.alpha / 2.0 || r->aside_rank[0].delta_bic >= 0.0);
+    free(r);
+    free(q);
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(concealed_effects_are_found_and_nulls_are_not)
 {
     size_t ncases, seeds = fe_test_quick() ? 2 : 20;
@@ -1294,6 +1509,9 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, long_range_model_of_the_fine_blocks);
     tcase_add_test(t, merged_parts_fit_as_the_whole_near_breaks);
     tcase_add_test(t, lags_are_an_option_of_an_empty_accumulation);
+    tcase_add_test(t, probes_are_scored_against_the_final_model_and_never_added);
+    tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
+    tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

@@ -77,6 +77,42 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* synth --rho sets the noise's colour and nothing else: the same truth
+   (coefficient and noise sd) for white noise and for an AR(1) with lag-one
+   correlation 0.9, and discover's baseline residual has the lag-one
+   correlation asked for. */
+START_TEST(synth_rho_sets_the_noise_colour)
+{
+    static char out[65536];
+    char cmd[2048], truth[2][256];
+    const double rho[2] = {0.0, 0.9};
+    make_dir();
+    for (int k = 0; k < 2; k++) {
+        const char *at, *end, *lag1;
+        snprintf(cmd, sizeof cmd, "%s synth --effect drift --seed 3 --rows 20000 --rho %g "
+                 "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, rho[k], dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+        at = strstr(out, "coefficient ");
+        ck_assert_ptr_nonnull(at);
+        end = strstr(at, ", lag-one correlation");
+        ck_assert_ptr_nonnull(end);
+        snprintf(truth[k], sizeof truth[k], "%.*s", (int)(end - at), at);
+        ck_assert_msg(atof(end + strlen(", lag-one correlation")) == rho[k], "%s", out);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel acceleration "
+                 "--role position=position --role velocity=velocity --role input=input "
+                 "--base bias,gain --json", FE_TEST_CLI, dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+        lag1 = strstr(out, "\"baseline\": {");
+        ck_assert_ptr_nonnull(lag1);
+        lag1 = strstr(lag1, "\"lag1\": ");
+        ck_assert_ptr_nonnull(lag1);
+        ck_assert_double_eq_tol(atof(lag1 + strlen("\"lag1\": ")), rho[k], 0.03);
+    }
+    ck_assert_str_eq(truth[0], truth[1]);
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
 /* Output error (--order K): a cart's missing viscous friction named in its
    acceleration with the synthetic truth inside the interval; a heated
    stand's missing convective loss in its dT/dt; the additive mode on a
@@ -112,6 +148,10 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     ck_assert_ptr_nonnull(p);
     ck_assert_int_eq(sscanf(p, "\"interval95\": [%lf, %lf]", &lo, &hi), 2);
     ck_assert_msg(lo <= truth && truth <= hi, "%g not in [%g, %g]", truth, lo, hi);
+    /* Seven bins of each of position, velocity and input probed, none left. */
+    ck_assert_msg(strstr(out, "\"probes\": {\"tested\": 21, \"variable\": \"") != NULL, "%s",
+                  out);
+    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
 
     snprintf(cmd, sizeof cmd, "%s synth --effect newton_cooling --order 1 --seed 2 --rows 8000 "
              "--real %s/tr.csv --sim %s/ts.csv", FE_TEST_CLI, dir, dir);
@@ -164,6 +204,46 @@ END_TEST
 /* One input from standard input or a pipe, or compressed: the same
    answer as from the files; the copy of standard input leaves nothing in
    TMPDIR; two inputs from standard input are refused. */
+START_TEST(a_function_of_the_state_left_is_not_explained)
+{
+    /* The recording has a drift the catalog names, and a bump where the
+       speed is below a quarter of its largest that no term describes: the
+       drift is named, the probes of the velocity find the bump, and the
+       verdict is not "explained", in the story and in the JSON. */
+    static char out[65536];
+    char cmd[2048], path[256];
+    fe_rng g = fe_rng_seed(11);
+    FILE *fr, *fs;
+    make_dir();
+    snprintf(path, sizeof path, "%s/r.csv", dir);
+    ck_assert_ptr_nonnull(fr = fopen(path, "w"));
+    snprintf(path, sizeof path, "%s/s.csv", dir);
+    ck_assert_ptr_nonnull(fs = fopen(path, "w"));
+    fprintf(fr, "t,y\n");
+    fprintf(fs, "t,y,v\n");
+    for (int i = 0; i < 5000; i++) {
+        double t = 0.01 * i, v = cos(1.3 * t), sim = sin(1.3 * t);
+        double real = sim + 0.002 * t + (fabs(v) < 0.25 ? 0.05 : 0.0) + 0.02 * fe_rng_normal(&g);
+        fprintf(fr, "%.4f,%.9f\n", t, real);
+        fprintf(fs, "%.4f,%.9f,%.9f\n", t, sim, v);
+    }
+    fclose(fr);
+    fclose(fs);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y "
+             "--role v=velocity --json", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch not explained by the catalog\"") != NULL,
+                  "%s", out);
+    ck_assert_msg(strstr(out, "\"probes\": {\"tested\": 7, \"variable\": \"velocity\"") != NULL,
+                  "%s", out);
+    ck_assert_msg(strstr(out, "\"name\": \"drift\"") != NULL, "%s", out);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y "
+             "--role v=velocity", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "a function of the state is left") != NULL, "%s", out);
+}
+END_TEST
+
 START_TEST(inputs_from_a_pipe_and_compressed)
 {
     static char want[65536], out[65536];
@@ -769,7 +849,9 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, synth_rho_sets_the_noise_colour);
     tcase_add_test(t, output_error_is_named_in_the_derivative_it_enters);
+    tcase_add_test(t, a_function_of_the_state_left_is_not_explained);
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);
     tcase_add_test(t, bursty_clocks_keep_every_covered_row);
     tcase_add_loop_test(t, bad_inputs, 0, (int)(sizeof bad_cases / sizeof bad_cases[0]));

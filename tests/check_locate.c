@@ -896,6 +896,31 @@ START_TEST(verdict_and_row_worth)
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_NOT_WHITE);
     r->noise.portmanteau_p = 0.001;
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    /* Probes of the state: one that stands out below alpha leaves a
+       function of the state unexplained; at alpha, untested (NaN), or
+       with none tested, it does not; without a term named, no probe
+       makes a mismatch. */
+    r->probes_tested = 7;
+    r->probe_p = 0.0499;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_STATE_LEFT);
+    r->probe_p = 0.05;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    r->probe_p = NAN;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    r->probes_tested = 0;
+    r->probe_p = 0.0;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    r->probes_tested = 7;
+    r->steps = 0;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 0, 0.05), FE_VERDICT_NO_MISMATCH);
+    r->steps = 1;
+    r->probe_p = 0.0499;                    /* the whiteness test comes first */
+    r->noise.portmanteau_p = 0.000999;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_NOT_WHITE);
+    r->probes_tested = 0;
+    ck_assert_str_eq(fe_verdict_text(FE_VERDICT_STATE_LEFT),
+                     "mismatch not explained by the catalog");
+    ck_assert_ptr_nonnull(strstr(fe_verdict_why(FE_VERDICT_STATE_LEFT), "function of the state"));
     r->noise.kind = FE_DISCOVER_NOISE_BATCH;
     r->noise.portmanteau_p = 0.0;
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);

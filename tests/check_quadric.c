@@ -498,10 +498,285 @@ START_TEST(compare_is_the_largest_scaled_difference)
 }
 END_TEST
 
+/* Single precision (the Cortex-M4F step).  Fits of a double and a float
+   accumulation of the same samples, compared as fractions of the field:
+   the largest of |offset difference| / R and R |matrix difference|. */
+static double fits_apart(const fe_quadric *qd, const fe_quadric *qf, int model)
+{
+    fe_sphere_fit fd, ff;
+    double worst = 0.0;
+    ck_assert_int_eq(fe_sphere_fit_moments(qd, (fe_sphere_model)model, NULL, &fd), FE_OK);
+    ck_assert_int_eq(fe_sphere_fit_moments(qf, (fe_sphere_model)model, NULL, &ff), FE_OK);
+    for (int j = 0; j < 3; j++)
+        worst = fmax(worst, fabs(fd.offset[j] - ff.offset[j]) / fd.radius);
+    for (int j = 0; j < 9; j++)
+        worst = fmax(worst, fabs(fd.matrix[j] - ff.matrix[j]) * fd.radius);
+    return worst;
+}
+
+/* Round samples to float in place, so that a double and a float fold see
+   the same numbers.  (Written as one loop: GCC 12's -O2 vectoriser drops
+   the rounding of a round trip through a float[3] rebuilt per sample.) */
+static void round_to_float(double *x, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        x[k] = (float)x[k];
+}
+
+/* The float step against the double step on a QMC5883L-like ellipsoid
+   (offset five times the field, semi-axes 1 : 1.6 : 2.3, 1.5% noise):
+   samples rounded to float first, so both fold the same numbers.  The
+   float fold re-centres itself near the centre; the fits agree to 1e-5
+   of the field, and the moments (moved to the double's reference) to
+   float rounding. */
+START_TEST(f32_step_agrees_with_the_double_step)
+{
+    enum { N = 20000 };
+    static double x[3 * N];
+    const double c[3] = {6000, 250, 3500}, r[3] = {700, 1100, 1600};
+    fe_quadric qd = FE_QUADRIC_EMPTY, qf;
+    fe_quadric_f32 f = FE_QUADRIC_F32_EMPTY;
+    fe_test_ellipsoid_points(x, N, c, r, 15.0, 21);
+    round_to_float(x, 3 * N);
+    for (size_t i = 0; i < N; i++) {
+        float xf[3] = {(float)x[3 * i], (float)x[3 * i + 1], (float)x[3 * i + 2]};
+        ck_assert_int_eq(fe_quadric_f32_add(&f, xf), FE_OK);
+        ck_assert_int_eq(fe_quadric_add(&qd, x + 3 * i), FE_OK);
+    }
+    ck_assert_uint_eq(f.n, N);
+    ck_assert_uint_gt(f.recentres, 0);
+    /* The reference ends within a tenth of the box's largest half-width
+       (z's) of the mean, which is within 10 of the centre (its standard
+       error is r / sqrt(3N) < 7): a reference 5 field-widths off would be
+       6000 away. */
+    for (int j = 0; j < 3; j++) {
+        double mean = qd.ref[j] + qd.m[1 + j] / qd.m[0];
+        ck_assert_double_le(fabs(f.ref[j] - mean), 0.1 * 0.5 * (qd.hi[2] - qd.lo[2]));
+        ck_assert_double_le(fabs(f.ref[j] - c[j]), 0.1 * 0.5 * (qd.hi[2] - qd.lo[2]) + 10.0);
+        ck_assert_double_eq(f.lo[j], qd.lo[j]);
+        ck_assert_double_eq(f.hi[j], qd.hi[j]);
+    }
+    ck_assert_int_eq(fe_quadric_from_f32(&qf, &f), FE_OK);
+    ck_assert_uint_eq(fe_quadric_count(&qf), N);
+    ck_assert_int_eq(fe_quadric_recentre(&qd, qf.ref), FE_OK);
+    ck_assert_double_le(moment_diff(&qf, &qd, 1600.0), 1e-5);
+    ck_assert_double_le(fits_apart(&qd, &qf, FE_FIT_ELLIPSOID), 1e-5);
+    ck_assert_double_le(fits_apart(&qd, &qf, FE_FIT_AXIAL), 1e-5);
+    ck_assert_double_le(fits_apart(&qd, &qf, FE_FIT_SPHERE), 1e-5);
+}
+END_TEST
+
+/* The binomial shift in float is exact where float arithmetic is: small
+   integer samples, whose moments about integer points are integers below
+   2^24, moved to another integer point equal the moments summed about it
+   from the start (in double, exactly).  Then on real-sized data the step's
+   moments, moved to an arbitrary point, equal the double moments summed
+   about that point to float rounding. */
+START_TEST(f32_recentre_is_exact)
+{
+    enum { N = 40 };
+    const double from[3] = {3, -2, 5}, to[3] = {-4, 6, 1};
+    const float tof[3] = {-4, 6, 1};
+    fe_quadric a, b;
+    fe_quadric_f32 f = FE_QUADRIC_F32_EMPTY;
+    fe_rng g = fe_rng_seed(22);
+    ck_assert_int_eq(fe_quadric_init(&a, from), FE_OK);
+    ck_assert_int_eq(fe_quadric_init(&b, to), FE_OK);
+    for (int i = 0; i < N; i++) {
+        double x[3];
+        for (int j = 0; j < 3; j++)
+            x[j] = (double)(int)(fe_rng_uniform(&g) * 17.0) - 8.0;
+        fe_quadric_add(&a, x);
+        fe_quadric_add(&b, x);
+    }
+    /* The float state holding a's moments about `from`, exactly. */
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++) {
+        f.m[k] = (float)a.m[k];
+        ck_assert_double_eq(f.m[k], a.m[k]);
+    }
+    for (int j = 0; j < 3; j++) {
+        f.ref[j] = (float)from[j];
+        f.lo[j] = (float)a.lo[j];
+        f.hi[j] = (float)a.hi[j];
+    }
+    f.n = N;
+    f.flags = FE_QUADRIC_HAS_REF;
+    ck_assert_int_eq(fe_quadric_f32_recentre(&f, tof), FE_OK);
+    for (int k = 0; k < FE_QUADRIC_MOMENTS; k++)
+        ck_assert_msg(f.m[k] == b.m[k], "moment %d: %.9g, want %.17g", k,
+                      (double)f.m[k], b.m[k]);
+    ck_assert_mem_eq(f.ref, tof, sizeof tof);
+    /* Real-sized data, with the step's own re-centres on the way. */
+    {
+        enum { M = 3000 };
+        static double x[3 * M];
+        const double there[3] = {90, -60, 40};
+        const float theref[3] = {90, -60, 40};
+        fe_quadric_f32 h = FE_QUADRIC_F32_EMPTY;
+        fe_quadric d, hq;
+        fe_test_ellipsoid_points(x, M, C0, R0, 2.0, 23);
+        round_to_float(x, 3 * M);
+        ck_assert_int_eq(fe_quadric_init(&d, there), FE_OK);
+        for (size_t i = 0; i < M; i++) {
+            float xf[3] = {(float)x[3 * i], (float)x[3 * i + 1], (float)x[3 * i + 2]};
+            ck_assert_int_eq(fe_quadric_f32_add(&h, xf), FE_OK);
+            fe_quadric_add(&d, x + 3 * i);
+        }
+        ck_assert_uint_gt(h.recentres, 0);
+        ck_assert_int_eq(fe_quadric_f32_recentre(&h, theref), FE_OK);
+        ck_assert_int_eq(fe_quadric_from_f32(&hq, &h), FE_OK);
+        ck_assert_mem_eq(hq.ref, there, sizeof there);
+        ck_assert_double_le(moment_diff(&hq, &d, 400.0), 1e-6);
+        ck_assert_double_gt(moment_diff(&hq, &d, 400.0), 0.0); /* float, not double */
+    }
+}
+END_TEST
+
+/* NaN, infinities, overflowing powers and a full count are refused and
+   leave the float accumulation as it was; NULL is FE_EINVAL. */
+START_TEST(f32_bad_samples_leave_it_unchanged)
+{
+    enum { N = 200 };
+    static double x[3 * N];
+    const float nonfinite[3] = {NAN, INFINITY, -INFINITY};
+    fe_quadric_f32 q = FE_QUADRIC_F32_EMPTY, before;
+    fe_quadric d;
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 24);
+    for (size_t i = 0; i < N; i++) {
+        float xf[3] = {(float)x[3 * i], (float)x[3 * i + 1], (float)x[3 * i + 2]};
+        ck_assert_int_eq(fe_quadric_f32_add(&q, xf), FE_OK);
+    }
+    for (int t = 0; t < 3; t++) {
+        float bad[3] = {1, 2, 3};
+        bad[t] = nonfinite[t];
+        before = q;
+        ck_assert_int_eq(fe_quadric_f32_add(&q, bad), FE_ENONFINITE);
+        ck_assert_mem_eq(&q, &before, sizeof q);
+        ck_assert_int_eq(fe_quadric_f32_recentre(&q, bad), FE_ENONFINITE);
+        ck_assert_mem_eq(&q, &before, sizeof q);
+        ck_assert_int_eq(fe_quadric_f32_init(&q, bad), FE_ENONFINITE);
+        ck_assert_mem_eq(&q, &before, sizeof q);
+    }
+    {
+        const float huge[3] = {1e12f, 0, 0};   /* (1e12)^4 overflows a float */
+        before = q;
+        ck_assert_int_eq(fe_quadric_f32_add(&q, huge), FE_ENONFINITE);
+        ck_assert_mem_eq(&q, &before, sizeof q);
+        ck_assert_int_eq(fe_quadric_f32_recentre(&q, huge), FE_ENONFINITE);
+        ck_assert_mem_eq(&q, &before, sizeof q);
+    }
+    {
+        const float one[3] = {1, 2, 3};
+        fe_quadric_f32 full = q;
+        full.n = UINT32_MAX;
+        before = full;
+        ck_assert_int_eq(fe_quadric_f32_add(&full, one), FE_ESIZE);
+        ck_assert_mem_eq(&full, &before, sizeof full);
+        ck_assert_int_eq(fe_quadric_f32_add(NULL, one), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_f32_add(&q, NULL), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_f32_recentre(NULL, one), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_f32_init(NULL, NULL), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_from_f32(NULL, &q), FE_EINVAL);
+        ck_assert_int_eq(fe_quadric_from_f32(&d, NULL), FE_EINVAL);
+    }
+    /* Empty, and a supplied first reference. */
+    {
+        const float centre[3] = {100, -50, 30};
+        fe_quadric_f32 e;
+        ck_assert_int_eq(fe_quadric_f32_init(&e, NULL), FE_OK);
+        ck_assert_int_eq(fe_quadric_from_f32(&d, &e), FE_OK);
+        ck_assert_uint_eq(fe_quadric_count(&d), 0);
+        ck_assert_int_eq(fe_quadric_f32_init(&e, centre), FE_OK);
+        ck_assert_mem_eq(e.ref, centre, sizeof centre);
+        ck_assert_uint_eq(e.flags, FE_QUADRIC_HAS_REF);
+        ck_assert_int_eq(fe_quadric_f32_add(&e, centre), FE_OK);
+        ck_assert_uint_eq(e.n, 1);
+        ck_assert_double_eq(e.m[0], 1.0);
+        for (int k = 1; k < FE_QUADRIC_MOMENTS; k++)
+            ck_assert_double_eq(e.m[k], 0.0);
+    }
+}
+END_TEST
+
 START_TEST(state_size)
 {
     /* The figure the prose promises and make size prints for the M4. */
     ck_assert_uint_eq(sizeof(fe_quadric), 760);
+    /* The float state make size measures on the M4F (limit 300). */
+    ck_assert_uint_eq(sizeof(fe_quadric_f32), 188);
+}
+END_TEST
+
+
+/* Blocks in time: `all` is the plain fold, the blocks partition the stream
+   in order (every block block_len long but the last, 8 to 16 of them),
+   two halves split at a multiple of the block length merge into exactly
+   the fold of the whole, and a refused sample changes nothing. */
+START_TEST(blocks_partition_the_stream_and_merge_in_time)
+{
+    enum { N = 4096 + 77 };
+    static double x[3 * N];
+    static fe_quadric_blocks whole, a, b, before;
+    const double c[3] = {10, -20, 5}, r[3] = {30, 45, 60};
+    fe_quadric plain = FE_QUADRIC_EMPTY, sum = FE_QUADRIC_EMPTY;
+    double apart, total = 0.0;
+    fe_test_ellipsoid_points(x, N, c, r, 0.5, 4);
+    ck_assert_int_eq(fe_quadric_blocks_init(&whole), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        ck_assert_int_eq(fe_quadric_blocks_add(&whole, x + 3 * i), FE_OK);
+        ck_assert_int_eq(fe_quadric_add(&plain, x + 3 * i), FE_OK);
+        if (i + 1 >= FE_QUADRIC_BLOCKS) {
+            ck_assert_uint_ge(whole.nblocks, FE_QUADRIC_BLOCKS / 2);
+            ck_assert_uint_le(whole.nblocks, FE_QUADRIC_BLOCKS);
+        }
+    }
+    ck_assert_mem_eq(&whole.all, &plain, sizeof plain);
+    /* 4173 samples in blocks of 512: 8 full and one of 77. */
+    ck_assert_uint_eq(whole.block_len, 512);
+    ck_assert_uint_eq(whole.nblocks, 9);
+    for (uint32_t k = 0; k < whole.nblocks; k++) {
+        double want = k + 1 < whole.nblocks ? 512.0 : 77.0;
+        ck_assert_double_eq(whole.block[k].m[0], want);
+        /* Block k holds samples 512 k ..: its extremes are theirs. */
+        for (int j = 0; j < 3; j++) {
+            double lo = INFINITY;
+            for (size_t i = 512 * k; i < 512 * k + (size_t)want; i++)
+                lo = fmin(lo, x[3 * i + j]);
+            ck_assert_double_eq(whole.block[k].lo[j], lo);
+        }
+        ck_assert_int_eq(fe_quadric_merge(&sum, &whole.block[k]), FE_OK);
+        total += whole.block[k].m[0];
+    }
+    ck_assert_double_eq(total, N);
+    ck_assert_int_eq(fe_quadric_recentre(&sum, plain.ref), FE_OK);
+    ck_assert_int_eq(fe_quadric_compare(&sum, &plain, &apart), FE_OK);
+    ck_assert_double_le(apart, 1e-12);
+    /* Halves at 2048: blocks of 128 each, merged into blocks of 512. */
+    fe_quadric_blocks_init(&a);
+    fe_quadric_blocks_init(&b);
+    for (size_t i = 0; i < N; i++)
+        ck_assert_int_eq(fe_quadric_blocks_add(i < 2048 ? &a : &b, x + 3 * i), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_merge(&a, &b), FE_OK);
+    ck_assert_uint_eq(a.nblocks, whole.nblocks);
+    ck_assert_uint_eq(a.block_len, whole.block_len);
+    for (uint32_t k = 0; k < a.nblocks; k++) {
+        fe_quadric moved = a.block[k];
+        ck_assert_double_eq(moved.m[0], whole.block[k].m[0]);
+        ck_assert_int_eq(fe_quadric_recentre(&moved, whole.block[k].ref), FE_OK);
+        ck_assert_int_eq(fe_quadric_compare(&moved, &whole.block[k], &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+    }
+    /* Refused samples: nothing changes. */
+    before = whole;
+    {
+        const double bad[3] = {NAN, 1, 2}, huge[3] = {1e300, 0, 0};
+        ck_assert_int_eq(fe_quadric_blocks_add(&whole, bad), FE_ENONFINITE);
+        ck_assert_int_ne(fe_quadric_blocks_add(&whole, huge), FE_OK);
+    }
+    ck_assert_mem_eq(&before, &whole, sizeof whole);
+    ck_assert_int_eq(fe_quadric_blocks_add(NULL, x), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_merge(&whole, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_init(NULL), FE_EINVAL);
 }
 END_TEST
 
@@ -514,6 +789,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, empty_and_one_sample);
     tcase_add_test(t, step_equals_block);
     tcase_add_test(t, two_shards_equal_one);
+    tcase_add_test(t, blocks_partition_the_stream_and_merge_in_time);
     tcase_add_test(t, merge_every_split_and_associativity);
     tcase_add_test(t, merged_hemispheres_cover_the_sphere);
     tcase_add_test(t, recentre_equals_accumulating_there);
@@ -525,6 +801,9 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, compare_a_box_of_one_point_absolutely);
     tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);
+    tcase_add_test(t, f32_step_agrees_with_the_double_step);
+    tcase_add_test(t, f32_recentre_is_exact);
+    tcase_add_test(t, f32_bad_samples_leave_it_unchanged);
     suite_add_tcase(s, t);
     return s;
 }

@@ -17,15 +17,18 @@ _foldest()
     fi
     case "$cmd" in
         stats) opts="--columns --skip --json" ;;
-        calibrate) opts="--model --columns --apply --skip --json --trace" ;;
+        calibrate) opts="--model --columns --apply --skip --json --trace --field --export
+                         --mgauss --static --window --still-sd --gyro --max-rate --robust
+                         --robust-k --report" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
                         --alpha --order --report --json --sphere --columns --term --terms
                         --only --exclude" ;;
-        synth) opts="--effect --real --sim --seed --rows --order" ;;
+        synth) opts="--effect --real --sim --seed --rows --order --rho" ;;
         *) return 0 ;;
     esac
     case "$prev" in
         --model) COMPREPLY=($(compgen -W "sphere axial ellipsoid" -- "$cur")); return 0 ;;
+        --export) COMPREPLY=($(compgen -W "ardupilot c json" -- "$cur")); return 0 ;;
         --noise) COMPREPLY=($(compgen -W "ar batch" -- "$cur")); return 0 ;;
         --order) COMPREPLY=($(compgen -W "0 1 2" -- "$cur")); return 0 ;;
         --effect) COMPREPLY=($(compgen -W "bias drift gain delay viscous_friction quadratic_drag

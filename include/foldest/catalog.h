@@ -50,6 +50,11 @@ typedef struct fe_term {
     void *user;
     unsigned needs;             /* fe_role bits it needs */
     const fe_expr *expr;        /* an expression term, or NULL */
+    int probe;                  /* 1: a probe of the state, not physics
+                                   (fe_catalog_add_probes): 1 where row
+                                   variable `var` lies in [lo, hi), else 0 */
+    int var;                    /* a probe's fe_catalog_var */
+    double lo, hi;              /* a probe's bin */
 } fe_term;
 
 /* The variables of a row, in this order: what an expression term reads,
@@ -99,6 +104,22 @@ const char *const *fe_catalog_var_names(size_t *count);
    fe_catalog_explain, would then be wrong). */
 int fe_catalog_add_expr(fe_catalog *c, const char *name, const char *description,
                         const fe_expr *e);
+
+/* The most bins fe_catalog_add_probes cuts a variable's range into. */
+enum { FE_CATALOG_MAX_BINS = 16 };
+
+/* fe_catalog_add_probes: bins - 1 probes of the row variable `var` (a
+   fe_catalog_var from FE_CATALOG_VAR_POSITION on), appended: probe k is 1
+   on rows whose variable lies in the k-th of `bins` equal bins of
+   [lo, hi], else 0; the first bin is open below, and the last, open
+   above, is left out (the probes and a constant would be collinear).
+   Probes are not physics: discovery tests them against its final model
+   and never selects them (fe_discover_options.nprobes), so that the
+   verdict can ask whether some function of the state that no term
+   describes is left.  fe_catalog_find does not see them.  All or none:
+   FE_ESIZE when they do not fit; FE_EINVAL for NULL, a variable out of
+   range, bins < 2 or > FE_CATALOG_MAX_BINS, lo >= hi or not finite. */
+int fe_catalog_add_probes(fe_catalog *c, int var, double lo, double hi, size_t bins);
 
 /* fe_catalog_remove: drop the term called `name`, the others keeping
    their order.  FE_EINVAL when there is none. */

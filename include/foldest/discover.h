@@ -19,6 +19,8 @@ enum {
     FE_DISCOVER_MAX_GROUP_SIZE = 3, /* columns in one term (three-axis terms) */
     FE_DISCOVER_MAX_BLOCKS = 64,    /* time blocks K */
     FE_DISCOVER_MAX_STEPS = 12,     /* forward-selection steps */
+    FE_DISCOVER_MAX_ASIDE = 4,      /* terms set aside, and selections
+                                       run again without them */
     FE_DISCOVER_LAGS = 16,          /* lagged products Z_1 .. Z_P a full
                                        accumulation can keep */
     FE_DISCOVER_DEFAULT_LAGS = 8,   /* ... and keeps unless told otherwise */
@@ -256,10 +258,13 @@ typedef struct fe_discover_options {
     int noise;                  /* FE_DISCOVER_NOISE_AR (default) or _BATCH */
     size_t max_order;           /* highest AR order tried: 4, at most
                                    FE_DISCOVER_EDGE (and lags - 1) */
+    size_t nprobes;             /* the last nprobes groups are probes
+                                   (fe_catalog_add_probes): tested against
+                                   the final model, never added: 0 */
 } fe_discover_options;
 
 /* fe_discover_default_options: alpha 0.05, 8 steps, no base terms, the AR
-   noise model up to order 4. */
+   noise model up to order 4, no probes. */
 fe_discover_options fe_discover_default_options(void);
 
 /* The noise model of a fitted model's residual e_t. */
@@ -380,6 +385,20 @@ typedef struct fe_discover_result {
     fe_discover_fit baseline, final;
     fe_discover_noise noise;                    /* of the final model */
     fe_discover_step path[FE_DISCOVER_MAX_STEPS + 1];  /* steps + 1 */
+    /* The probes (options.nprobes), each scored against the final model
+       as a candidate would be: how many were tested (not redundant), the
+       one with the smallest p-value, and that p-value times the number
+       tested (Bonferroni, at most 1; NaN when none was tested). */
+    size_t probes_tested;
+    fe_discover_rank probe;
+    double probe_p;
+    /* Terms set aside: forward selection added each, and once the terms
+       added after it were in, it no longer passed the test a candidate must
+       pass (aside_rank: its test against the model without it); selection
+       then ran again without it.  In the order they were set aside. */
+    size_t naside;
+    size_t aside[FE_DISCOVER_MAX_ASIDE];
+    fe_discover_rank aside_rank[FE_DISCOVER_MAX_ASIDE];
 } fe_discover_result;
 
 /* fe_discover_workspace_doubles: scratch needed by fe_discover_select. */

@@ -218,9 +218,12 @@ typedef enum fe_verdict {
                                        is not white */
     FE_VERDICT_OUT_OF_LINE,         /* named, but a window or region stays
                                        out of line after the terms */
-    FE_VERDICT_DIVERGES             /* the residual left stays correlated far
+    FE_VERDICT_DIVERGES,            /* the residual left stays correlated far
                                        above its high-frequency floor: the
                                        trajectories part (output error) */
+    FE_VERDICT_STATE_LEFT           /* named, but a probe of the state still
+                                       explains part of the residual
+                                       (fe_discover_result.probe_p) */
 } fe_verdict;
 
 /* fe_discover_verdict: the verdict of the result r, whose map is m and

@@ -103,6 +103,78 @@ void fe_quadric_exponents(int k, int e[3]);
    to fe_quadric_init by fe_init. */
 fe_accumulator fe_quadric_accumulator(const double *centre);
 
+/* Consecutive blocks in time, for standard errors that survive correlated
+   samples (sphere.org, "Honest standard errors").  `all` is the ordinary
+   accumulation of every sample; block[0..nblocks-1] hold consecutive runs
+   of block_len samples (the last may be shorter).  When the slots are full
+   neighbours merge pairwise and block_len doubles, so memory is constant
+   (about 13 KB) and there are between 8 and 16 blocks once N >= 16. */
+enum { FE_QUADRIC_BLOCKS = 16 };
+typedef struct fe_quadric_blocks {
+    fe_quadric all;
+    fe_quadric block[FE_QUADRIC_BLOCKS];
+    uint64_t block_len;         /* 1, 2, 4, ... (0 in an all-zero struct: 1) */
+    uint32_t nblocks;           /* blocks begun */
+    uint32_t reserved;          /* zero */
+} fe_quadric_blocks;
+
+/* fe_quadric_blocks_init: the empty blocked accumulation (references are
+   first samples).  FE_EINVAL for NULL. */
+int fe_quadric_blocks_init(fe_quadric_blocks *qb);
+
+/* fe_quadric_blocks_add: fold x[0..2] into `all` and the current block.
+   FE_ENONFINITE as fe_quadric_add; then qb is unchanged.  No allocation;
+   cost: two steps and a copy of one block, and every block_len samples
+   at most 16 merges. */
+int fe_quadric_blocks_add(fe_quadric_blocks *qb, const double x[3]);
+
+/* fe_quadric_blocks_merge: a <- a followed in time by b: the blocks of the
+   one with shorter blocks merge pairwise until both have the same length,
+   then b's are appended (merging pairwise again while there are more than
+   FE_QUADRIC_BLOCKS).  FE_EINVAL for NULL, FE_ENONFINITE on overflow (a
+   unchanged).  Uses about 26 KB of stack. */
+int fe_quadric_blocks_merge(fe_quadric_blocks *a, const fe_quadric_blocks *b);
+
+/* Single precision, for a microcontroller with a float FPU (Cortex-M4F):
+   the same moments in float, of d = x - ref, with the reference moved to
+   the running mean whenever the mean has drifted from it by more than a
+   tenth of the box's largest half-width (an exact binomial shift).  No
+   coverage (it would take 400 bytes).  188 bytes; all zero bytes is the
+   empty accumulation whose reference is its first sample. */
+typedef struct fe_quadric_f32 {
+    float m[FE_QUADRIC_MOMENTS];   /* m[0] = N (rounded past 2^24); m[k] =
+                                      sum of d^alpha_k, as in fe_quadric */
+    float ref[3];                  /* the reference point c */
+    float lo[3], hi[3];            /* per-axis min and max of x (N > 0) */
+    uint32_t n;                    /* N, exact */
+    uint32_t recentres;            /* times the step moved the reference */
+    uint32_t flags;                /* FE_QUADRIC_HAS_REF */
+} fe_quadric_f32;
+
+#define FE_QUADRIC_F32_EMPTY {{0}, {0}, {0}, {0}, 0, 0, 0}
+
+/* fe_quadric_f32_init: the empty accumulation; `centre` NULL: the first
+   sample is the first reference, else centre[0..2] (copied).  FE_EINVAL
+   for NULL q, FE_ENONFINITE for a non-finite centre (q unchanged). */
+int fe_quadric_f32_init(fe_quadric_f32 *q, const float *centre);
+
+/* fe_quadric_f32_add (step): fold one sample x[0..2], in float
+   arithmetic only (no double, no libc: freestanding).  FE_EINVAL for
+   NULL, FE_ENONFINITE when x is not finite or a sum would overflow,
+   FE_ESIZE past 2^32 - 1 samples; then q is unchanged.  Cost: 34
+   multiply-adds, and now and then (logarithmically often) a re-centre. */
+int fe_quadric_f32_add(fe_quadric_f32 *q, const float x[3]);
+
+/* fe_quadric_f32_recentre: move q's moments to the reference `ref` (the
+   binomial shift, in float).  FE_EINVAL for NULL, FE_ENONFINITE for a
+   non-finite ref or on overflow (q unchanged). */
+int fe_quadric_f32_recentre(fe_quadric_f32 *q, const float ref[3]);
+
+/* fe_quadric_from_f32 (read-out): the double accumulation holding f's
+   moments, count, reference and box, for fe_sphere_fit_moments on the
+   host; its coverage is empty (not measured).  FE_EINVAL for NULL. */
+int fe_quadric_from_f32(fe_quadric *q, const fe_quadric_f32 *f);
+
 #ifdef __cplusplus
 }
 #endif

@@ -91,6 +91,11 @@ typedef struct fe_sphere_fit {
                                    is the algebraic least-squares sphere */
     double frame_centre[3];     /* c and sigma of the solve's frame */
     double frame_scale;
+    double matrix_se[9];        /* standard errors of matrix's entries */
+    double se_iid[FE_SPHERE_MAX_PARAMS]; /* the errors independent samples
+                                   would have (se when se_blocks is 0) */
+    int se_blocks;              /* 0: se assumes independent samples; B:
+                                   batch means over B blocks in time */
 } fe_sphere_fit;
 
 /* fe_sphere_fit_moments: (iii), the fit users call.  Fits `model` to the
@@ -102,6 +107,16 @@ typedef struct fe_sphere_fit {
    a few dozen 10x10 products per iteration, independent of N. */
 int fe_sphere_fit_moments(const fe_quadric *q, fe_sphere_model model,
                           const fe_sphere_options *opt, fe_sphere_fit *fit);
+
+/* fe_sphere_fit_blocks: fe_sphere_fit_moments on qb->all, with standard
+   errors (se, cov, matrix_se) from the spread of the estimating equations
+   over qb's blocks in time (batch means), which holds for correlated
+   samples; se_iid keeps the independent-sample errors.  With fewer than 8
+   blocks, or for the algebraic sphere, the errors are the independent
+   ones and se_blocks is 0.  Errors as fe_sphere_fit_moments.  No
+   allocation; cost: one 10 x 10 moment matrix per block. */
+int fe_sphere_fit_blocks(const fe_quadric_blocks *qb, fe_sphere_model model,
+                         const fe_sphere_options *opt, fe_sphere_fit *fit);
 
 /* fe_sphere_fit_algebraic: the algebraic least-squares sphere, fitted
    linearly from the moments (what fe_sphere_fit_moments falls back to when
@@ -138,6 +153,119 @@ int fe_sphere_cost(const fe_quadric *q, const fe_sphere_fit *fit,
    sphere.  x and y may be the same array. */
 void fe_sphere_apply(const fe_sphere_fit *fit, const double x[3],
                      double y[3]);
+
+/* A calibration scaled to a known field F: y = matrix (x - offset) has
+   magnitude F (9.80665 for an accelerometer in m/s^2, the local Earth
+   field for a magnetometer), and how the fit's field compares with F. */
+typedef struct fe_sphere_scaled {
+    double field;               /* F, in the units the user chose */
+    double offset[3];           /* b, the sensor's units */
+    double matrix[9];           /* F M, row-major */
+    double gain;                /* fitted radius / F: sensor units per unit of F */
+} fe_sphere_scaled;
+
+/* fe_sphere_scale: the calibration `fit` scaled so that calibrated
+   samples have magnitude `field`; field 0 takes the fitted radius (the
+   calibrated samples stay in the sensor's units, gain 1).  FE_EINVAL for
+   NULL, or a field that is negative or not finite, or a fit without a
+   radius; then *out is unchanged.  No allocation. */
+int fe_sphere_scale(const fe_sphere_fit *fit, double field,
+                    fe_sphere_scaled *out);
+
+/* fe_sphere_scaled_apply: y = matrix (x - offset), magnitude about F.
+   x and y may be the same array. */
+void fe_sphere_scaled_apply(const fe_sphere_scaled *s, const double x[3],
+                            double y[3]);
+
+/* ArduPilot's compass parameters: its driver corrects a reading h in
+   milligauss as mat (h + ofs), mat symmetric with diagonal dia and
+   off-diagonal odi = (m12, m13, m23). */
+typedef struct fe_sphere_ardupilot {
+    double ofs[3];              /* COMPASS_OFS_X/Y/Z, milligauss */
+    double dia[3];              /* COMPASS_DIA_X/Y/Z */
+    double odi[3];              /* COMPASS_ODI_X/Y/Z */
+} fe_sphere_ardupilot;
+
+/* fe_sphere_to_ardupilot: ArduPilot's parameters for `fit`, whose samples
+   are in units of mgauss_per_unit milligauss (K: 1 in milligauss, 1000 in
+   gauss): ofs = -K b and mat = F M / K, so that ArduPilot's corrected
+   field has magnitude field_mgauss (F; 0: the fitted field K R, and mat
+   is then R M, near the identity).  FE_EINVAL for NULL, a fit without a
+   radius, K not finite and positive, or F negative or not finite (*out
+   unchanged).  No allocation. */
+int fe_sphere_to_ardupilot(const fe_sphere_fit *fit, double field_mgauss,
+                           double mgauss_per_unit, fe_sphere_ardupilot *out);
+
+/* Still segments: a streaming gate that passes the samples taken at rest
+   (an accelerometer reads gravity only then).  A window of `window`
+   consecutive samples is still when the standard deviation of |x| over it
+   is at most max_rel_sd times its mean, and, when rates are given (a
+   gyroscope), no rate's norm in it exceeds max_rate; every sample of a
+   still window is still.  Decisions are final `window` samples later, so
+   the gate hands samples back in order with that delay. */
+typedef struct fe_still_options {
+    size_t window;              /* default 50 */
+    double max_rel_sd;          /* default 0.002 */
+    double max_rate;            /* default 0: rates not tested */
+} fe_still_options;
+
+typedef struct fe_still {
+    fe_still_options opt;
+    double *ring;               /* the caller's: fe_still_workspace doubles */
+    size_t head, count;         /* oldest sample, samples held */
+    uint64_t still, moving;     /* samples handed back, by verdict */
+} fe_still;
+
+/* fe_still_default_options: the defaults above, by value. */
+fe_still_options fe_still_default_options(void);
+
+/* fe_still_workspace: doubles of ring fe_still_init needs: 7 window. */
+size_t fe_still_workspace(size_t window);
+
+/* fe_still_init: an empty gate over the caller's `work` (work_len
+   doubles; FE_ESIZE if too small).  FE_EINVAL for NULL, a window below 2,
+   or thresholds that are negative or not finite. */
+int fe_still_init(fe_still *s, const fe_still_options *opt, double *work,
+                  size_t work_len);
+
+/* fe_still_push: take x (and rate, 3 doubles, or NULL); when the ring is
+   full the oldest sample is handed back first: *ready = 1, out its x,
+   *still its verdict; otherwise *ready = 0.  FE_ENONFINITE for a
+   non-finite x or rate, FE_EINVAL for NULL; then s is unchanged.  No
+   allocation; cost O(window). */
+int fe_still_push(fe_still *s, const double x[3], const double *rate,
+                  double out[3], int *still, int *ready);
+
+/* fe_still_flush: at the end of the stream, hand back the oldest sample
+   held (out, *still): FE_OK, or FE_END when none is left. */
+int fe_still_flush(fe_still *s, double out[3], int *still);
+
+/* Radial residuals and a robust scale for them, to reject outliers
+   (samples far outside the bulk: a magnet passing by, a knock on an
+   accelerometer).  fe_sphere_radial: e = |M (x - b)| - 1, the sample's
+   radial error as a fraction of the field. */
+double fe_sphere_radial(const fe_sphere_fit *fit, const double x[3]);
+
+/* A histogram of |e| in constant memory: 25 bins a decade from 1e-7 to
+   10 (below and above go to the end bins); the median of |e| is read to
+   within 5 %.  All zero bytes is the empty histogram. */
+enum { FE_RADIAL_BINS = 200 };
+typedef struct fe_radial_hist {
+    double count[FE_RADIAL_BINS];
+    double n;
+} fe_radial_hist;
+
+/* fe_radial_hist_add: count |e|.  FE_ENONFINITE for a non-finite e (h
+   unchanged), FE_EINVAL for NULL. */
+int fe_radial_hist_add(fe_radial_hist *h, double e);
+
+/* fe_radial_hist_merge: a <- a + b.  FE_EINVAL for NULL. */
+int fe_radial_hist_merge(fe_radial_hist *a, const fe_radial_hist *b);
+
+/* fe_radial_hist_scale: the robust scale of e, 1.4826 times the median
+   of |e| (the standard deviation for normal errors centred on zero, as a
+   fit's are); 0 for an empty histogram. */
+double fe_radial_hist_scale(const fe_radial_hist *h);
 
 /* fe_sphere_model_name: "sphere", "axial", "ellipsoid" (NULL if unknown);
    fe_sphere_model_parse: the inverse, FE_EINVAL if unknown. */

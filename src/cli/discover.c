@@ -309,6 +309,16 @@ static int fe__flush_panel(const fe_catalog *c, fe_discover_acc *acc, fe__panel 
     return rc;
 }
 /* A panel of rows ends here */
+/* [[file:../../literate/cli_discover.org::Name a probe's bin][Name a probe's bin]] */
+static void fe__probe_bin(const fe_term *t, char *buf, size_t len)
+{
+    const char *v = fe_catalog_var_names(NULL)[t->var];
+    if (isinf(t->lo))
+        snprintf(buf, len, "%s < %.4g", v, t->hi);
+    else
+        snprintf(buf, len, "%.4g <= %s < %.4g", t->lo, v, t->hi);
+}
+/* Name a probe's bin ends here */
 /* [[file:../../literate/cli_discover.org::Discover Options][Discover Options]] */
 static const char fe__discover_help[] =
     "usage: foldest discover --real REAL.csv --sim SIM.csv --channel NAME [options]\n"
@@ -1171,7 +1181,26 @@ static void fe__json_path(FILE *f, const fe__outcome *o)
 static void fe__print_json(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
-    fprintf(f, "{\"verdict\": \"%s\", ", o->verdict);
+    fprintf(f, "{\"verdict\": \"%s\", \"set_aside\": [", o->verdict);
+    for (size_t k = 0; k < r->naside; k++) {
+        fprintf(f, "%s{\"name\": \"%s\", \"statistic\": ", k ? ", " : "",
+                o->c->terms[r->aside[k]].name);
+        fe__json_number(f, r->aside_rank[k].statistic);
+        fe__json_pair(f, "p_value", r->aside_rank[k].p_value);
+        fprintf(f, "}");
+    }
+    fprintf(f, "], ");
+    if (r->probes_tested > 0) {
+        const fe_term *t = &o->c->terms[r->probe.group];
+        fprintf(f, "\"probes\": {\"tested\": %zu, \"variable\": \"%s\", \"bin\": [",
+                r->probes_tested, fe_catalog_var_names(NULL)[t->var]);
+        fe__json_number(f, t->lo);
+        fprintf(f, ", ");
+        fe__json_number(f, t->hi);
+        fprintf(f, "]");
+        fe__json_pair(f, "p", r->probe_p);
+        fprintf(f, "}, ");
+    }
     fprintf(f, "\"rows\": {\"compared\": %zu, \"outside_simulation\": %zu, \"fit\": %zu, "
                "\"heldout\": %zu, \"outside_by_reason\": {\"before_start\": %zu, "
                "\"after_end\": %zu, \"in_gap\": %zu}}, \"bad_rows\": ", o->rows, o->skipped,
@@ -1347,6 +1376,21 @@ static void fe__story_regions(FILE *f, const fe_residual_map *m)
     }
 }
 
+/* The probes' line: how many, and the one that stands out most. */
+static void fe__story_probe(FILE *f, const fe__outcome *o)
+{
+    const fe_discover_result *r = o->r;
+    const fe_term *t;
+    char bin[160];
+    if (r->probes_tested == 0)
+        return;
+    t = &o->c->terms[r->probe.group];
+    fe__probe_bin(t, bin, sizeof bin);
+    fprintf(f, "  probes of the state: %zu bins tested against the final model; the strongest, "
+               "%s, p = %.2g after Bonferroni%s\n", r->probes_tested, bin, r->probe_p,
+            r->steps > 0 && r->probe_p < o->alpha ? ": a function of the state is left" : "");
+}
+
 static void fe__print_story(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
@@ -1423,6 +1467,11 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             fprintf(f, "\n");
         }
     }
+    for (size_t k = 0; k < r->naside; k++)
+        fprintf(f, "  set aside: %s, added first as a stand-in; with the terms above in, its "
+                   "statistic is %.2f, p = %.2g, and selection ran again without it\n",
+                o->c->terms[r->aside[k]].name, r->aside_rank[k].statistic,
+                r->aside_rank[k].p_value);
     if (r->steps > 0)
         fe__story_path(f, o);
     if (r->steps > 0 && o->npairs > 1 && o->per_coef != NULL) {
@@ -1455,6 +1504,7 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     fprintf(f, "\nverdict: %s\n", o->verdict);
     if (o->why != NULL)
         fprintf(f, "  (%s)\n", o->why);
+    fe__story_probe(f, o);
 }
 /* Print the story ends here */
 /* [[file:../../literate/cli_discover.org::The unit in a column name, and a mean's standard error][The unit in a column name, and a mean's standard error]] */
@@ -1801,6 +1851,8 @@ typedef struct fe__run {
     unsigned roles;
     int kelvin[FE__ROLES];
     double lo[3], hi[3];                /* position, velocity, temperature */
+    double vlo[FE_CATALOG_VARS], vhi[FE_CATALOG_VARS];  /* every row variable */
+    size_t nprobes;                     /* the catalog's last terms */
     size_t base[FE_DISCOVER_MAX_GROUPS], nbase;
     fe_discover_acc acc;
     double *storage, *work;
@@ -1862,6 +1914,25 @@ static void fe__run_free(fe__run *u)
 #define FE__OOM(u) (snprintf((u)->err, sizeof (u)->err, "out of memory or internal error"), \
                     FE_CLI_IO)
 
+
+enum { FE__PROBE_BINS = 8 };
+
+/* Probes of every state variable the roles give, after the catalog's own
+   and the user's terms (u->nprobes: how many). */
+static void fe__run_probes(fe__run *u)
+{
+    static const struct { unsigned role; int var; } vars[] = {
+        {FE_ROLE_POSITION, FE_CATALOG_VAR_POSITION}, {FE_ROLE_VELOCITY, FE_CATALOG_VAR_VELOCITY},
+        {FE_ROLE_TEMPERATURE, FE_CATALOG_VAR_TEMPERATURE},
+        {FE_ROLE_AMBIENT, FE_CATALOG_VAR_AMBIENT}, {FE_ROLE_INPUT, FE_CATALOG_VAR_INPUT}};
+    size_t before = u->cat.count;
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; i++)
+        if (u->roles & vars[i].role)
+            (void)fe_catalog_add_probes(&u->cat, vars[i].var, u->vlo[vars[i].var],
+                                        u->vhi[vars[i].var], FE__PROBE_BINS);
+    u->nprobes = u->cat.count - before;
+}
+
 /* Pass 1: the catalog's scale, the state's ranges, the rows compared. */
 static int fe__run_scan(fe__run *u)
 {
@@ -1871,7 +1942,17 @@ static int fe__run_scan(fe__run *u)
         u->lo[v] = INFINITY;
         u->hi[v] = -INFINITY;
     }
+    for (int v = 0; v < FE_CATALOG_VARS; v++) {
+        u->vlo[v] = INFINITY;
+        u->vhi[v] = -INFINITY;
+    }
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+        double row[FE_CATALOG_VARS];
+        fe_catalog_row(&s, row);
+        for (int v = 0; v < FE_CATALOG_VARS; v++) {
+            u->vlo[v] = row[v] < u->vlo[v] ? row[v] : u->vlo[v];
+            u->vhi[v] = row[v] > u->vhi[v] ? row[v] : u->vhi[v];
+        }
         fe_catalog_scale_add(&u->scale, &s);
         if (u->a.order > 0 && fe_dynamics_span_add(&u->span, &s) != FE_OK) {
             snprintf(u->err, sizeof u->err, "%.1000s:%zu: a state value is not finite at t = %g",
@@ -1907,6 +1988,7 @@ static int fe__run_scan(fe__run *u)
         return FE__OOM(u);
     if ((rc = fe__terms_catalog(&u->terms, &u->a, &u->cat, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    fe__run_probes(u);
     u->out.heldout = (size_t)floor(u->a.holdout * (double)u->out.rows);
     u->out.fit = u->out.rows - u->out.heldout;
     if (u->out.fit < 2 * (size_t)u->a.blocks + 10) {
@@ -2189,6 +2271,7 @@ static int fe__run_select(fe__run *u)
     opt.base = u->base;
     opt.nbase = u->nbase;
     opt.noise = u->a.noise;
+    opt.nprobes = u->nprobes;
     rc = fe_discover_select(&u->acc, groups, u->cat.count, &opt, u->res, u->work, u->nwork);
     if (rc != FE_OK) {
         snprintf(u->err, sizeof u->err, "%s%s", fe_strerror(rc),

@@ -8,8 +8,8 @@
 #include <unistd.h>
 
 static const char fe__synth_help[] =
-    "usage: foldest synth --effect NAME [--seed S] [--rows N] [--order K] --real REAL.csv\n"
-    "                     --sim SIM.csv\n"
+    "usage: foldest synth --effect NAME [--seed S] [--rows N] [--order K] [--rho R]\n"
+    "                     --real REAL.csv --sim SIM.csv\n"
     "\n"
     "Write a recording/simulation pair of a synthetic experiment in which the\n"
     "recording has one effect the simulation lacks, concealed (at most 0.3 noise\n"
@@ -21,7 +21,10 @@ static const char fe__synth_help[] =
     "              the cart's acceleration and the channel is its position; 1: it\n"
     "              acts on the heated stand's dT/dt and the channel is its\n"
     "              temperature.  The trajectories part (by about 3 noise sds of\n"
-    "              static response); analyse with discover --order K.\n";
+    "              static response); analyse with discover --order K.\n"
+    "  --rho R     the noise's lag-one correlation, an AR(1) with 0 <= R < 1\n"
+    "              (default 0.5; 0: white noise).  Its standard deviation and the\n"
+    "              effect's coefficient do not depend on R.\n";
 
 /* `s` as one word of a POSIX shell (see above). */
 static void fe__shell_word(FILE *f, const char *s)
@@ -45,6 +48,7 @@ int fe_cli_synth(int argc, char **argv)
 {
     const char *effect = NULL, *real = NULL, *sim = NULL;
     long seed = 1, rows = 0, order = 0;
+    double rho = -1.0;                  /* not given: the generator's default */
     char err[1024];
     fe_synth g;
     fe_synth_spec spec;
@@ -54,7 +58,7 @@ int fe_cli_synth(int argc, char **argv)
     int rc;
     static const fe_cli_option options[] = {
         {"--effect", 1}, {"--real", 1}, {"--sim", 1}, {"--seed", 1}, {"--rows", 1},
-        {"--order", 1}, {NULL, 0}};
+        {"--order", 1}, {"--rho", 1}, {NULL, 0}};
     rc = fe_cli_options("synth", options, &argc, &argv);
     if (rc != FE_CLI_OK)
         return rc < 0 ? FE_CLI_OK : rc;
@@ -92,6 +96,12 @@ int fe_cli_synth(int argc, char **argv)
                 snprintf(err, sizeof err, "--order: %s is not 0, 1 or 2", v);
                 rc = FE_CLI_USAGE;
             }
+        } else if (strcmp(o, "--rho") == 0) {
+            rc = fe_cli_parse_double(o, v, &rho, err, sizeof err);
+            if (rc == FE_CLI_OK && !(rho >= 0.0 && rho < 1.0)) {
+                snprintf(err, sizeof err, "--rho: %s is not in [0, 1)", v);
+                rc = FE_CLI_USAGE;
+            }
         } else {
             snprintf(err, sizeof err, "unknown option '%s'", o);
             rc = FE_CLI_USAGE;
@@ -109,6 +119,8 @@ int fe_cli_synth(int argc, char **argv)
     if (rows > 0)
         spec.rows = (size_t)rows;
     spec.order = (size_t)order;
+    if (rho >= 0.0)
+        spec.noise_rho = rho;
     rc = fe_synth_init(&g, &spec);
     if (rc != FE_OK) {
         fprintf(stderr, "foldest synth: --effect %s%s: %s\n", effect,

@@ -14,7 +14,9 @@ to the end instead of guessing a delay.  In the rendered document, outside
 text must hold no raw TeX: no \\begin, \\end, \\mathsf, \\frac, \\[, \\], \\(,
 \\) nor any other backslash command; and no MathJax error may be shown
 (merror, noError, "Math Processing Error", or an undefined macro, which
-MathJax typesets as its name in red).  The index of the public API
+MathJax typesets as its name in red).  Every image must have loaded (the
+figures make doc draws into figures/: a page that names one that is not
+there fails).  The index of the public API
 (api.html) must list every public name of the headers (no "api-missing").  One line per failing page,
 then "N passed, N failed".  Standard library only.
 """
@@ -106,6 +108,9 @@ function poll() {
     var d = null;
     try { d = f.contentDocument; } catch (e) {}
     if (d && d.documentElement && d.documentElement.getAttribute('data-mathjax') === 'done') {
+      Array.prototype.forEach.call(d.images, function (img) {
+        if (!img.complete || img.naturalWidth === 0) img.setAttribute('data-broken', 'yes');
+      });
       var t = document.createElement('textarea');
       t.id = 'page-' + i; t.textContent = d.documentElement.outerHTML;
       document.body.appendChild(t); f.remove(); frames[i] = null; left--;
@@ -155,6 +160,9 @@ def check(dom):
         problems.append("the API index misses names the headers declare (see the page)")
     if not r.done:
         problems.append("MathJax did not finish typesetting")
+    for m in re.finditer(r'<img\b[^>]*\bdata-broken="yes"[^>]*>', dom):
+        src = re.search(r'\bsrc="([^"]*)"', m.group(0))
+        problems.append("image did not load: " + (src.group(1) if src else m.group(0)[:80]))
     for e in r.errors:
         problems.append("MathJax error: " + " ".join(e.split())[:120])
     for m in re.finditer(r"\\[A-Za-z]+", "".join(r.math_text)):
