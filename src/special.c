@@ -263,27 +263,34 @@ double fe_normal_quantile(double p)
 
 double fe_chi2_quantile(double q, double dof)
 {
-    double a, h, t, x, lo = 0.0, hi = INFINITY, lognorm;
+    double a, h, t, x, lo, hi = INFINITY, lognorm, logq;
+    int lower;
     if (!(q > 0.0 && q < 1.0) || !(dof > 0.0) || !isfinite(dof))
         return NAN;
     a = 0.5 * dof;
     h = 2.0 / (9.0 * dof);
     t = 1.0 - h + fe_normal_quantile(q) * sqrt(h);
     x = t > 0.0 ? dof * t * t * t : 0.0;
-    if (!(x > 1e-300))
-        x = 1e-300 + dof * 1e-6;
     lognorm = a * log(2.0) + fe_log_gamma(a);
-    for (int it = 0; it < 200; it++) {
-        double F = fe_gamma_p(a, 0.5 * x) - q;
+    logq = log(q);
+    /* P(a, y) <= y^a / Gamma(a + 1): the quantile is at least this. */
+    lo = 2.0 * exp((logq + fe_log_gamma(a + 1.0)) / a);
+    if (!(lo > 0.0))
+        return 0.0;                     /* below the smallest double */
+    if (!(x > lo))
+        x = lo;
+    lower = q < 0.5;
+    for (int it = 0; it < 400; it++) {
+        double P = fe_gamma_p(a, 0.5 * x);
         double f = exp((a - 1.0) * log(x) - 0.5 * x - lognorm);
-        double xn;
-        if (F < 0.0)
+        double g = lower ? log(P) - logq : P - q, d = lower ? f / P : f, xn;
+        if (P < q)
             lo = x;
         else
             hi = x;
-        xn = f > 0.0 ? x - F / f : NAN;
+        xn = d > 0.0 && isfinite(g) ? x - g / d : NAN;
         if (!(xn > lo && xn < hi))
-            xn = isfinite(hi) ? 0.5 * (lo + hi) : 2.0 * x;
+            xn = !isfinite(hi) ? 2.0 * x : hi > 4.0 * lo ? sqrt(lo * hi) : 0.5 * (lo + hi);
         if (fabs(xn - x) <= 1e-15 * x)
             return xn;
         x = xn;

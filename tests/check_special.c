@@ -172,6 +172,23 @@ static const double chi2_reference[][3] = {
     {10026833.0, 10000000, 1.018479628954806e-9},
 };
 
+START_TEST(chi_square_quantile_far_in_the_lower_tail)
+{
+    /* Against 60-digit references (mpmath: the root of the regularised
+       lower incomplete gamma, solved in log x), where the Wilson-Hilferty
+       start fails: q far below the median, few and many degrees of
+       freedom; a quantile below the smallest double is 0. */
+    static const double ref[][3] = {
+        {1e-100, 100, 0.39116223402411124654},   {1e-30, 30, 0.12898731599295860178},
+        {1e-10, 1, 1.5707963267948966192e-20},   {1e-300, 2, 2.0e-300},
+        {1e-12, 10, 0.020778689705003601115},    {1e-5, 1000, 820.6036570313778617},
+    };
+    for (size_t i = 0; i < sizeof ref / sizeof ref[0]; i++)
+        FE_ASSERT_REL(fe_chi2_quantile(ref[i][0], ref[i][1]), ref[i][2], 1e-12);
+    ck_assert(fe_chi2_quantile(1e-200, 0.5) == 0.0);         /* 1.35e-800 */
+}
+END_TEST
+
 START_TEST(chi2_upper_large_degrees_of_freedom)
 {
     const double *c = chi2_reference[_i];
@@ -189,6 +206,7 @@ Suite *fe_special_suite(void)
     tcase_add_test(t, normal_quantile_within_its_promised_error);
     tcase_add_test(t, bad_arguments_give_nan);
     tcase_add_test(t, digamma_and_trigamma_closed_forms);
+    tcase_add_test(t, chi_square_quantile_far_in_the_lower_tail);
     tcase_add_loop_test(t, chi2_upper_large_degrees_of_freedom, 0,
                         (int)(sizeof chi2_reference / sizeof chi2_reference[0]));
     suite_add_tcase(s, t);
