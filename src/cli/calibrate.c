@@ -1051,11 +1051,8 @@ int fe_cli_calibrate(int argc, char **argv)
     }
     if (rc == FE_CLI_OK)
         rc = fe__calibrate_fold(&t, cols, ncols, g, flags, &q);
-    if (rc != FE_CLI_OK) {
-        free(ring);
-        fe_cli_table_close(&t);
-        return rc;
-    }
+    if (rc != FE_CLI_OK)
+        goto done;
     if (g != NULL) {
         still_kept = g->still;
         still_out = g->moving;
@@ -1074,11 +1071,8 @@ int fe_cli_calibrate(int argc, char **argv)
         fe_quadric_blocks_init(&q);
         if (rc == FE_CLI_OK)
             rc = fe__calibrate_walk(&a, cols, ncols, g, fe__calibrate_robust_keep, &robust);
-        if (rc != FE_CLI_OK) {
-            free(ring);
-            fe_cli_table_close(&t);
-            return rc;
-        }
+        if (rc != FE_CLI_OK)
+            goto done;
         fitrc = fe_sphere_fit_blocks(&q, a.model, &opt, &fit);
     }
     memset(&p2, 0, sizeof p2);
@@ -1091,13 +1085,9 @@ int fe_cli_calibrate(int argc, char **argv)
         if (rc == FE_CLI_OK)
             rc = fe__calibrate_second_pass(&a, cols, ncols, g, robust.threshold, t.rows, &fit,
                                            &sc, &p2);
-        if (rc != FE_CLI_OK) {
-            free(ring);
-            fe_cli_table_close(&t);
-            return rc;
-        }
+        if (rc != FE_CLI_OK)
+            goto done;
     }
-    free(ring);
     p2.still = a.still;
     p2.kept = still_kept;
     p2.left_out = still_out;
@@ -1108,8 +1098,8 @@ int fe_cli_calibrate(int argc, char **argv)
         fe__calibrate_json(&t, &fit, &sc, a.field, fitrc, &p2);
     if (fitrc != FE_OK) {
         fe__calibrate_refusal(&t, &fit, fitrc);
-        fe_cli_table_close(&t);
-        return FE_CLI_REFUSED;
+        rc = FE_CLI_REFUSED;
+        goto done;
     }
     if (a.export_format != FE__EXPORT_NONE)
         fe__calibrate_export(&a, &t, &fit, &sc);
@@ -1117,15 +1107,15 @@ int fe_cli_calibrate(int argc, char **argv)
         fe__calibrate_text(stdout, &t, &fit, &sc, a.field, &p2);
     if (a.report != NULL) {
         rc = fe__calibrate_report(&a, &t, cols, &fit, &sc, &p2);
-        if (rc != FE_CLI_OK) {
-            fe_cli_table_close(&t);
-            return rc;
-        }
+        if (rc != FE_CLI_OK)
+            goto done;
         fe_cli_pending_clear();
         if (!a.json && a.export_format == FE__EXPORT_NONE)
             printf("  report           %s/report.md\n", a.report);
     }
+done:                                   /* every path after the open */
+    free(ring);
     fe_cli_table_close(&t);
-    return FE_CLI_OK;
+    return rc;
 }
 /* Calibrate a recording ends here */
