@@ -724,6 +724,183 @@ START_TEST(refusals_leave_the_accumulation_unchanged)
 }
 END_TEST
 
+START_TEST(short_panels_and_single_rows)
+{
+    /* Rows folded two at a time, each pair a recording of its own (a
+       break before it), by rows, by columns and one by one: the lag-one
+       product is the pair's z_1 z_0^T, folded (L_ii on the diagonal, L_ij
+       + L_ji above it); a part that does not know its row refuses one row
+       as it refuses many; a copy refuses what is not bound. */
+    enum { M = 3, K = 4, N = 40 };
+    size_t nst = fe_discover_acc_doubles(M, K), dim = M + 1;
+    double *s[3], phi[N][M], cols[M][N], r[N];
+    long double L[M + 1][M + 1] = {{0}};
+    fe_discover_acc a[3], z;
+    size_t done = 7;
+    fe_rng g = fe_rng_seed(17);
+    for (int q = 0; q < 3; q++) {
+        s[q] = malloc(nst * sizeof *s[q]);
+        ck_assert_int_eq(fe_discover_acc_init(&a[q], M, K, N, 0, s[q], nst), FE_OK);
+    }
+    for (size_t t = 0; t < N; t++) {
+        for (size_t c = 0; c < M; c++)
+            cols[c][t] = phi[t][c] = fe_rng_normal(&g);
+        r[t] = fe_rng_normal(&g);
+    }
+    for (size_t t = 0; t < N; t += 2) {
+        fe_discover_break(&a[0]);
+        fe_discover_break(&a[1]);
+        fe_discover_break(&a[2]);
+        ck_assert_int_eq(fe_discover_add_rows(&a[0], phi[t], M, r + t, 2, &done), FE_OK);
+        ck_assert_uint_eq(done, 2);
+        ck_assert_int_eq(fe_discover_add_columns(&a[1], cols[0] + t, N, r + t, 2, &done), FE_OK);
+        ck_assert_uint_eq(done, 2);
+        ck_assert_int_eq(fe_discover_add(&a[2], phi[t], r[t]), FE_OK);
+        ck_assert_int_eq(fe_discover_add(&a[2], phi[t + 1], r[t + 1]), FE_OK);
+        for (size_t i = 0; i <= M; i++)
+            for (size_t j = 0; j <= M; j++)
+                L[i][j] += (long double)(i < M ? phi[t + 1][i] : r[t + 1])
+                           * (j < M ? phi[t][j] : r[t]);
+    }
+    for (int q = 0; q < 3; q++)
+        for (size_t i = 0; i <= M; i++)
+            for (size_t j = 0; j <= M; j++) {
+                double want = i == j ? (double)L[i][i] : i < j ? (double)(L[i][j] + L[j][i]) : 0.0;
+                ck_assert_double_eq_tol(a[q].lag[i * dim + j], want, 1e-12);
+            }
+    ck_assert_double_ne(a[0].lag[0], 0.0);
+    /* One row, or many, into a part whose row0 is unknown. */
+    ck_assert_int_eq(fe_discover_reset(&a[0]), FE_OK);
+    ck_assert_int_eq(fe_discover_add_rows(&a[0], phi[0], M, r, 1, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_int_eq(fe_discover_add_rows(&a[0], phi[0], M, r, 3, &done), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_add_columns(&a[0], cols[0], N, r, 1, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_uint_eq(a[0].n, 0);
+    for (size_t k = 0; k <= K; k++)
+        ck_assert_double_eq(a[0].counts[k], 0.0);
+    /* Copies: each missing or unbound side alone. */
+    memset(&z, 0, sizeof z);
+    ck_assert_int_eq(fe_discover_copy(NULL, &a[1]), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_copy(&a[0], NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_copy(&z, &a[1]), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_copy(&a[0], &z), FE_EINVAL);
+    ck_assert_uint_eq(a[0].n, 0);
+    ck_assert_int_eq(fe_discover_copy(&a[0], &a[1]), FE_OK);
+    ck_assert_mem_eq(s[0], s[1], FE_DISCOVER_ACC_VALUES(M, K) * sizeof *s[0]);
+    for (int q = 0; q < 3; q++)
+        free(s[q]);
+}
+END_TEST
+
+START_TEST(batch_tests_match_block_shares)
+{
+    /* Batch means by brute force over the stored rows: the base fit's
+       residual e and each candidate column's residual x~ on the base
+       columns (both over all fitted rows), the K block shares c_k = sum
+       over block k of x~ e, their mean and covariance (divisor K - 1),
+       Hotelling's T^2 = K mean' V^-1 mean; a one-column term's statistic
+       is sign(mean) sqrt(T^2) with Student's t on K - 1 degrees of
+       freedom, a two-column term's (K - d) T^2 / (d (K - 1)) with F on
+       (d, K - d).  The same with a full accumulation (lagged products
+       kept) as with one that keeps none. */
+    enum { M = 5, K = 8, N = 4000 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static double phi[N][M], r[N];
+    fe_discover_group groups[4] = {{"one", 0, 1}, {"ramp", 1, 1}, {"pair", 2, 2}, {"sine", 4, 1}};
+    size_t base[2] = {0, 1};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *res = malloc(sizeof *res);
+    fe_rng g = fe_rng_seed(23);
+    long double e[N], xt[M][N];
+    for (size_t t = 0; t < N; t++) {
+        double u = fe_rng_normal(&g);
+        phi[t][0] = 1.0;
+        phi[t][1] = (double)t / N;
+        phi[t][2] = sin(0.003 * (double)t) + 0.3 * fe_rng_normal(&g);
+        phi[t][3] = cos(0.002 * (double)t) + 0.3 * fe_rng_normal(&g);
+        phi[t][4] = sin(0.005 * (double)t);
+        r[t] = 0.2 + 0.5 * phi[t][1] + 0.05 * phi[t][2] - 0.04 * phi[t][3]
+               + 0.03 * phi[t][4] + 0.5 * u;
+    }
+    /* Residuals on the base columns (1, t/N): two-by-two normal equations. */
+    {
+        long double s00 = 0, s01 = 0, s11 = 0, det;
+        for (size_t t = 0; t < N; t++) {
+            s00 += 1;
+            s01 += phi[t][1];
+            s11 += (long double)phi[t][1] * phi[t][1];
+        }
+        det = s00 * s11 - s01 * s01;
+        for (size_t c = 0; c <= M; c++) {
+            long double y0 = 0, y1 = 0, b0, b1;
+            for (size_t t = 0; t < N; t++) {
+                long double y = c < M ? phi[t][c] : r[t];
+                y0 += y;
+                y1 += y * phi[t][1];
+            }
+            b0 = (s11 * y0 - s01 * y1) / det;
+            b1 = (s00 * y1 - s01 * y0) / det;
+            for (size_t t = 0; t < N; t++) {
+                long double y = c < M ? phi[t][c] : r[t];
+                if (c < M)
+                    xt[c][t] = y - b0 - b1 * phi[t][1];
+                else
+                    e[t] = y - b0 - b1 * phi[t][1];
+            }
+        }
+    }
+    o.base = base;
+    o.nbase = 2;
+    o.max_steps = 0;
+    o.noise = FE_DISCOVER_NOISE_BATCH;
+    for (int lags = 0; lags < 2; lags++) {
+        fe_discover_acc a;
+        ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_set_lags(&a, lags ? FE_DISCOVER_DEFAULT_LAGS : 0), FE_OK);
+        for (size_t t = 0; t < N; t++)
+            ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+        ck_assert_int_eq(fe_discover_select(&a, groups, 4, &o, res, w, nw), FE_OK);
+        ck_assert_uint_eq(res->nranked[0], 2);
+        for (size_t i = 0; i < 2; i++) {
+            const fe_discover_rank *rk = &res->ranking[0][i];
+            const fe_discover_group *gr = &groups[rk->group];
+            size_t d = gr->count;
+            long double c[K][2] = {{0}}, mean[2] = {0}, v[2][2] = {{0}}, t2;
+            ck_assert(rk->group == 2 || rk->group == 3);
+            for (size_t t = 0; t < N; t++)
+                for (size_t p = 0; p < d; p++)
+                    c[t * K / N][p] += xt[gr->first + p][t] * e[t];
+            for (size_t k = 0; k < K; k++)
+                for (size_t p = 0; p < d; p++)
+                    mean[p] += c[k][p] / K;
+            for (size_t k = 0; k < K; k++)
+                for (size_t p = 0; p < d; p++)
+                    for (size_t q = 0; q < d; q++)
+                        v[p][q] += (c[k][p] - mean[p]) * (c[k][q] - mean[q]) / (K - 1);
+            if (d == 1) {
+                long double tt = mean[0] / sqrtl(v[0][0] / K);
+                FE_ASSERT_REL(rk->statistic, (double)tt, 1e-8);
+                FE_ASSERT_REL(rk->p_value, fe_student_t_two_sided((double)tt, K - 1), 1e-8);
+            } else {
+                long double det = v[0][0] * v[1][1] - v[0][1] * v[1][0], f;
+                t2 = K * (mean[0] * (v[1][1] * mean[0] - v[0][1] * mean[1])
+                          + mean[1] * (v[0][0] * mean[1] - v[1][0] * mean[0])) / det;
+                f = (K - d) * t2 / (d * (K - 1.0L));
+                FE_ASSERT_REL(rk->statistic, (double)f, 1e-8);
+                FE_ASSERT_REL(rk->p_value, fe_f_upper((double)f, (double)d, (double)(K - d)),
+                              1e-8);
+            }
+            ck_assert_double_lt(rk->p_value, 0.999);
+        }
+    }
+    free(st);
+    free(w);
+    free(res);
+}
+END_TEST
+
 START_TEST(selection_refuses_empty_blocks_and_collinear_base)
 {
     enum { M = 3, K = 4 };
@@ -741,6 +918,20 @@ START_TEST(selection_refuses_empty_blocks_and_collinear_base)
         fe_discover_add(&a, phi, fe_rng_normal(&rng));
     }
     ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_ETOOFEW);
+    /* Each group checked, not only the first: no columns, too many, past
+       the last column, each alone in the second or third place. */
+    {
+        fe_discover_group bad[3];
+        /* {group, first, count}: the others as they are. */
+        const size_t fix[5][3] = {{1, 1, 0}, {1, 0, FE_DISCOVER_MAX_GROUP_SIZE + 1},
+                                  {2, 2, 2}, {2, 3, 1}, {2, 1, 3}};
+        for (int c = 0; c < 5; c++) {
+            memcpy(bad, g, sizeof bad);
+            bad[fix[c][0]].first = fix[c][1];
+            bad[fix[c][0]].count = fix[c][2];
+            ck_assert_int_eq(fe_discover_select(&a, bad, 3, &o, r, w, nw), FE_EINVAL);
+        }
+    }
     for (int i = 20; i < 100; i++) {
         double x = fe_rng_normal(&rng), phi[M] = {x, fe_rng_normal(&rng), 2 * x};
         fe_discover_add(&a, phi, fe_rng_normal(&rng));
@@ -851,6 +1042,42 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
                     FE_ASSERT_REL(acc[q]->fsum[k * dim + c] + 1.0, (double)want[c] + 1.0, 1e-11);
             }
         }
+        /* The K blocks' sums of rows, every column (the constant one too). */
+        for (size_t k = 0; k < NK; k++) {
+            long double want[NM + 1] = {0};
+            for (size_t t = 0; t < NFIT; t++)
+                if (t * NK / NFIT == k) {
+                    for (size_t c = 0; c < NM; c++)
+                        want[c] += nphi[t][c];
+                    want[NM] += nr[t];
+                }
+            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
+            for (int q = 0; q < 4; q++)
+                for (size_t c = 0; c <= NM; c++)
+                    FE_ASSERT_REL(acc[q]->bsum[k * dim + c] + 1.0, (double)want[c] + 1.0, 1e-11);
+        }
+        /* The edges: the second recording's first E rows stacked (x x^T,
+           the first recording's start is the head), and the first
+           recording's last E rows, newest first (the second is open). */
+        {
+            enum { E = FE_DISCOVER_EDGE, NE = FE_DISCOVER_EDGE * (NM + 1) };
+            double xs[NE], xe[NE];
+            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
+            for (size_t u = 0; u < E; u++)
+                for (size_t c = 0; c <= NM; c++) {
+                    size_t ts = NBREAK + u, te = NBREAK - 1 - u;
+                    xs[u * dim + c] = c < NM ? nphi[ts][c] : nr[ts];
+                    xe[u * dim + c] = c < NM ? nphi[te][c] : nr[te];
+                }
+            for (int q = 0; q < 4; q++)
+                for (size_t i = 0; i < NE; i++)
+                    for (size_t j = 0; j < NE; j++) {
+                        ck_assert_double_eq_tol(acc[q]->edge_start[i * NE + j], xs[i] * xs[j],
+                                                1e-15 * (1 + fabs(xs[i] * xs[j])));
+                        ck_assert_double_eq_tol(acc[q]->edge_end[i * NE + j], xe[i] * xe[j],
+                                                1e-15 * (1 + fabs(xe[i] * xe[j])));
+                    }
+        }
         for (size_t l = 1; l <= FE_DISCOVER_DEFAULT_LAGS; l++)
             for (size_t i = 0; i < dim; i++)
                 for (size_t j = 0; j < dim; j++) {
@@ -890,6 +1117,38 @@ START_TEST(levinson_recovers_a_known_autoregression)
     ck_assert_double_eq_tol(nz.innovation_variance, 1.0, 1e-12);
     /* n_eff = n gamma_0 (1 - phi1 - phi2)^2 / sigma^2. */
     ck_assert_double_eq_tol(nz.n_eff, n * q[0] / n * 0.3 * 0.3, 1e-8);
+    /* AR(3) and AR(4), whose recursion uses every earlier coefficient:
+       the autocovariances gamma_l = sum_i psi_i psi_{i+l} from the impulse
+       response psi (psi_0 = 1, psi_t = sum_i phi_i psi_{t-i}), summed in
+       long double until psi is below 1e-30. */
+    {
+        static const double ar[2][4] = {{0.5, -0.4, 0.3, 0}, {0.6, 0.2, -0.3, 0.25}};
+        for (int c = 0; c < 2; c++) {
+            size_t p = c == 0 ? 3 : 4;
+            static long double psi[20000];
+            long double gam[FE_DISCOVER_LAGS] = {0};
+            size_t T = 0;
+            for (size_t t = 0; t < 20000; t++) {
+                psi[t] = t == 0;
+                for (size_t i = 1; i <= p && i <= t; i++)
+                    psi[t] += ar[c][i - 1] * psi[t - i];
+                T = t + 1;
+                if (t > 50 && fabsl(psi[t]) < 1e-30L && fabsl(psi[t - 1]) < 1e-30L)
+                    break;
+            }
+            ck_assert_uint_lt(T, 20000);
+            for (size_t l = 0; l < FE_DISCOVER_LAGS; l++) {
+                for (size_t t = 0; t + l < T; t++)
+                    gam[l] += psi[t] * psi[t + l];
+                q[l] = (double)(n * gam[l]);
+            }
+            ck_assert_int_eq(fe_discover_noise_fit(q, n, 4, &nz), FE_OK);
+            ck_assert_uint_eq(nz.order, p);
+            for (size_t i = 0; i < p; i++)
+                ck_assert_double_eq_tol(nz.phi[i], ar[c][i], 1e-10);
+            ck_assert_double_eq_tol(nz.innovation_variance, 1.0, 1e-10);
+        }
+    }
     ck_assert_int_eq(fe_discover_noise_fit(q, 1.0, 4, &nz), FE_EINVAL);
     ck_assert_int_eq(fe_discover_noise_fit(q, n, FE_DISCOVER_LAGS, &nz), FE_EINVAL);
     ck_assert_int_eq(fe_discover_noise_fit(NULL, n, 4, &nz), FE_EINVAL);
@@ -1498,6 +1757,8 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, panels_of_split_parts_merge_to_the_whole);
     tcase_add_test(t, panels_stop_at_the_first_refused_row);
     tcase_add_test(t, selection_refuses_empty_blocks_and_collinear_base);
+    tcase_add_test(t, short_panels_and_single_rows);
+    tcase_add_test(t, batch_tests_match_block_shares);
     tcase_add_test(t, column_path_equals_row_path);
     tcase_add_test(t, screen_keeps_what_ranking_reads);
     tcase_add_test(t, screen_ranks_as_the_full_accumulation);
