@@ -1267,6 +1267,118 @@ START_TEST(gls_matches_prewhitened_least_squares)
 END_TEST
 
 
+/* The autocovariance sums out[h] = sum_t y_t y_{t-h}, h = 0 .. H, of y =
+   alpha * x, the series x[0 .. n) whitened by nz's filter alpha (alpha_0
+   = 1, alpha_i = -phi_i) with zeros outside [0, n): all n + p values of
+   the full convolution. */
+static void padded_white_acov(const long double *x, size_t n, const fe_discover_noise *nz,
+                              size_t H, long double *out)
+{
+    size_t p = nz->order;
+    long double *y = calloc(n + p, sizeof *y);
+    ck_assert_ptr_nonnull(y);
+    for (size_t t = 0; t < n + p; t++)
+        for (size_t i = 0; i <= p; i++)
+            if (t >= i && t - i < n)
+                y[t] += (i == 0 ? 1.0L : -(long double)nz->phi[i - 1]) * x[t - i];
+    for (size_t h = 0; h <= H; h++) {
+        out[h] = 0;
+        for (size_t t = h; t < n + p; t++)
+            out[h] += y[t] * y[t - h];
+    }
+    free(y);
+}
+
+START_TEST(long_run_factor_of_the_standard_errors)
+{
+    /* Noise an AR model of order 4 cannot whiten (e_t = u_t + 0.8 u_{t-6}),
+       16 lags kept, the long range off: the whitened residual fails the
+       portmanteau test, and each standard error is the GLS one (s^2
+       [(X~'X~)^-1]_ii, X~ the whitened rows without the first p) times
+       Bartlett's factor f = 1 + 2 sum_{h=1}^{H} (1 - h / (H + 1)) rho_e(h)
+       rho_x(h), over the whitened residual e and the whitened series x_t =
+       sum_c [(X~'X~)^-1]_ci phi_tc, each zero-padded, H = 16 - p.  All of
+       it by brute force over the stored rows, from the returned
+       coefficients and filter. */
+    enum { N = 6000, M = 3, K = 10, P = 16 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static double phi[N][M], r[N];
+    static long double e[N], x[N];
+    size_t cols[3] = {0, 1, 2}, p, H;
+    double coef[3], se[3], u[N + 6];
+    long double xtx[3][3] = {{0}}, inv[3][3], det, rss = 0, nu, s2, ae[P + 1], ax[P + 1];
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    fe_discover_acc a;
+    fe_rng g = fe_rng_seed(41);
+    for (size_t t = 0; t < N + 6; t++)
+        u[t] = fe_rng_normal(&g);
+    for (size_t t = 0; t < N; t++) {
+        phi[t][0] = 1.0;
+        phi[t][1] = (double)t / N;
+        phi[t][2] = sin(0.004 * (double)t);
+        r[t] = 0.3 * phi[t][1] - 0.2 * phi[t][2] + 0.1 * (u[t + 6] + 0.8 * u[t]);
+    }
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&a, P), FE_OK);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 1), FE_OK);
+    for (size_t t = 0; t < N; t++)
+        ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 3, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_int_eq(nz.long_run, 1);
+    ck_assert_uint_eq(nz.scales, 0);
+    p = nz.order;
+    H = P - p;
+    ck_assert_uint_eq(nz.lags_tested, H);
+    /* X~'X~ and the whitened RSS over rows p .. N - 1. */
+    for (size_t t = p; t < N; t++) {
+        long double xw[3] = {0}, y = 0;
+        for (size_t i = 0; i <= p; i++) {
+            long double al = i == 0 ? 1.0L : -(long double)nz.phi[i - 1];
+            for (int c = 0; c < 3; c++)
+                xw[c] += al * phi[t - i][c];
+            y += al * r[t - i];
+        }
+        for (int c = 0; c < 3; c++) {
+            y -= coef[c] * xw[c];
+            for (int d = 0; d < 3; d++)
+                xtx[c][d] += xw[c] * xw[d];
+        }
+        rss += y * y;
+    }
+    det = xtx[0][0] * (xtx[1][1] * xtx[2][2] - xtx[1][2] * xtx[2][1])
+          - xtx[0][1] * (xtx[1][0] * xtx[2][2] - xtx[1][2] * xtx[2][0])
+          + xtx[0][2] * (xtx[1][0] * xtx[2][1] - xtx[1][1] * xtx[2][0]);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
+            inv[i][j] = (xtx[i1][j1] * xtx[i2][j2] - xtx[i1][j2] * xtx[i2][j1]) / det;
+        }
+    nu = N - 3 - (long double)p;
+    s2 = rss / nu;
+    for (size_t t = 0; t < N; t++)
+        e[t] = r[t] - coef[0] * phi[t][0] - coef[1] * phi[t][1] - coef[2] * phi[t][2];
+    padded_white_acov(e, N, &nz, H, ae);
+    for (int i = 0; i < 3; i++) {
+        long double f = 0;
+        for (size_t t = 0; t < N; t++)
+            x[t] = inv[0][i] * phi[t][0] + inv[1][i] * phi[t][1] + inv[2][i] * phi[t][2];
+        padded_white_acov(x, N, &nz, H, ax);
+        for (size_t h = 1; h <= H; h++)
+            f += (1 - (long double)h / (H + 1)) * (ae[h] / ae[0]) * (ax[h] / ax[0]);
+        f = 1 + 2 * f;
+        if (f < 1)
+            f = 1;
+        if (i > 0)
+            ck_assert_double_gt((double)f, 1.2);     /* the factor acts */
+        FE_ASSERT_REL(se[i], (double)sqrtl(s2 * inv[i][i] * f), 1e-7);
+    }
+    free(st);
+    free(w);
+}
+END_TEST
+
 /* v(m) = Var(sum of m consecutive values) of the AR model nz per unit
    innovation variance, from its autocovariances: gamma_0 .. gamma_p by
    solving the Yule-Walker equations gamma_k - sum_i phi_i gamma_|k-i| =
@@ -1759,6 +1871,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, selection_refuses_empty_blocks_and_collinear_base);
     tcase_add_test(t, short_panels_and_single_rows);
     tcase_add_test(t, batch_tests_match_block_shares);
+    tcase_add_test(t, long_run_factor_of_the_standard_errors);
     tcase_add_test(t, column_path_equals_row_path);
     tcase_add_test(t, screen_keeps_what_ranking_reads);
     tcase_add_test(t, screen_ranks_as_the_full_accumulation);

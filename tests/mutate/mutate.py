@@ -10,7 +10,12 @@ runs the fast suites that exercise its module; a mutant is
   survived    every suite passed,
   stillborn   it did not compile or link (counted apart, not as killed),
   identical   its object code equals the original's (the compiler proved it
-              equivalent; counted apart, like stillborn ones).
+              equivalent; counted apart, like stillborn ones),
+  not run     it survived, but its line is in code compiled only for
+              processors with AVX-512 (inside `#if defined(FE__LANES_X86)`,
+              the eight-lane kernels and their dispatch) and this processor
+              lacks avx512f (/proc/cpuinfo): no test here can run it
+              (counted apart, like stillborn ones).
 
 The kill rate is killed / (killed + survived), per module and overall, and
 the survivors are listed with file:line and the change.  Python 3 standard
@@ -216,6 +221,38 @@ def candidates(src, types):
     return out
 
 
+def wide_lines(src):
+    """Lines inside `#if defined(FE__LANES_X86)` ... its `#endif`: the
+    eight-lane (AVX-512) kernels and the branches that call them."""
+    out, depth, inside = set(), 0, 0
+    for n, ln in enumerate(src.splitlines(), 1):
+        t = ln.strip()
+        if t.startswith("#if"):
+            depth += 1
+            if inside == 0 and re.match(r"#if\s+defined\s*\(\s*FE__LANES_X86\s*\)\s*$", t):
+                inside = depth
+        elif t.startswith("#endif"):
+            if depth == inside:
+                inside = 0
+            depth -= 1
+        elif inside:
+            out.add(n)
+    return out
+
+
+def cpu_has_wide():
+    """Whether this processor runs AVX-512 code (avx512f in /proc/cpuinfo);
+    True when that cannot be read, so that nothing is set apart."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for ln in f:
+                if ln.startswith("flags"):
+                    return "avx512f" in ln.split()
+    except OSError:
+        pass
+    return True
+
+
 def functions_defined(src):
     """Public functions a source defines (names fe_..., not fe__...)."""
     return set(re.findall(r"^(?!static)[A-Za-z_][\w \t\*]*?\b(fe_[a-z0-9][a-z0-9_]*)\s*\([^;]*$",
@@ -343,6 +380,8 @@ def main():
         cands[m] = candidates(src[m], types)
         lines[m] = sum(1 for ln in src[m].splitlines()
                        if ln.strip() and not ln.lstrip().startswith(("/*", "*", "//")))
+    wide = {m: wide_lines(src[m]) for m in mods}
+    wide_here = cpu_has_wide()
     rng = random.Random(a.seed)
     chosen = []
     if a.ids:
@@ -503,6 +542,8 @@ def main():
                 break
         if verdict is None:
             verdict = "survived" if ran else "identical"
+            if verdict == "survived" and not wide_here and line in wide[m]:
+                verdict = "not run"
         results.append(dict(id="%s:%d" % (m, k), module=m, where=where, kind=kind, change=desc,
                             verdict=verdict, by=by,
                             line=src[m].splitlines()[line - 1].strip()))
@@ -511,7 +552,7 @@ def main():
 
     # The report.
     secs = time.monotonic() - t_start
-    rows, tot = [], dict(killed=0, survived=0, stillborn=0, identical=0)
+    rows, tot = [], {"killed": 0, "survived": 0, "stillborn": 0, "identical": 0, "not run": 0}
     for m in mods:
         r = [x for x in results if x["module"] == m]
         if not r:
@@ -525,19 +566,25 @@ def main():
         d = c["killed"] + c["survived"]
         return "%5.1f %%" % (100.0 * c["killed"] / d) if d else "    -  "
 
-    lines_out = ["", "module      mutants  killed  survived  stillborn  identical   kill rate"]
+    lines_out = ["", "module      mutants  killed  survived  stillborn  identical  not run   kill rate"]
     for m, nm, c in rows:
-        lines_out.append("%-10s %8d %7d %9d %10d %10d   %s" % (
-            m, nm, c["killed"], c["survived"], c["stillborn"], c["identical"], rate(c)))
-    lines_out.append("%-10s %8d %7d %9d %10d %10d   %s" % (
+        lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s" % (
+            m, nm, c["killed"], c["survived"], c["stillborn"], c["identical"], c["not run"],
+            rate(c)))
+    lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s" % (
         "overall", len(results), tot["killed"], tot["survived"], tot["stillborn"],
-        tot["identical"], rate(tot)))
+        tot["identical"], tot["not run"], rate(tot)))
     lines_out.append("(seed %d, %d mutants in %.0f s; excluded: %s)" % (
         a.seed, len(results), secs, ", ".join(sorted(excluded)) or "none"))
     surv = [x for x in results if x["verdict"] == "survived"]
     if surv:
         lines_out += ["", "surviving mutants:"]
         for x in surv:
+            lines_out.append("  %-10s %-22s %-34s | %s" % (x["id"], x["where"], x["change"], x["line"]))
+    notrun = [x for x in results if x["verdict"] == "not run"]
+    if notrun:
+        lines_out += ["", "not run here (AVX-512 code; this processor lacks avx512f):"]
+        for x in notrun:
             lines_out.append("  %-10s %-22s %-34s | %s" % (x["id"], x["where"], x["change"], x["line"]))
     report = "\n".join(lines_out) + "\n"
     print(report, end="")
