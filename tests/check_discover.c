@@ -1442,6 +1442,32 @@ START_TEST(long_range_model_of_the_fine_blocks)
         ck_assert_double_gt(nz.scale_ratio[t], 0.5);
         ck_assert_double_lt(nz.scale_ratio[t], 2.0);
     }
+    /* A part of 20 rows around the middle of a stream of 10000 fitted
+       rows in 2 blocks: 512 fine blocks over the whole stream, so that
+       the finest levels' halves round to no rows and are taken as one. */
+    {
+        fe_discover_acc b;
+        enum { R0 = 4990, NP = 20 };
+        ck_assert_int_eq(fe_discover_acc_init(&b, NM, 2, 10000, R0, st, nst), FE_OK);
+        for (size_t t = 0; t < NP; t++) {
+            double ph[NM] = {1.0, (double)t / NP, sin(0.3 * (double)t), cos(0.7 * (double)t)};
+            ck_assert_int_eq(fe_discover_add(&b, ph, sin(0.25 * (double)t) + 0.01 * (double)(t % 3)),
+                             FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_fit_noise(&b, cols, 1, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+        ck_assert_uint_eq(b.fine, 512);
+        ck_assert_uint_eq(nz.scales, 9);
+        ck_assert_uint_ge(nz.order, 1);
+        for (size_t j = 1; j <= 9; j++) {
+            size_t m = (size_t)((double)NP * (double)(1u << (j - 1)) / 512.0 + 0.5);
+            long double want;
+            if (m < 1)
+                m = 1;
+            want = (4 * ar_sum_variance(&nz, m) - ar_sum_variance(&nz, 2 * m)) / (2 * m);
+            FE_ASSERT_REL(nz.scale_model[j - 1], (double)want, 1e-9);
+        }
+        FE_ASSERT_REL(nz.scale_model[9], (double)(ar_sum_variance(&nz, NP) / NP), 1e-9);
+    }
     /* A slow random walk under white noise, and a trend fitted to it. */
     {
         fe_rng g = fe_rng_seed(7);
