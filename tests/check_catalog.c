@@ -334,6 +334,14 @@ START_TEST(three_axis_terms_are_their_formulas)
         ck_assert_int_eq(fe_catalog_axes_eval(&c, far, 0, 0, phi, &r), FE_ENONFINITE);
         ck_assert_int_eq(fe_catalog_axes_eval(&c, nan3, 0, 0, phi, &r), FE_ENONFINITE);
         ck_assert_int_eq(fe_catalog_axes_eval(&c, x, NAN, 0, phi, &r), FE_ENONFINITE);
+        ck_assert_int_eq(fe_catalog_axes_eval(&c, x, 0, NAN, phi, &r), FE_ENONFINITE);
+        /* A NaN in each coordinate alone (its length is NaN too, which the
+           singular test would otherwise take). */
+        for (int i = 0; i < 3; i++) {
+            double y[3] = {x[0], x[1], x[2]};
+            y[i] = NAN;
+            ck_assert_int_eq(fe_catalog_axes_eval(&c, y, 0, 0, phi, &r), FE_ENONFINITE);
+        }
         ck_assert_int_eq(fe_catalog_axes_init(&c, bad, 0, 0, 0, 0), FE_ENONFINITE);
         ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, NAN, 0, 0), FE_ENONFINITE);
         ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, 0, 1, INFINITY), FE_ENONFINITE);
