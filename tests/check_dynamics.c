@@ -28,6 +28,21 @@ START_TEST(a_free_mass_signature_is_exact)
         FE_ASSERT_REL(y, 0.5 * (t - 3.0) * (t - 3.0), 1e-12);
         FE_ASSERT_REL(rate, t - 3.0, 1e-12);
     }
+    /* A new recording from t1: zero at its first row, then (t - t1)^2 / 2. */
+    {
+        double t1 = t + 1.0;
+        fe_dynamics_sens_restart(&sn);
+        fe_dynamics_sens_restart(NULL);
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, t1, a, &phi, &y, &rate), FE_OK);
+        ck_assert_double_eq(y, 0.0);
+        ck_assert_double_eq(rate, 0.0);
+        for (int i = 1; i <= 50; i++) {
+            t = t1 + 0.02 * i;
+            ck_assert_int_eq(fe_dynamics_sens_step(&sn, t, a, &phi, &y, &rate), FE_OK);
+            FE_ASSERT_REL(y, 0.5 * (t - t1) * (t - t1), 1e-12);
+            FE_ASSERT_REL(rate, t - t1, 1e-12);
+        }
+    }
 }
 END_TEST
 

@@ -291,6 +291,23 @@ START_TEST(product_rejects_bad_layout)
         ck_assert_int_eq(fe_product_accumulator(&prod, &none, 12), FE_EINVAL);
         ck_assert_int_eq(fe_product_accumulator(&prod, &empty, 12), FE_OK);
     }
+    /* A part starting past the observation (whose size would then wrap),
+       and parts that cannot fold, each at a place that fits. */
+    {
+        fe_accumulator nostep = mv, nosize = mv, noobs = mv;
+        const fe_product_part past[1] = {{&mv, 13}}, nullacc[1] = {{NULL, 0}};
+        const fe_product_part bad[3][1] = {{{&nostep, 0}}, {{&nosize, 0}}, {{&noobs, 0}}};
+        const fe_product sp = {past, 1}, sn = {nullacc, 1};
+        nostep.step = NULL;
+        nosize.acc_size = 0;
+        noobs.obs_size = 0;
+        ck_assert_int_eq(fe_product_accumulator(&prod, &sp, 12), FE_EINVAL);
+        ck_assert_int_eq(fe_product_accumulator(&prod, &sn, 12), FE_EINVAL);
+        for (int i = 0; i < 3; i++) {
+            const fe_product sb = {bad[i], 1};
+            ck_assert_int_eq(fe_product_accumulator(&prod, &sb, 12), FE_EINVAL);
+        }
+    }
     /* Every part is checked, not only the first: the second one ending
        exactly at the end of the observation fits, one byte further not. */
     {
