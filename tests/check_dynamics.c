@@ -297,6 +297,20 @@ static int constant_force(const fe_sample *s, double *g, void *user)
     return 0;
 }
 
+static int damped_spring(const fe_sample *s, double *d, void *user)
+{
+    (void)user;
+    *d = -4.0 * s->position - 0.8 * s->velocity;
+    return 0;
+}
+
+static int input_force(const fe_sample *s, double *g, void *user)
+{
+    (void)user;
+    *g = s->input;
+    return 0;
+}
+
 START_TEST(a_deviation_follows_its_closed_form)
 {
     fe_dynamics_deviation dv;
@@ -325,6 +339,40 @@ START_TEST(a_deviation_follows_its_closed_form)
         ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a1, lag, NULL, constant_force, &c,
                                                     d), FE_OK);
         ck_assert_msg(fabs(d[0] - c * (1.0 - exp(-0.5 * t)) / 0.5) < 1e-6, "t %g: %g", t, d[0]);
+    }
+    /* Damping, f = -4 x - 0.8 v (w0 = 2, zeta = 0.2), constant c: the step
+       response c/4 (1 - e^{-zeta w0 t} (cos wd t + zeta w0 / wd sin wd t)),
+       wd = w0 sqrt(1 - zeta^2), and its rate c/wd e^{-zeta w0 t} sin wd t. */
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 2), FE_OK);
+    for (int i = 0; i <= 200; i++) {
+        fe_sample s;
+        double t = 0.05 * i, wd = 2.0 * sqrt(1.0 - 0.04), ex = exp(-0.4 * t);
+        memset(&s, 0, sizeof s);
+        s.t = t;
+        s.position = s.sim = 0.1 * sin(3.0 * t);
+        s.velocity = 0.3 * cos(3.0 * t);
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a2, damped_spring, NULL,
+                                                    constant_force, &c, d), FE_OK);
+        ck_assert_msg(fabs(d[0] - c / 4.0 * (1.0 - ex * (cos(wd * t) + 0.4 / wd * sin(wd * t))))
+                          < 1e-5, "t %g: %g", t, d[0]);
+        ck_assert_msg(fabs(d[1] - c / wd * ex * sin(wd * t)) < 1e-5, "t %g: rate %g", t, d[1]);
+    }
+    /* A forcing that is the input, linear between rows (input = t): d' =
+       -d/2 + t, d = 2 t - 4 + 4 e^{-t/2}; RK4 over half-unit rows is within
+       a few 1e-6 (an input read as a + l / (b - a) instead of a + l (b - a)
+       between rows moves d by about 0.4 a row). */
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 1), FE_OK);
+    for (int i = 0; i <= 60; i++) {
+        fe_sample s;
+        double t = 0.5 * i, want = 2.0 * t - 4.0 + 4.0 * exp(-0.5 * t);
+        memset(&s, 0, sizeof s);
+        s.t = t;
+        s.input = t;
+        s.temperature = s.sim = 20.0 + t;
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a1, lag, NULL, input_force, NULL,
+                                                    d), FE_OK);
+        ck_assert_msg(fabs(d[0] - want) < 1e-5 * (1.0 + fabs(want)), "t %g: %g against %g", t,
+                      d[0], want);
     }
 }
 END_TEST
