@@ -768,6 +768,14 @@ START_TEST(residual_map_locates_a_window_and_a_region)
     ck_assert_int_eq(fe_residual_map_locate(&m, 1.5, 0.05, loc, 8, &n), FE_EINVAL);
     ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 1.0, loc, 8, &n), FE_EINVAL);
     ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, NULL, 8, &n), FE_EINVAL);
+    /* Each of the other arguments alone: no map, no count, alpha 0 and
+       NaN, worth NaN; no room and no array is a valid question. */
+    ck_assert_int_eq(fe_residual_map_locate(NULL, 1.0, 0.05, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, loc, 8, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.0, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, NAN, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, NAN, 0.05, loc, 8, &n), FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, NULL, 0, &n), FE_OK);
 }
 END_TEST
 
