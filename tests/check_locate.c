@@ -813,6 +813,12 @@ START_TEST(residual_map_statistics_by_hand)
         double w = 0.5, ms = 22.0 / 3.0;
         double z2 = (20.0 / ms - 1.0) / sqrt(2.0 / (10 * w));
         ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), z2, 1e-12);
+        /* At w = 0.01 every statistic is under 1 (block 2's z 0.386, its
+           t 0.156), and the largest is still block 2's z. */
+        w = 0.01;
+        z2 = (20.0 / ms - 1.0) / sqrt(2.0 / (10 * w));
+        ck_assert_double_lt(z2, 0.5);
+        ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), z2, 1e-12);
     }
     /* The bound is two-sided Bonferroni over the 3 places: block 2's z =
        19 sqrt(5 w) crosses b = -Phi^-1(0.05 / 6) at w = (b / 19)^2 / 5

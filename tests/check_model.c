@@ -379,6 +379,12 @@ START_TEST(arguments_and_failing_callbacks)
     ck_assert_uint_eq(term, 0);
     ck_assert_int_eq(fe_model_group_is_term(&a, 3, NULL), 1);
     ck_assert_int_eq(fe_model_group_is_term(NULL, 3, &term), 0);
+    /* The last group is a term; the one after it is no group. */
+    ck_assert_int_eq(fe_model_group_is_term(&a, a.ngroups - 1, &term), 1);
+    ck_assert_uint_eq(term, a.ngroups - 1 - a.model.p);
+    term = 77;
+    ck_assert_int_eq(fe_model_group_is_term(&a, a.ngroups, &term), 0);
+    ck_assert_uint_eq(term, 77);
     bad = m;
     bad.names = NULL;
     ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_OK);

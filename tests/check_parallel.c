@@ -915,6 +915,15 @@ START_TEST(bad_arguments_fold_nothing)
     wrong |= fe_parallel_fold(&f, &a, x, 4, 2, NULL, &done) != FE_EINVAL;
     wrong |= fe_parallel_fold(&f, &a, x, 4, FE_PARALLEL_MAX_THREADS + 1, pp, &done) != FE_ESIZE;
     wrong |= fe_parallel_fold(&nomerge, &a, x, 4, 2, pp, &done) != FE_ENOTSUP;
+    {   /* An accumulator that cannot fold, each defect alone. */
+        fe_accumulator nostep = f, noacc = f, noobs = f;
+        nostep.step = NULL;
+        noacc.acc_size = 0;
+        noobs.obs_size = 0;
+        wrong |= fe_parallel_fold(&nostep, &a, x, 4, 2, pp, &done) != FE_EINVAL;
+        wrong |= fe_parallel_fold(&noacc, &a, x, 4, 2, pp, &done) != FE_EINVAL;
+        wrong |= fe_parallel_fold(&noobs, &a, x, 4, 2, pp, &done) != FE_EINVAL;
+    }
     ck_assert_msg(!wrong, "a bad argument was not refused with the right code");
     ck_assert_uint_eq(done, 0);
     /* Aliased partials: with the result, and with each other. */
