@@ -73,6 +73,20 @@ static int nan_jacobian(const fe_sample *s, const double *th, double *jac, void 
     jac[2] = NAN;
     return rc;
 }
+/* NaN in the first column, and infinity in the second. */
+static int nan0_jacobian(const fe_sample *s, const double *th, double *jac, void *user)
+{
+    int rc = rig_jacobian(s, th, jac, user);
+    jac[0] = NAN;
+    return rc;
+}
+
+static int inf1_jacobian(const fe_sample *s, const double *th, double *jac, void *user)
+{
+    int rc = rig_jacobian(s, th, jac, user);
+    jac[1] = -INFINITY;
+    return rc;
+}
 static const char *const names[3] = {"input_gain_param", "frequency", "damping"};
 
 typedef struct {
@@ -242,6 +256,71 @@ START_TEST(a_right_model_discovers_nothing)
 }
 END_TEST
 
+START_TEST(the_fold_is_its_rows)
+{
+    /* Every row folded as the text says, recomputed from the stored rows:
+       the prediction y_i at theta0, the Jacobian columns, the catalog's
+       terms of the row with sim = y_i and dsim the central difference of
+       the predictions (one-sided at each end of a recording), and r =
+       real - y_i; the block Gram matrices summed against the products of
+       those rows.  Two recordings, 300 and 200 rows. */
+    enum { N = 500, NB = 300, K = 4 };
+    fe_synth_spec spec = fe_synth_default_spec("bias", 11);
+    fe_model m = {3, theta0, names, rig_predict, rig_jacobian, 0, NULL, NULL};
+    fe_synth g;
+    fe_catalog c;
+    fe_model_acc a;
+    static fe_sample rows[N];
+    static double y[N];
+    double *st;
+    size_t nst, M, dim;
+    static long double want[FE_DISCOVER_MAX_COLUMNS + 1][FE_DISCOVER_MAX_COLUMNS + 1];
+    spec.rows = N;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    ck_assert_int_eq(fe_catalog_init(&c, g.roles, &g.scale), FE_OK);
+    ck_assert_int_ge(fe_catalog_find(&c, "delay"), 0);
+    nst = fe_model_acc_doubles(3, c.count, K);
+    st = malloc(nst * sizeof *st);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, K, N, st, nst), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        ck_assert_int_eq(fe_synth_next(&g, &rows[i]), FE_OK);
+        if (i == NB)
+            ck_assert_int_eq(fe_model_break(&a), FE_OK);
+        ck_assert_int_eq(fe_model_add(&a, &rows[i]), FE_OK);
+        rig_predict(&rows[i], theta0, &y[i], NULL);
+    }
+    ck_assert_int_eq(fe_model_break(&a), FE_OK);
+    M = 3 + c.count;
+    dim = M + 1;
+    memset(want, 0, sizeof want);
+    for (size_t i = 0; i < N; i++) {
+        size_t lo = i < NB ? 0 : NB, hi = i < NB ? NB - 1 : N - 1;
+        size_t i0 = i > lo ? i - 1 : i, i1 = i < hi ? i + 1 : i;
+        fe_sample row = rows[i];
+        double z[FE_DISCOVER_MAX_COLUMNS + 1];
+        row.sim = y[i];
+        row.dsim = (y[i1] - y[i0]) / (rows[i1].t - rows[i0].t);
+        rig_jacobian(&rows[i], theta0, z, NULL);
+        ck_assert_int_eq(fe_catalog_eval(&c, &row, z + 3), FE_OK);
+        z[M] = rows[i].real - y[i];
+        for (size_t u = 0; u < dim; u++)
+            for (size_t v = 0; v < dim; v++)
+                want[u][v] += (long double)z[u] * z[v];
+    }
+    for (size_t u = 0; u < dim; u++)
+        for (size_t v = u; v < dim; v++) {
+            double got = 0.0;
+            for (size_t k = 0; k < K; k++)
+                got += a.acc.gram[k * dim * dim + u * dim + v];
+            ck_assert_msg(fabs(got - (double)want[u][v])
+                              <= 1e-10 * sqrt((double)(want[u][u] * want[v][v])) + 1e-300,
+                          "gram[%zu][%zu] = %.17g, want %.17g", u, v, got, (double)want[u][v]);
+        }
+    free(st);
+}
+END_TEST
+
 START_TEST(finite_difference_steps_and_calls)
 {
     /* The step is eps^(1/3) max(|theta|, typical), exactly representable
@@ -403,6 +482,10 @@ START_TEST(arguments_and_failing_callbacks)
     ck_assert_int_eq(fe_model_add(&a, &s), FE_ESTOPPED);
     a.model.jacobian = nan_jacobian;
     ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
+    a.model.jacobian = nan0_jacobian;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
+    a.model.jacobian = inf1_jacobian;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
     a.model.jacobian = NULL;
     a.model.predict = failing_away_predict;
     ck_assert_int_eq(fe_model_add(&a, &s), FE_ESTOPPED);
@@ -496,6 +579,7 @@ Suite *fe_model_suite(void)
     TCase *t = tcase_create("model");
     tcase_set_timeout(t, 600);
     tcase_add_test(t, finite_difference_steps_and_calls);
+    tcase_add_test(t, the_fold_is_its_rows);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, arguments_and_failing_callbacks);
     tcase_add_test(t, analytic_and_numerical_jacobians_discover_the_same);
