@@ -909,13 +909,18 @@ START_TEST(sessions_start_at_the_centroids)
     ck_assert_double_eq_tol(x[9], -4.0, 1e-15);
     ck_assert_double_eq_tol(x[10], 0.0, 1e-15);
     ck_assert_double_eq_tol(x[11], 5.0, 1e-15);
-    /* One offset for both: the mean of the centroids, (-1.5, 1, 4). */
+    /* One offset for both: the mean of the centroids, (-1.5, 1, 4); the
+       start is 9 numbers, and what follows them is not written. */
     c.one_offset = 1;
+    for (int k = 9; k < 12; k++)
+        x[k] = 99.0;
     fe_sessions_start(&c, x);
     ck_assert_double_eq_tol(x[0], s, 1e-15);
     ck_assert_double_eq_tol(x[6], -1.5, 1e-15);
     ck_assert_double_eq_tol(x[7], 1.0, 1e-15);
     ck_assert_double_eq_tol(x[8], 4.0, 1e-15);
+    for (int k = 9; k < 12; k++)
+        ck_assert_double_eq(x[k], 99.0);
 }
 END_TEST
 

@@ -189,6 +189,25 @@ START_TEST(chi_square_quantile_far_in_the_lower_tail)
 }
 END_TEST
 
+START_TEST(incomplete_beta_on_both_sides_of_its_switch)
+{
+    /* I_x(a, b) against mpmath 1.3 (betainc, regularized, 40 digits), at
+       and above the mean (a + 1) / (a + b + 2), where the continued
+       fraction is taken for 1 - I_x(b, a) and converges fast, and below
+       it. */
+    static const double ref[][4] = {
+        {500, 500, 0.55, 0.99923632106047350918},
+        {50, 3, 0.99, 0.98464737426634086262},
+        {2000, 10, 0.998, 0.99169423191736340482},
+        {0.5, 0.5, 0.9, 0.79516723530086657191},
+        {30, 30, 0.7, 0.99936156208526031872},
+        {30, 30, 0.3, 0.00063843791473967910199},
+    };
+    for (size_t i = 0; i < sizeof ref / sizeof ref[0]; i++)
+        FE_ASSERT_REL(fe_beta_inc(ref[i][0], ref[i][1], ref[i][2]), ref[i][3], 1e-13);
+}
+END_TEST
+
 START_TEST(chi2_upper_large_degrees_of_freedom)
 {
     const double *c = chi2_reference[_i];
@@ -207,6 +226,7 @@ Suite *fe_special_suite(void)
     tcase_add_test(t, bad_arguments_give_nan);
     tcase_add_test(t, digamma_and_trigamma_closed_forms);
     tcase_add_test(t, chi_square_quantile_far_in_the_lower_tail);
+    tcase_add_test(t, incomplete_beta_on_both_sides_of_its_switch);
     tcase_add_loop_test(t, chi2_upper_large_degrees_of_freedom, 0,
                         (int)(sizeof chi2_reference / sizeof chi2_reference[0]));
     suite_add_tcase(s, t);
