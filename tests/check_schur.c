@@ -262,11 +262,43 @@ START_TEST(shapes_and_degenerate_dimensions)
 }
 END_TEST
 
+START_TEST(merge_refuses_an_overflow_in_any_local_diagonal)
+{
+    /* One global and two local parameters in one block: each part holds
+       V_11 = 2.5e307 (the largest diagonal either may hold is DBL_MAX / 4,
+       4.49e307), whose sum would pass it; V_00 = 1 stays small. */
+    static double sa[256], sb[256], before[256];
+    fe_schur a, b, a0;
+    size_t n = fe_schur_storage(1, 2, 1);
+    const double jg[1] = {0.0}, jl[2] = {1.0, 5e153};
+    ck_assert_uint_le(n, 256);
+    ck_assert_int_eq(fe_schur_init(&a, 1, 2, 1, sa), FE_OK);
+    ck_assert_int_eq(fe_schur_init(&b, 1, 2, 1, sb), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&a, jg, 0, jl, 0.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&b, jg, 0, jl, 0.0, 1.0), FE_OK);
+    a0 = a;
+    memcpy(before, sa, n * sizeof *sa);
+    ck_assert_int_eq(fe_schur_merge(&a, &b), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &a0, sizeof a);
+    ck_assert_mem_eq(sa, before, n * sizeof *sa);
+    /* At 2e307 each, the sum 4e307 is kept. */
+    {
+        const double small[2] = {1.0, sqrt(2e307)};
+        ck_assert_int_eq(fe_schur_init(&a, 1, 2, 1, sa), FE_OK);
+        ck_assert_int_eq(fe_schur_init(&b, 1, 2, 1, sb), FE_OK);
+        ck_assert_int_eq(fe_schur_add(&a, jg, 0, small, 0.0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_schur_add(&b, jg, 0, small, 0.0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_schur_merge(&a, &b), FE_OK);
+    }
+}
+END_TEST
+
 Suite *fe_schur_suite(void)
 {
     Suite *s = suite_create("schur");
     TCase *t = tcase_create("arrow");
     tcase_set_timeout(t, 120);
+    tcase_add_test(t, merge_refuses_an_overflow_in_any_local_diagonal);
     tcase_add_test(t, elimination_equals_dense_and_qr);
     tcase_add_test(t, damped_elimination_equals_damped_dense);
     tcase_add_test(t, merge_every_split_equals_the_whole);
