@@ -115,6 +115,27 @@ START_TEST(three_algorithms_agree)
         fe_quadric_add_many(&q, x, n, NULL);
         ck_assert_int_eq(fe_sphere_cost(&q, &streaming, &rss), FE_OK);
         FE_ASSERT_REL(rss, streaming.rss, 1e-8);
+        rss = 5.0;
+        ck_assert_int_eq(fe_sphere_cost(NULL, &streaming, &rss), FE_EINVAL);
+        ck_assert_int_eq(fe_sphere_cost(&q, NULL, &rss), FE_EINVAL);
+        ck_assert_int_eq(fe_sphere_cost(&q, &streaming, NULL), FE_EINVAL);
+        ck_assert_double_eq(rss, 5.0);
+    }
+    /* A sphere's or an axial ellipsoid's matrix is diag(1 / s_j): its
+       entries' standard errors are se(s_j) / s_j^2 (delta method) on the
+       diagonal and 0 off it, where nothing is estimated. */
+    if (model != FE_FIT_ELLIPSOID) {
+        int p = streaming.nparams;
+        for (int i = 0; i < 9; i++) {
+            if (i % 4 == 0) {
+                int k = model == FE_FIT_SPHERE ? 3 : 3 + i / 4;
+                double sj = streaming.params[k];
+                FE_ASSERT_REL(streaming.matrix_se[i], sqrt(streaming.cov[k * p + k]) / (sj * sj),
+                              1e-12);
+            } else {
+                ck_assert_double_eq(streaming.matrix_se[i], 0.0);
+            }
+        }
     }
 }
 END_TEST
