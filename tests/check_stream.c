@@ -97,6 +97,15 @@ START_TEST(fd_source_reads_records_through_a_small_buffer)
     a = (fe_meanvar)FE_MEANVAR_EMPTY;
     ck_assert_int_eq(fe_fold_source(&f, &a, &src, NULL), FE_OK);
     ck_assert_uint_eq(a.n, 1000);
+    /* A buffer of 20 bytes holds two and a half records: the half is
+       moved to the front before the next read, and every value arrives. */
+    ck_assert_int_eq(lseek(fd, 0, SEEK_SET), 0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, fd, sizeof(double), buf, 20), FE_OK);
+    for (int i = 0; i < 1000; i++) {
+        const void *obs;
+        ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+        ck_assert_double_eq(*(const double *)obs, x[i]);
+    }
     /* A truncated last record is an error, after the whole records. */
     ck_assert_int_eq(write(fd, x, 3), 3);
     ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
