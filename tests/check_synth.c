@@ -83,6 +83,19 @@ START_TEST(rows_carry_the_central_difference_of_sim)
                           "%s row %zu: dsim %.17g, want %.17g", cases[c].effect, i, row[i].dsim,
                           want);
         }
+        /* The noise's sd: noise_sd, in 0.1 % of the channel's span (the
+           simulated channel over all the rows) when order > 0. */
+        {
+            double lo = row[0].sim, hi = row[0].sim;
+            for (size_t i = 1; i < N; i++) {
+                lo = fmin(lo, row[i].sim);
+                hi = fmax(hi, row[i].sim);
+            }
+            if (cases[c].order > 0)
+                FE_ASSERT_REL(g.sigma, spec.noise_sd * 1e-3 * (hi - lo), 1e-12);
+            else
+                ck_assert_double_eq(g.sigma, spec.noise_sd);
+        }
     }
 }
 END_TEST
