@@ -305,7 +305,7 @@ accept-dynamics: all $(B)/accept/gen_dyn
 # See tests/mutate/README.md.
 MUTANTS        ?= 0
 SEED           ?= 1
-MUTATE_EXCLUDE ?= discover
+MUTATE_EXCLUDE ?=
 MUTATE_MIN     ?= 0
 mutate: lib cli $(B)/tests/suites.h
 	python3 tests/mutate/mutate.py --mutants $(MUTANTS) --seed $(SEED) --exclude '$(MUTATE_EXCLUDE)' \

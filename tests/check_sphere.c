@@ -357,6 +357,21 @@ START_TEST(algebraic_sphere_on_its_own)
         f.refusal = FE_SPHERE_ACCEPTED;
         ck_assert_int_eq(fe_sphere_fit_algebraic(&q, NULL, &f), FE_EUNDETERMINED);
         ck_assert_int_eq(f.refusal, FE_SPHERE_PLANAR);
+        /* With the planarity test off (min_planarity 0), a box of no
+           extent along the axis is still refused as planar, by each fit. */
+        {
+            fe_sphere_options o = fe_sphere_default_options();
+            o.min_planarity = 0.0;
+            f.refusal = FE_SPHERE_ACCEPTED;
+            ck_assert_int_eq(fe_sphere_fit_algebraic(&q, &o, &f), FE_EUNDETERMINED);
+            ck_assert_int_eq(f.refusal, FE_SPHERE_PLANAR);
+            for (int model = 0; model < 3; model++) {
+                f.refusal = FE_SPHERE_ACCEPTED;
+                ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, &o, &f),
+                                 FE_EUNDETERMINED);
+                ck_assert_int_eq(f.refusal, FE_SPHERE_PLANAR);
+            }
+        }
     }
 }
 END_TEST
