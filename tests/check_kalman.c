@@ -1488,12 +1488,37 @@ START_TEST(chi_square_quantiles)
 }
 END_TEST
 
+START_TEST(fast_update_refuses_a_singular_z_whose_whitened_row_is_infinite)
+{
+    /* One state, two observations of it (A = (1, 2)) with Z = [1 1; 1 1]:
+       the Cholesky's second pivot is 1 - 1 = 0 and the second whitened
+       row (2 - 1) / 0 infinite, not NaN; the fast update promises
+       FE_ENOTPD for a Z that is not positive definite, with the filter
+       unchanged (the reference update takes the packet: D = A P A^T + Z is
+       positive definite). */
+    kf f;
+    const double x0 = 0.5, A[2] = {1, 2}, z[2] = {1, 3}, Z[4] = {1, 1, 1, 1};
+    double snap[2];
+    fe_kalman desc;
+    fe_kalman_obs o = {2, A, z, Z};
+    kf_make(&f, 1, 2);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, &x0, 4.0), FE_OK);
+    memcpy(snap, f.mem, sizeof snap);
+    desc = f.k;
+    ck_assert_int_eq(fe_kalman_update_fast(&f.k, &o, NULL), FE_ENOTPD);
+    ASSERT_UNCHANGED(f, snap, desc);
+    ck_assert_int_eq(fe_kalman_update(&f.k, &o, NULL), FE_OK);
+    kf_free(&f);
+}
+END_TEST
+
 Suite *fe_kalman_suite(void)
 {
     Suite *s = suite_create("kalman");
     TCase *t = tcase_create("core");
     tcase_set_timeout(t, 120);
     tcase_add_test(t, least_squares_5x4);
+    tcase_add_test(t, fast_update_refuses_a_singular_z_whose_whitened_row_is_infinite);
     tcase_add_test(t, mean_is_a_kalman_filter);
     tcase_add_test(t, update_matches_textbook_for_b_ne_n);
     tcase_add_test(t, row_major_dposv_needs_ldb_nrhs);
