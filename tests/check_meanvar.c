@@ -116,6 +116,17 @@ START_TEST(empty_and_single)
     ck_assert_double_eq(a.mean, 3.5);
     ck_assert_int_eq(fe_meanvar_merge(&e, &a), FE_OK);
     ck_assert_double_eq(e.mean, 3.5);
+    /* Each missing argument alone, nothing changed. */
+    ck_assert_int_eq(fe_meanvar_merge(NULL, &a), FE_EINVAL);
+    ck_assert_int_eq(fe_meanvar_merge(&a, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_meanvar_add_many(NULL, ten, 10, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    done = 7;
+    ck_assert_int_eq(fe_meanvar_add_many(&a, NULL, 3, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_int_eq(fe_meanvar_add_many(&a, NULL, 0, &done), FE_OK);
+    ck_assert_uint_eq(a.n, 1);
+    ck_assert_double_eq(a.mean, 3.5);
 }
 END_TEST
 

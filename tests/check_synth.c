@@ -35,6 +35,10 @@ START_TEST(spec_refusals_at_their_edges)
     s.effect = NULL;
     ck_assert_int_eq(fe_synth_init(&g, &s), FE_EINVAL);
     ck_assert_int_eq(fe_synth_init(NULL, &s), FE_EINVAL);
+    /* A valid spec without a generator, and no spec. */
+    s = fe_synth_default_spec("quadratic_drag", 3);
+    ck_assert_int_eq(fe_synth_init(NULL, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_synth_init(&g, NULL), FE_EINVAL);
     /* The rig of each order: order 2 is the cart, with no temperature for
        a thermal effect; order 1 the stand, with no velocity for a
        friction; order 0 takes either; no order above 2. */
