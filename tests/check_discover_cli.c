@@ -41,7 +41,8 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s --json --report %s/rep",
              FE_TEST_CLI, dir, dir, roles, dir);
     ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
-    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\"") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch explained\", \"why\": null") != NULL, "%s",
+                  out);
     ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"quadratic_drag\"") != NULL, "%s", out);
     {
         char path[256];
@@ -232,8 +233,9 @@ START_TEST(a_function_of_the_state_left_is_not_explained)
     snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y "
              "--role v=velocity --json", FE_TEST_CLI, dir, dir);
     ck_assert_int_eq(fe_test_run(cmd, 1, out, sizeof out), 0);
-    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch not explained by the catalog\"") != NULL,
-                  "%s", out);
+    ck_assert_msg(strstr(out, "\"verdict\": \"mismatch not explained by the catalog\", \"why\": "
+                              "\"terms were found, but ") != NULL,
+                  "%.300s", out);
     ck_assert_msg(strstr(out, "\"probes\": {\"tested\": 7, \"variable\": \"velocity\"") != NULL,
                   "%s", out);
     ck_assert_msg(strstr(out, "\"name\": \"drift\"") != NULL, "%s", out);

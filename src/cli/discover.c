@@ -1181,7 +1181,12 @@ static void fe__json_path(FILE *f, const fe__outcome *o)
 static void fe__print_json(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
-    fprintf(f, "{\"verdict\": \"%s\", \"set_aside\": [", o->verdict);
+    fprintf(f, "{\"verdict\": \"%s\", \"why\": ", o->verdict);
+    if (o->why != NULL)
+        fe_cli_json_string(f, o->why);
+    else
+        fputs("null", f);
+    fprintf(f, ", \"set_aside\": [");
     for (size_t k = 0; k < r->naside; k++) {
         fprintf(f, "%s{\"name\": \"%s\", \"statistic\": ", k ? ", " : "",
                 o->c->terms[r->aside[k]].name);
