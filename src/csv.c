@@ -151,13 +151,14 @@ static int fe__csv_blank(char c)
 int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
                  size_t max, size_t *count, size_t *bad_column)
 {
-    char *p = line;
+    char *p = line, *end;
     size_t k = 0;
     int ws = delimiter == FE_CSV_WHITESPACE;
 
     if (line == NULL || count == NULL || (fields == NULL && max > 0))
         return FE_EINVAL;
     *count = 0;
+    end = line + strlen(line);
     if (ws) {
         while (fe__csv_blank(*p))
             p++;
@@ -196,8 +197,13 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
                 return FE_EPARSE;
             }
         } else {
-            while (*p != '\0' && (ws ? !fe__csv_blank(*p) : *p != delimiter))
-                p++;
+            if (!ws) {                  /* memchr: many bytes a step */
+                char *d = memchr(p, delimiter, (size_t)(end - p));
+                p = d != NULL ? d : end;
+            } else {
+                while (*p != '\0' && !fe__csv_blank(*p))
+                    p++;
+            }
             out = p;
             while (out > field_start && fe__csv_blank(out[-1]))
                 out--;
