@@ -2831,10 +2831,20 @@ static int fe__discover_sphere(fe__sphere_args *a)
     /* Report. */
     {
         const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
-        const char *verdict = res->steps > 0 ? "mismatch explained" : "no significant mismatch";
+        /* Explained when a term is named and the rows held out are not
+           predicted worse with the terms than without (locate.org). */
+        fe_verdict v = res->steps == 0 ? FE_VERDICT_NO_MISMATCH
+                       : b1->heldout_n > 0 && b1->heldout_rms > b0->heldout_rms
+                           ? FE_VERDICT_HELDOUT_WORSE
+                           : FE_VERDICT_EXPLAINED;
+        const char *verdict = fe_verdict_text(v), *why = fe_verdict_why(v);
         if (a->json) {
-            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu",
-                   verdict, rows, held);
+            printf("{\"verdict\": \"%s\", \"why\": ", verdict);
+            if (why != NULL)
+                fe_cli_json_string(stdout, why);
+            else
+                fputs("null", stdout);
+            printf(", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu", rows, held);
             fe__json_pair(stdout, "radius", fit.radius);
             printf(", \"offset\": [");
             for (int c = 0; c < 3; c++) {
@@ -2922,6 +2932,8 @@ static int fe__discover_sphere(fe__sphere_args *a)
                 printf("held out: radial RMS %.4g%% -> %.4g%%\n", 100 * b0->heldout_rms / fit.radius,
                        100 * b1->heldout_rms / fit.radius);
             printf("\nverdict: %s\n", verdict);
+            if (why != NULL)
+                printf("  (%s)\n", why);
         }
     }
     rc = FE_CLI_OK;
