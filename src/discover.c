@@ -2340,8 +2340,9 @@ static double fe__gls_dof(const fe_discover_fit *fit, const fe_discover_noise *n
 
 /* After fe__gls: the covariance of the coefficients, sigma^2 gt_SS^{-1}
    with each variance (and covariance) scaled by the long-run factors
-   when nz->long_run, into w->inv (ncols x ncols), and the standard
-   errors into se (if not NULL). */
+   when nz->long_run, into w->inv (ncols x ncols), the standard errors
+   into se and each one's degrees of freedom into dof (each if not
+   NULL). */
 static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
                         size_t ncols, const double *coef, const fe_discover_fit *fit,
                         const fe_discover_noise *nz, double *se, double *dof)
@@ -2361,16 +2362,14 @@ static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t 
     for (size_t i = 0; i < ncols; i++)
         w->inv[i * ncols + i] = 1.0;
     fe__solve(&mo, w->inv, ncols);
-    if (dof != NULL)
-        *dof = nu;
     for (size_t i = 0; i < ncols; i++) {
         double di;
         memset(w->uv, 0, dim * sizeof *w->uv);
         for (size_t k = 0; k < ncols; k++)
             w->uv[cols[k]] = w->inv[k * ncols + i];
         f[i] = fe__variance_factor(a, w, nz, w->uv, nu, &sf, &di);
-        if (dof != NULL && di < *dof)
-            *dof = di;
+        if (dof != NULL)
+            dof[i] = di < nu ? di : nu;
     }
     for (size_t i = 0; i < ncols; i++)
         for (size_t j = 0; j < ncols; j++)
@@ -2532,12 +2531,13 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     if (ar) {
         rc = fe__gls(a, w, cols, ncols, maxp, beta, fit, &nz);
         if (rc == FE_OK && st != NULL && ncols > 0)
-            fe__gls_cov(a, w, cols, ncols, beta, fit, &nz, st->stderr_, &st->dof);
+            fe__gls_cov(a, w, cols, ncols, beta, fit, &nz, st->stderr_, st->dof);
     } else {
         rc = fe__fit(a, w, cols, ncols, beta, st != NULL ? st->stderr_ : NULL, fit);
         if (rc == FE_OK && st != NULL) {
             fe__batch_noise(a, w, cols, ncols, beta, fit, &nz);
-            st->dof = (double)(a->blocks - 1);
+            for (size_t i = 0; i < ncols; i++)
+                st->dof[i] = (double)(a->blocks - 1);
         }
     }
     if (rc == FE_OK && st != NULL) {
@@ -2759,8 +2759,10 @@ int fe_discover_select(const fe_discover_acc *a,
         memcpy(res->stderr_, last->stderr_, ncols * sizeof *res->stderr_);
         res->final = last->fit;
         res->noise = last->noise;
-        res->dof = ar ? last->dof : (double)(a->blocks - 1);
-        res->t_critical = fe_student_t_quantile(0.05, res->dof);
+        for (size_t i = 0; i < ncols; i++) {
+            res->dof[i] = ar ? last->dof[i] : (double)(a->blocks - 1);
+            res->t_critical[i] = fe_student_t_quantile(0.05, res->dof[i]);
+        }
         if (!ar) {
             double ne = res->final.n_eff, n = res->final.n;
             fe_discover_fit *f[2] = {&res->baseline, &res->final};

@@ -45,6 +45,22 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
                   out);
     ck_assert_msg(strstr(out, "\"discovered\": [{\"name\": \"quadratic_drag\"") != NULL, "%s", out);
     {
+        /* The interval is the coefficient +/- Student's t at the term's
+           own degrees of freedom times its standard error. */
+        const char *d = strstr(out, "\"discovered\": [");
+        double coef, se, dof, lo, hi, t;
+        ck_assert_ptr_nonnull(d);
+        ck_assert_int_eq(sscanf(strstr(d, "\"coefficient\": "), "\"coefficient\": %lf", &coef), 1);
+        ck_assert_int_eq(sscanf(strstr(d, "\"stderr\": "), "\"stderr\": %lf", &se), 1);
+        ck_assert_int_eq(sscanf(strstr(d, "\"dof\": "), "\"dof\": %lf", &dof), 1);
+        ck_assert_int_eq(sscanf(strstr(d, "\"interval95\": "), "\"interval95\": [%lf, %lf]", &lo, &hi),
+                         2);
+        t = fe_student_t_quantile(0.05, dof);
+        ck_assert(dof > 1.0 && se > 0.0);
+        FE_ASSERT_REL(lo, coef - t * se, 1e-12);
+        FE_ASSERT_REL(hi, coef + t * se, 1e-12);
+    }
+    {
         char path[256];
         snprintf(path, sizeof path, "%s/rep/report.md", dir);
         ck_assert_int_eq(access(path, R_OK), 0);

@@ -1086,6 +1086,25 @@ static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
     return 0.0;
 }
 
+/* The half-width of the 95% interval of column col's coefficient, and
+   the degrees of freedom of that interval (its own: see discover.org);
+   0 when col is not in the final model. */
+static double fe__halfwidth_of(const fe_discover_result *r, size_t col)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (r->cols[i] == col)
+            return r->t_critical[i] * r->stderr_[i];
+    return 0.0;
+}
+
+static double fe__dof_of(const fe_discover_result *r, size_t col)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (r->cols[i] == col)
+            return r->dof[i];
+    return 0.0;
+}
+
 static void fe__json_number(FILE *f, double x)
 {
     fe_cli_json_number(f, x);   /* one format in every command (cli.org) */
@@ -1255,10 +1274,11 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         }
         fe__json_pair(f, "coefficient", coef);
         fe__json_pair(f, "stderr", se);
+        fe__json_pair(f, "dof", fe__dof_of(r, r->added[s]));
         fprintf(f, ", \"interval95\": [");
-        fe__json_number(f, coef - r->t_critical * se);
+        fe__json_number(f, coef - fe__halfwidth_of(r, r->added[s]));
         fprintf(f, ", ");
-        fe__json_number(f, coef + r->t_critical * se);
+        fe__json_number(f, coef + fe__halfwidth_of(r, r->added[s]));
         fprintf(f, "], \"statistic\": ");
         fe__json_number(f, r->added_rank[s].statistic);
         fe__json_pair(f, "p_value", r->added_rank[s].p_value);
@@ -1462,8 +1482,9 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fe__explain(o, r->added[s], coef, se, words, sizeof words);
         fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
                    "statistic %.2f, p = %.2g\n     %s\n",
-                s + 1, t->name, t->description, coef, se, coef - r->t_critical * se,
-                coef + r->t_critical * se, r->added_rank[s].statistic,
+                s + 1, t->name, t->description, coef, se,
+                coef - fe__halfwidth_of(r, r->added[s]), coef + fe__halfwidth_of(r, r->added[s]),
+                r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
         if (r->nalike[s] > 0) {
             fprintf(f, "     indistinguishable on these data from:");
