@@ -1388,6 +1388,33 @@ static double fe__quad_resid(const double *m, size_t dim, const size_t *cols,
     return s;
 }
 
+/* The final model against the baseline on the held-out rows, as a z:
+   with d = beta_final - beta_baseline (the baseline's columns come first),
+   RSS_final - RSS_baseline = Q - 2 L, Q = d^T H d and L = d^T h, h the
+   held-out rows' x_t e_t under the baseline.  Were the terms worth nothing
+   there, L would be noise of variance sigma^2 Q over what a row is worth
+   (the noise's correlation along a slow d^T x_t), so the difference is
+   divided by 2 sigma sqrt(Q / worth). */
+static double fe__heldout_z(const fe_discover_acc *a, const fe_discover_result *res)
+{
+    size_t dim = a->m + 1, K = a->blocks;
+    const double *h = a->gram + K * dim * dim;
+    const fe_discover_step *base = &res->path[0];
+    double d[FE_DISCOVER_MAX_COLUMNS] = {0}, q = 0.0, n = a->counts[K], diff, sd, worth;
+    if (!(n > 0) || res->steps == 0)
+        return NAN;
+    for (size_t i = 0; i < res->ncols; i++)
+        d[i] = res->coef[i] - (i < base->ncols ? base->coef[i] : 0.0);
+    for (size_t i = 0; i < res->ncols; i++)
+        for (size_t j = 0; j < res->ncols; j++)
+            q += d[i] * d[j] * fe__sym(h, dim, res->cols[i], res->cols[j]);
+    diff = n * (res->final.heldout_rms * res->final.heldout_rms
+                - res->baseline.heldout_rms * res->baseline.heldout_rms);
+    worth = fe_discover_row_worth(&res->noise, res->final.n);
+    sd = 2.0 * res->final.rms * sqrt((q > 0.0 ? q : 0.0) / worth);
+    return sd > 0.0 ? diff / sd : NAN;
+}
+
 /* The held-out rows' RMS under the coefficients (NaN without any). */
 static void fe__heldout(const fe_discover_acc *a, const size_t *cols, size_t ncols,
                         const double *coef, fe_discover_fit *fit)
@@ -2763,6 +2790,7 @@ int fe_discover_select(const fe_discover_acc *a,
             res->dof[i] = ar ? last->dof[i] : (double)(a->blocks - 1);
             res->t_critical[i] = fe_student_t_quantile(0.05, res->dof[i]);
         }
+        res->heldout_z = fe__heldout_z(a, res);
         if (!ar) {
             double ne = res->final.n_eff, n = res->final.n;
             fe_discover_fit *f[2] = {&res->baseline, &res->final};

@@ -395,6 +395,11 @@ typedef struct fe_discover_result {
     size_t probes_tested;
     fe_discover_rank probe;
     double probe_p;
+    /* How much worse the final model predicts the held-out rows than the
+       baseline: (RSS_final - RSS_baseline) over the held-out rows, in
+       standard deviations of that difference under the final noise model
+       (positive: worse; NaN when nothing is held out or nothing named). */
+    double heldout_z;
     /* Terms set aside: forward selection added each, and once the terms
        added after it were in, it no longer passed the test a candidate must
        pass (aside_rank: its test against the model without it); selection

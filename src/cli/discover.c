@@ -1205,6 +1205,7 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         fe_cli_json_string(f, o->why);
     else
         fputs("null", f);
+    fe__json_pair(f, "heldout_z", r->heldout_z);
     fprintf(f, ", \"set_aside\": [");
     for (size_t k = 0; k < r->naside; k++) {
         fprintf(f, "%s{\"name\": \"%s\", \"statistic\": ", k ? ", " : "",
@@ -1522,10 +1523,15 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
             r->baseline.lag1, r->final.lag1, r->final.floor,
             r->final.floor > 0 ? r->final.rms / r->final.floor : 0.0);
-    if (o->heldout > 0)
-        fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
+    if (o->heldout > 0) {
+        fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%",
                 r->baseline.heldout_rms, r->final.heldout_rms,
                 100.0 * (r->final.heldout_rms / r->baseline.heldout_rms - 1.0));
+        if (isfinite(r->heldout_z))
+            fprintf(f, "; %.2f standard deviations %s under the noise model",
+                    fabs(r->heldout_z), r->heldout_z > 0 ? "worse" : "better");
+        fprintf(f, ")\n");
+    }
     fe__story_noise(f, "final", &r->noise, r->final.n, o->blocks);
     fprintf(f, "\nverdict: %s\n", o->verdict);
     if (o->why != NULL)
