@@ -811,8 +811,7 @@ const char *fe_verdict_why(fe_verdict v)
         return "terms were found, but the rows held out are predicted worse with them than "
                "without them: what they fit does not carry over to rows they were not chosen "
                "on; they may stand in for physics the catalog lacks, or be too weak for these "
-               "rows to confirm (the held-out line above says how far beyond the noise the loss "
-               "is)";
+               "rows to confirm (the held-out z says how far beyond the noise the loss is)";
     case FE_VERDICT_DIVERGES:
         return "the residual left stays correlated (lag one 0.98 or more) at ten times its "
                "high-frequency floor or more: the trajectories diverge, as they do when the "
