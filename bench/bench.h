@@ -13,16 +13,31 @@ static inline double fe_bench_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Run the statement(s) `...` `reps` times; `best` receives the fastest time in seconds. */
+/* Run the statement(s) `...` in rounds of `reps` timings until a round's
+   fastest is within 2 % of the fastest before it (the figure is stable),
+   at most FE_BENCH_ROUNDS rounds; `best` receives the fastest time in
+   seconds.  On a busy machine the rounds go on while the figure still
+   moves. */
+#define FE_BENCH_ROUNDS 6
 #define FE_BENCH_BEST(best, reps, ...)                                      \
     do {                                                                     \
         (best) = 1e300;                                                      \
-        for (int fe_r_ = 0; fe_r_ < (reps); fe_r_++) {                       \
-            double fe_t0_ = fe_bench_now();                                  \
-            __VA_ARGS__;                                                     \
-            double fe_dt_ = fe_bench_now() - fe_t0_;                         \
-            if (fe_dt_ < (best))                                             \
-                (best) = fe_dt_;                                             \
+        for (int fe_k_ = 0; fe_k_ < FE_BENCH_ROUNDS; fe_k_++) {              \
+            double fe_round_ = 1e300;                                        \
+            int fe_stable_;                                                  \
+            for (int fe_r_ = 0; fe_r_ < (reps); fe_r_++) {                   \
+                double fe_t0_ = fe_bench_now();                              \
+                __VA_ARGS__;                                                 \
+                double fe_dt_ = fe_bench_now() - fe_t0_;                     \
+                if (fe_dt_ < fe_round_)                                      \
+                    fe_round_ = fe_dt_;                                      \
+            }                                                                \
+            fe_stable_ = fe_k_ > 0 && fe_round_ >= 0.98 * (best)             \
+                         && fe_round_ <= 1.02 * (best);                      \
+            if (fe_round_ < (best))                                          \
+                (best) = fe_round_;                                          \
+            if (fe_stable_)                                                  \
+                break;                                                       \
         }                                                                    \
     } while (0)
 

@@ -1388,6 +1388,33 @@ static double fe__quad_resid(const double *m, size_t dim, const size_t *cols,
     return s;
 }
 
+/* The final model against the baseline on the held-out rows, as a z:
+   with d = beta_final - beta_baseline (the baseline's columns come first),
+   RSS_final - RSS_baseline = Q - 2 L, Q = d^T H d and L = d^T h, h the
+   held-out rows' x_t e_t under the baseline.  Were the terms worth nothing
+   there, L would be noise of variance sigma^2 Q over what a row is worth
+   (the noise's correlation along a slow d^T x_t), so the difference is
+   divided by 2 sigma sqrt(Q / worth). */
+static double fe__heldout_z(const fe_discover_acc *a, const fe_discover_result *res)
+{
+    size_t dim = a->m + 1, K = a->blocks;
+    const double *h = a->gram + K * dim * dim;
+    const fe_discover_step *base = &res->path[0];
+    double d[FE_DISCOVER_MAX_COLUMNS] = {0}, q = 0.0, n = a->counts[K], diff, sd, worth;
+    if (!(n > 0) || res->steps == 0)
+        return NAN;
+    for (size_t i = 0; i < res->ncols; i++)
+        d[i] = res->coef[i] - (i < base->ncols ? base->coef[i] : 0.0);
+    for (size_t i = 0; i < res->ncols; i++)
+        for (size_t j = 0; j < res->ncols; j++)
+            q += d[i] * d[j] * fe__sym(h, dim, res->cols[i], res->cols[j]);
+    diff = n * (res->final.heldout_rms * res->final.heldout_rms
+                - res->baseline.heldout_rms * res->baseline.heldout_rms);
+    worth = fe_discover_row_worth(&res->noise, res->final.n);
+    sd = 2.0 * res->final.rms * sqrt((q > 0.0 ? q : 0.0) / worth);
+    return sd > 0.0 ? diff / sd : NAN;
+}
+
 /* The held-out rows' RMS under the coefficients (NaN without any). */
 static void fe__heldout(const fe_discover_acc *a, const size_t *cols, size_t ncols,
                         const double *coef, fe_discover_fit *fit)
@@ -2340,8 +2367,9 @@ static double fe__gls_dof(const fe_discover_fit *fit, const fe_discover_noise *n
 
 /* After fe__gls: the covariance of the coefficients, sigma^2 gt_SS^{-1}
    with each variance (and covariance) scaled by the long-run factors
-   when nz->long_run, into w->inv (ncols x ncols), and the standard
-   errors into se (if not NULL). */
+   when nz->long_run, into w->inv (ncols x ncols), the standard errors
+   into se and each one's degrees of freedom into dof (each if not
+   NULL). */
 static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t *cols,
                         size_t ncols, const double *coef, const fe_discover_fit *fit,
                         const fe_discover_noise *nz, double *se, double *dof)
@@ -2361,16 +2389,14 @@ static void fe__gls_cov(const fe_discover_acc *a, const fe__ws *w, const size_t 
     for (size_t i = 0; i < ncols; i++)
         w->inv[i * ncols + i] = 1.0;
     fe__solve(&mo, w->inv, ncols);
-    if (dof != NULL)
-        *dof = nu;
     for (size_t i = 0; i < ncols; i++) {
         double di;
         memset(w->uv, 0, dim * sizeof *w->uv);
         for (size_t k = 0; k < ncols; k++)
             w->uv[cols[k]] = w->inv[k * ncols + i];
         f[i] = fe__variance_factor(a, w, nz, w->uv, nu, &sf, &di);
-        if (dof != NULL && di < *dof)
-            *dof = di;
+        if (dof != NULL)
+            dof[i] = di < nu ? di : nu;
     }
     for (size_t i = 0; i < ncols; i++)
         for (size_t j = 0; j < ncols; j++)
@@ -2532,12 +2558,13 @@ static int fe__fit_step(const fe_discover_acc *a, const fe__ws *w, int ar, size_
     if (ar) {
         rc = fe__gls(a, w, cols, ncols, maxp, beta, fit, &nz);
         if (rc == FE_OK && st != NULL && ncols > 0)
-            fe__gls_cov(a, w, cols, ncols, beta, fit, &nz, st->stderr_, &st->dof);
+            fe__gls_cov(a, w, cols, ncols, beta, fit, &nz, st->stderr_, st->dof);
     } else {
         rc = fe__fit(a, w, cols, ncols, beta, st != NULL ? st->stderr_ : NULL, fit);
         if (rc == FE_OK && st != NULL) {
             fe__batch_noise(a, w, cols, ncols, beta, fit, &nz);
-            st->dof = (double)(a->blocks - 1);
+            for (size_t i = 0; i < ncols; i++)
+                st->dof[i] = (double)(a->blocks - 1);
         }
     }
     if (rc == FE_OK && st != NULL) {
@@ -2759,8 +2786,11 @@ int fe_discover_select(const fe_discover_acc *a,
         memcpy(res->stderr_, last->stderr_, ncols * sizeof *res->stderr_);
         res->final = last->fit;
         res->noise = last->noise;
-        res->dof = ar ? last->dof : (double)(a->blocks - 1);
-        res->t_critical = fe_student_t_quantile(0.05, res->dof);
+        for (size_t i = 0; i < ncols; i++) {
+            res->dof[i] = ar ? last->dof[i] : (double)(a->blocks - 1);
+            res->t_critical[i] = fe_student_t_quantile(0.05, res->dof[i]);
+        }
+        res->heldout_z = fe__heldout_z(a, res);
         if (!ar) {
             double ne = res->final.n_eff, n = res->final.n;
             fe_discover_fit *f[2] = {&res->baseline, &res->final};

@@ -780,6 +780,8 @@ fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_ma
         return FE_VERDICT_OUT_OF_LINE;
     if (r->probes_tested > 0 && r->probe_p < alpha)
         return FE_VERDICT_STATE_LEFT;
+    if (r->final.heldout_n > 0 && r->final.heldout_rms > r->baseline.heldout_rms)
+        return FE_VERDICT_HELDOUT_WORSE;
     return FE_VERDICT_EXPLAINED;
 }
 
@@ -805,6 +807,11 @@ const char *fe_verdict_why(fe_verdict v)
         return "terms were found, but a function of the state that none of them describes "
                "still explains part of the residual (a probe of the state stands out): the "
                "catalog lacks the physics, and the terms found stand in for it";
+    case FE_VERDICT_HELDOUT_WORSE:
+        return "terms were found, but the rows held out are predicted worse with them than "
+               "without them: what they fit does not carry over to rows they were not chosen "
+               "on; they may stand in for physics the catalog lacks, or be too weak for these "
+               "rows to confirm (the held-out z says how far beyond the noise the loss is)";
     case FE_VERDICT_DIVERGES:
         return "the residual left stays correlated (lag one 0.98 or more) at ten times its "
                "high-frequency floor or more: the trajectories diverge, as they do when the "

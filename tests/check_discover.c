@@ -120,6 +120,92 @@ START_TEST(fit_matches_brute_force)
 }
 END_TEST
 
+START_TEST(each_coefficient_has_its_own_interval)
+{
+    /* Each coefficient's 95% interval uses its own degrees of freedom
+       (Satterthwaite's, from its variance factor, at most the whitened
+       regression's n - params - p), not one figure for all: t_critical[i]
+       is Student's quantile at dof[i], the final step's; under batch means
+       every one has K - 1. */
+    synth_case sc;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
+    o.base = sc.base;
+    o.nbase = sc.nbase;
+    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
+                     FE_OK);
+    ck_assert_uint_ge(r->steps, 1);
+    for (size_t i = 0; i < r->ncols; i++) {
+        double nu = r->final.n - (double)r->final.params - (double)r->noise.order;
+        ck_assert_msg(r->dof[i] > 0.0 && r->dof[i] <= nu, "%zu: dof %g, nu %g", i, r->dof[i], nu);
+        ck_assert_double_eq(r->dof[i], r->path[r->steps].dof[i]);
+        ck_assert_double_eq(r->t_critical[i], fe_student_t_quantile(0.05, r->dof[i]));
+    }
+    o.noise = FE_DISCOVER_NOISE_BATCH;
+    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
+                     FE_OK);
+    for (size_t i = 0; i < r->ncols; i++) {
+        ck_assert_double_eq(r->dof[i], 19.0);
+        ck_assert_double_eq_tol(r->t_critical[i], 2.093024054408263, 1e-12);
+    }
+    free(r);
+    free_case(&sc);
+}
+END_TEST
+
+START_TEST(heldout_z_is_the_held_out_loss_over_its_spread)
+{
+    /* heldout_z from the held-out Gram matrix equals a direct computation
+       over the held-out rows: (RSS_final - RSS_baseline) over
+       2 sigma sqrt(sum_t (d^T x_t)^2 / worth), d the change of the
+       coefficients from the baseline to the final model. */
+    synth_case sc;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_sample s;
+    double phi[FE_DISCOVER_MAX_COLUMNS], rb = 0.0, rf = 0.0, q = 0.0, worth, want;
+    size_t i = 0, fitrows;
+    fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
+    o.base = sc.base;
+    o.nbase = sc.nbase;
+    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
+                     FE_OK);
+    ck_assert_uint_ge(r->steps, 1);
+    fitrows = (size_t)sc.a.fit_rows;
+    fe_synth_rewind(&sc.g);
+    while (fe_synth_next(&sc.g, &s) == FE_OK) {
+        double eb = s.real - s.sim, ef = eb, dx = 0.0;
+        fe_catalog_eval(&sc.c, &s, phi);
+        for (size_t j = 0; j < r->ncols; j++) {
+            double b = j < r->path[0].ncols ? r->path[0].coef[j] : 0.0;
+            eb -= b * phi[r->cols[j]];
+            ef -= r->coef[j] * phi[r->cols[j]];
+            dx += (r->coef[j] - b) * phi[r->cols[j]];
+        }
+        if (i++ >= fitrows) {
+            rb += eb * eb;
+            rf += ef * ef;
+            q += dx * dx;
+        }
+    }
+    worth = fe_discover_row_worth(&r->noise, r->final.n);
+    want = (rf - rb) / (2.0 * r->final.rms * sqrt(q / worth));
+    ck_assert_msg(isfinite(r->heldout_z), "%g", r->heldout_z);
+    ck_assert_msg(fabs(r->heldout_z - want) <= 1e-6 * (1.0 + fabs(want)), "%.12g vs %.12g",
+                  r->heldout_z, want);
+    /* A right term predicts the held-out rows better: z < 0. */
+    ck_assert(r->heldout_z < 0.0);
+    /* Nothing named: NaN. */
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
+                     FE_OK);
+    ck_assert(isnan(r->heldout_z));
+    free(r);
+    free_case(&sc);
+}
+END_TEST
+
 START_TEST(score_is_the_drop_in_rss)
 {
     /* The ranking's rss_drop equals RSS(base) - RSS(base + j), for every j. */
@@ -1857,7 +1943,7 @@ START_TEST(concealed_effects_are_found_and_nulls_are_not)
                 for (size_t i = 0; i < r->ncols; i++)
                     if ((long)r->cols[i] == truth)
                         covered += fabs(r->coef[i] - sc.g.coefficient)
-                                   <= r->t_critical * r->stderr_[i];
+                                   <= r->t_critical[i] * r->stderr_[i];
                 improved += r->final.heldout_rms < r->baseline.heldout_rms;
                 /* Concealment: the effect inflates the residual RMS by at
                    most 5% over the noise alone (RMS of the fit without it). */
@@ -1889,6 +1975,8 @@ Suite *fe_discover_suite(void)
     tcase_set_timeout(t, 120);
     tcase_add_test(t, fit_matches_brute_force);
     tcase_add_test(t, score_is_the_drop_in_rss);
+    tcase_add_test(t, each_coefficient_has_its_own_interval);
+    tcase_add_test(t, heldout_z_is_the_held_out_loss_over_its_spread);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, panel_path_equals_row_path);

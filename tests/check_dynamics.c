@@ -701,8 +701,8 @@ START_TEST(a_missing_viscous_friction_is_named_with_its_coefficient)
     ck_assert_uint_eq(res.added[0], visc);
     for (size_t j = 0; j < res.ncols; j++)
         if (res.cols[j] == visc) {
-            double lo = res.coef[j] - res.t_critical * res.stderr_[j];
-            double hi = res.coef[j] + res.t_critical * res.stderr_[j];
+            double lo = res.coef[j] - res.t_critical[j] * res.stderr_[j];
+            double hi = res.coef[j] + res.t_critical[j] * res.stderr_[j];
             ck_assert_msg(lo <= truth && truth <= hi, "%g not in [%g, %g]", truth, lo, hi);
             named = 1;
         }

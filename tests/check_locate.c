@@ -932,6 +932,27 @@ START_TEST(verdict_and_row_worth)
     r->noise.portmanteau_p = 0.000999;
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_NOT_WHITE);
     r->probes_tested = 0;
+    /* Held-out rows predicted worse with the terms than without: not
+       explained; equal, or nothing held out (NaN), explained. */
+    r->noise.portmanteau_p = 0.5;
+    r->baseline.heldout_rms = 2.0;
+    r->final.heldout_n = 100;
+    r->final.heldout_rms = nextafter(2.0, 3.0);
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_HELDOUT_WORSE);
+    r->final.heldout_rms = 2.0;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    r->final.heldout_rms = 3.0;
+    r->probes_tested = 7;                   /* a probe comes first */
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_STATE_LEFT);
+    r->probes_tested = 0;
+    r->final.heldout_n = 0;
+    r->final.heldout_rms = NAN;
+    r->baseline.heldout_rms = NAN;
+    ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    ck_assert_str_eq(fe_verdict_text(FE_VERDICT_HELDOUT_WORSE),
+                     "mismatch not explained by the catalog");
+    ck_assert_ptr_nonnull(strstr(fe_verdict_why(FE_VERDICT_HELDOUT_WORSE), "held out"));
+    r->noise.portmanteau_p = 0.000999;
     ck_assert_str_eq(fe_verdict_text(FE_VERDICT_STATE_LEFT),
                      "mismatch not explained by the catalog");
     ck_assert_ptr_nonnull(strstr(fe_verdict_why(FE_VERDICT_STATE_LEFT), "function of the state"));

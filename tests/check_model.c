@@ -232,7 +232,7 @@ START_TEST(concealed_effects_are_found_through_the_model)
             for (size_t j = 0; j < mc.r->ncols; j++)
                 if ((long)mc.r->cols[j] == truth)
                     covered += fabs(mc.r->coef[j] - mc.g.coefficient)
-                               <= mc.r->t_critical * mc.r->stderr_[j];
+                               <= mc.r->t_critical[j] * mc.r->stderr_[j];
             free_case(&mc);
         }
     fprintf(stderr, "model acceptance: named first %u/%u, 95%% interval covers truth %u/%u\n",

@@ -359,7 +359,8 @@ typedef struct fe_discover_step {
                                                    (size_t)-1 */
     size_t ncols;                               /* = result's cols[0 .. ncols) */
     double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
-    double dof;                                 /* of the intervals */
+    double dof[FE_DISCOVER_MAX_COLUMNS];        /* of each coefficient's
+                                                   interval */
     fe_discover_fit fit;
     fe_discover_noise noise;
 } fe_discover_step;
@@ -380,8 +381,10 @@ typedef struct fe_discover_result {
     size_t ncols;
     size_t cols[FE_DISCOVER_MAX_COLUMNS];
     double coef[FE_DISCOVER_MAX_COLUMNS], stderr_[FE_DISCOVER_MAX_COLUMNS];
-    double t_critical;                          /* for 95% intervals */
-    double dof;                                 /* of t_critical */
+    double t_critical[FE_DISCOVER_MAX_COLUMNS]; /* each coefficient's 95%
+                                                   interval: coef +/-
+                                                   t_critical stderr_ */
+    double dof[FE_DISCOVER_MAX_COLUMNS];        /* of t_critical */
     fe_discover_fit baseline, final;
     fe_discover_noise noise;                    /* of the final model */
     fe_discover_step path[FE_DISCOVER_MAX_STEPS + 1];  /* steps + 1 */
@@ -392,6 +395,11 @@ typedef struct fe_discover_result {
     size_t probes_tested;
     fe_discover_rank probe;
     double probe_p;
+    /* How much worse the final model predicts the held-out rows than the
+       baseline: (RSS_final - RSS_baseline) over the held-out rows, in
+       standard deviations of that difference under the final noise model
+       (positive: worse; NaN when nothing is held out or nothing named). */
+    double heldout_z;
     /* Terms set aside: forward selection added each, and once the terms
        added after it were in, it no longer passed the test a candidate must
        pass (aside_rank: its test against the model without it); selection

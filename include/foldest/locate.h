@@ -221,9 +221,12 @@ typedef enum fe_verdict {
     FE_VERDICT_DIVERGES,            /* the residual left stays correlated far
                                        above its high-frequency floor: the
                                        trajectories part (output error) */
-    FE_VERDICT_STATE_LEFT           /* named, but a probe of the state still
+    FE_VERDICT_STATE_LEFT,          /* named, but a probe of the state still
                                        explains part of the residual
                                        (fe_discover_result.probe_p) */
+    FE_VERDICT_HELDOUT_WORSE        /* named, but the held-out rows are
+                                       predicted worse with the terms than
+                                       by the baseline */
 } fe_verdict;
 
 /* fe_discover_verdict: the verdict of the result r, whose map is m and

@@ -1086,6 +1086,25 @@ static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
     return 0.0;
 }
 
+/* The half-width of the 95% interval of column col's coefficient, and
+   the degrees of freedom of that interval (its own: see discover.org);
+   0 when col is not in the final model. */
+static double fe__halfwidth_of(const fe_discover_result *r, size_t col)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (r->cols[i] == col)
+            return r->t_critical[i] * r->stderr_[i];
+    return 0.0;
+}
+
+static double fe__dof_of(const fe_discover_result *r, size_t col)
+{
+    for (size_t i = 0; i < r->ncols; i++)
+        if (r->cols[i] == col)
+            return r->dof[i];
+    return 0.0;
+}
+
 static void fe__json_number(FILE *f, double x)
 {
     fe_cli_json_number(f, x);   /* one format in every command (cli.org) */
@@ -1181,7 +1200,13 @@ static void fe__json_path(FILE *f, const fe__outcome *o)
 static void fe__print_json(FILE *f, const fe__outcome *o)
 {
     const fe_discover_result *r = o->r;
-    fprintf(f, "{\"verdict\": \"%s\", \"set_aside\": [", o->verdict);
+    fprintf(f, "{\"verdict\": \"%s\", \"why\": ", o->verdict);
+    if (o->why != NULL)
+        fe_cli_json_string(f, o->why);
+    else
+        fputs("null", f);
+    fe__json_pair(f, "heldout_z", r->heldout_z);
+    fprintf(f, ", \"set_aside\": [");
     for (size_t k = 0; k < r->naside; k++) {
         fprintf(f, "%s{\"name\": \"%s\", \"statistic\": ", k ? ", " : "",
                 o->c->terms[r->aside[k]].name);
@@ -1250,10 +1275,11 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         }
         fe__json_pair(f, "coefficient", coef);
         fe__json_pair(f, "stderr", se);
+        fe__json_pair(f, "dof", fe__dof_of(r, r->added[s]));
         fprintf(f, ", \"interval95\": [");
-        fe__json_number(f, coef - r->t_critical * se);
+        fe__json_number(f, coef - fe__halfwidth_of(r, r->added[s]));
         fprintf(f, ", ");
-        fe__json_number(f, coef + r->t_critical * se);
+        fe__json_number(f, coef + fe__halfwidth_of(r, r->added[s]));
         fprintf(f, "], \"statistic\": ");
         fe__json_number(f, r->added_rank[s].statistic);
         fe__json_pair(f, "p_value", r->added_rank[s].p_value);
@@ -1457,8 +1483,9 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fe__explain(o, r->added[s], coef, se, words, sizeof words);
         fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
                    "statistic %.2f, p = %.2g\n     %s\n",
-                s + 1, t->name, t->description, coef, se, coef - r->t_critical * se,
-                coef + r->t_critical * se, r->added_rank[s].statistic,
+                s + 1, t->name, t->description, coef, se,
+                coef - fe__halfwidth_of(r, r->added[s]), coef + fe__halfwidth_of(r, r->added[s]),
+                r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
         if (r->nalike[s] > 0) {
             fprintf(f, "     indistinguishable on these data from:");
@@ -1496,10 +1523,15 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
             r->baseline.rms, r->final.rms, rel, r->baseline.bic, r->final.bic,
             r->baseline.lag1, r->final.lag1, r->final.floor,
             r->final.floor > 0 ? r->final.rms / r->final.floor : 0.0);
-    if (o->heldout > 0)
-        fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%)\n",
+    if (o->heldout > 0) {
+        fprintf(f, "held out (never seen by selection or fitting): RMS %.5g -> %.5g (%+.2f%%",
                 r->baseline.heldout_rms, r->final.heldout_rms,
                 100.0 * (r->final.heldout_rms / r->baseline.heldout_rms - 1.0));
+        if (isfinite(r->heldout_z))
+            fprintf(f, "; %.2f standard deviations %s under the noise model",
+                    fabs(r->heldout_z), r->heldout_z > 0 ? "worse" : "better");
+        fprintf(f, ")\n");
+    }
     fe__story_noise(f, "final", &r->noise, r->final.n, o->blocks);
     fprintf(f, "\nverdict: %s\n", o->verdict);
     if (o->why != NULL)
@@ -2826,10 +2858,20 @@ static int fe__discover_sphere(fe__sphere_args *a)
     /* Report. */
     {
         const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
-        const char *verdict = res->steps > 0 ? "mismatch explained" : "no significant mismatch";
+        /* Explained when a term is named and the rows held out are not
+           predicted worse with the terms than without (locate.org). */
+        fe_verdict v = res->steps == 0 ? FE_VERDICT_NO_MISMATCH
+                       : b1->heldout_n > 0 && b1->heldout_rms > b0->heldout_rms
+                           ? FE_VERDICT_HELDOUT_WORSE
+                           : FE_VERDICT_EXPLAINED;
+        const char *verdict = fe_verdict_text(v), *why = fe_verdict_why(v);
         if (a->json) {
-            printf("{\"verdict\": \"%s\", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu",
-                   verdict, rows, held);
+            printf("{\"verdict\": \"%s\", \"why\": ", verdict);
+            if (why != NULL)
+                fe_cli_json_string(stdout, why);
+            else
+                fputs("null", stdout);
+            printf(", \"model\": \"sphere\", \"n\": %zu, \"heldout_rows\": %zu", rows, held);
             fe__json_pair(stdout, "radius", fit.radius);
             printf(", \"offset\": [");
             for (int c = 0; c < 3; c++) {
@@ -2917,6 +2959,8 @@ static int fe__discover_sphere(fe__sphere_args *a)
                 printf("held out: radial RMS %.4g%% -> %.4g%%\n", 100 * b0->heldout_rms / fit.radius,
                        100 * b1->heldout_rms / fit.radius);
             printf("\nverdict: %s\n", verdict);
+            if (why != NULL)
+                printf("  (%s)\n", why);
         }
     }
     rc = FE_CLI_OK;

@@ -78,6 +78,7 @@ def score(truth, js, rc):
     names = [d["name"] for d in found]
     s["verdict"] = js.get("verdict")
     s["named"] = names
+    s["heldout_rms"] = [js["baseline"].get("heldout_rms"), js["final"].get("heldout_rms")]
     fam = truth["family"]
     if truth["truth"]:
         tnames = [t["name"] for t in truth["truth"]]
