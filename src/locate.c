@@ -764,6 +764,12 @@ double fe_residual_map_largest_after(const fe_residual_map *m, double worth)
 #define FE_DIVERGE_LAG1 0.98
 #define FE_DIVERGE_RATIO 10.0
 
+int fe_discover_heldout_worse(const fe_discover_result *r)
+{
+    return r != NULL && r->final.heldout_n > 0
+           && r->final.heldout_rms > r->baseline.heldout_rms;
+}
+
 fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_map *m,
                                size_t nlocated, double alpha)
 {
@@ -780,7 +786,7 @@ fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_ma
         return FE_VERDICT_OUT_OF_LINE;
     if (r->probes_tested > 0 && r->probe_p < alpha)
         return FE_VERDICT_STATE_LEFT;
-    if (r->final.heldout_n > 0 && r->final.heldout_rms > r->baseline.heldout_rms)
+    if (fe_discover_heldout_worse(r))
         return FE_VERDICT_HELDOUT_WORSE;
     return FE_VERDICT_EXPLAINED;
 }

@@ -71,6 +71,15 @@ static void fold_case(synth_case *sc, const char *effect, uint64_t seed, size_t 
     fold_case_probed(sc, effect, seed, rows, K, holdout, 0);
 }
 
+/* Select on sc with its base terms and the options o (base set here). */
+static void select_case(synth_case *sc, fe_discover_options *o, fe_discover_result *r)
+{
+    o->base = sc->base;
+    o->nbase = sc->nbase;
+    ck_assert_int_eq(fe_discover_select(&sc->a, sc->groups, sc->c.count, o, r, sc->work, sc->nwork),
+                     FE_OK);
+}
+
 static void free_case(synth_case *sc)
 {
     free(sc->storage);
@@ -131,10 +140,7 @@ START_TEST(each_coefficient_has_its_own_interval)
     fe_discover_options o = fe_discover_default_options();
     fe_discover_result *r = malloc(sizeof *r);
     fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
-    o.base = sc.base;
-    o.nbase = sc.nbase;
-    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
-                     FE_OK);
+    select_case(&sc, &o, r);
     ck_assert_uint_ge(r->steps, 1);
     for (size_t i = 0; i < r->ncols; i++) {
         double nu = r->final.n - (double)r->final.params - (double)r->noise.order;
@@ -143,8 +149,7 @@ START_TEST(each_coefficient_has_its_own_interval)
         ck_assert_double_eq(r->t_critical[i], fe_student_t_quantile(0.05, r->dof[i]));
     }
     o.noise = FE_DISCOVER_NOISE_BATCH;
-    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
-                     FE_OK);
+    select_case(&sc, &o, r);
     for (size_t i = 0; i < r->ncols; i++) {
         ck_assert_double_eq(r->dof[i], 19.0);
         ck_assert_double_eq_tol(r->t_critical[i], 2.093024054408263, 1e-12);
@@ -167,10 +172,7 @@ START_TEST(heldout_z_is_the_held_out_loss_over_its_spread)
     double phi[FE_DISCOVER_MAX_COLUMNS], rb = 0.0, rf = 0.0, q = 0.0, worth, want;
     size_t i = 0, fitrows;
     fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
-    o.base = sc.base;
-    o.nbase = sc.nbase;
-    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
-                     FE_OK);
+    select_case(&sc, &o, r);
     ck_assert_uint_ge(r->steps, 1);
     fitrows = (size_t)sc.a.fit_rows;
     fe_synth_rewind(&sc.g);
@@ -198,8 +200,7 @@ START_TEST(heldout_z_is_the_held_out_loss_over_its_spread)
     ck_assert(r->heldout_z < 0.0);
     /* Nothing named: NaN. */
     o.max_steps = 0;
-    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork),
-                     FE_OK);
+    select_case(&sc, &o, r);
     ck_assert(isnan(r->heldout_z));
     free(r);
     free_case(&sc);
@@ -213,11 +214,9 @@ START_TEST(score_is_the_drop_in_rss)
     fe_discover_options o = fe_discover_default_options();
     fe_discover_result *r = malloc(sizeof *r);
     fold_case(&sc, "coulomb_friction", 5, 20000, 20, 0.2);
-    o.base = sc.base;
-    o.nbase = sc.nbase;
     o.max_steps = 0;
     o.noise = FE_DISCOVER_NOISE_BATCH;
-    ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r, sc.work, sc.nwork), FE_OK);
+    select_case(&sc, &o, r);
     ck_assert_uint_eq(r->steps, 0);
     for (size_t i = 0; i < r->nranked[0]; i++) {
         size_t cols[4];
@@ -1926,10 +1925,7 @@ START_TEST(concealed_effects_are_found_and_nulls_are_not)
             fe_discover_result *r = malloc(sizeof *r);
             long truth;
             fold_case(&sc, effects[e], seed, 0, 20, 0.3);
-            o.base = sc.base;
-            o.nbase = sc.nbase;
-            ck_assert_int_eq(fe_discover_select(&sc.a, sc.groups, sc.c.count, &o, r,
-                                                sc.work, sc.nwork), FE_OK);
+            select_case(&sc, &o, r);
             if (null_case) {
                 null_runs++;
                 false_found += r->steps > 0;

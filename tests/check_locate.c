@@ -939,8 +939,11 @@ START_TEST(verdict_and_row_worth)
     r->final.heldout_n = 100;
     r->final.heldout_rms = nextafter(2.0, 3.0);
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_HELDOUT_WORSE);
+    ck_assert_int_eq(fe_discover_heldout_worse(r), 1);
+    ck_assert_int_eq(fe_discover_heldout_worse(NULL), 0);
     r->final.heldout_rms = 2.0;
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_EXPLAINED);
+    ck_assert_int_eq(fe_discover_heldout_worse(r), 0);
     r->final.heldout_rms = 3.0;
     r->probes_tested = 7;                   /* a probe comes first */
     ck_assert_int_eq(fe_discover_verdict(r, &m, 1, 0.05), FE_VERDICT_STATE_LEFT);

@@ -235,6 +235,12 @@ typedef enum fe_verdict {
 fe_verdict fe_discover_verdict(const fe_discover_result *r, const fe_residual_map *m,
                                size_t nlocated, double alpha);
 
+/* fe_discover_heldout_worse: 1 when rows were held out and the final
+   model predicts them worse than the baseline (fe_discover_verdict's last
+   test, also the whole verdict of a model without a residual map, as the
+   three-axis mode's), else 0; 0 on NULL. */
+int fe_discover_heldout_worse(const fe_discover_result *r);
+
 /* fe_verdict_text: "no significant mismatch", "mismatch explained" or
    "mismatch not explained by the catalog".  fe_verdict_why: why not
    explained when terms were named (NULL otherwise).  Static storage. */

@@ -1073,36 +1073,26 @@ static void fe__explain(const fe__outcome *o, size_t j, double coef, double se, 
         fe_dynamics_explain(o->c->terms[j].name, o->order, coef, se, words, len);
 }
 
-static double fe__coef_of(const fe_discover_result *r, size_t col, double *se)
+/* The final model's figures for column col: its coefficient, standard
+   error, the half-width of its 95% interval and that interval's degrees
+   of freedom (its own: see discover.org); zeros when col is not in the
+   final model. */
+typedef struct fe__coef {
+    double value, se, halfwidth, dof;
+} fe__coef;
+
+static fe__coef fe__coef_of(const fe_discover_result *r, size_t col)
 {
+    fe__coef c = {0.0, 0.0, 0.0, 0.0};
     for (size_t i = 0; i < r->ncols; i++)
         if (r->cols[i] == col) {
-            if (se != NULL)
-                *se = r->stderr_[i];
-            return r->coef[i];
+            c.value = r->coef[i];
+            c.se = r->stderr_[i];
+            c.halfwidth = r->t_critical[i] * r->stderr_[i];
+            c.dof = r->dof[i];
+            break;
         }
-    if (se != NULL)
-        *se = 0.0;
-    return 0.0;
-}
-
-/* The half-width of the 95% interval of column col's coefficient, and
-   the degrees of freedom of that interval (its own: see discover.org);
-   0 when col is not in the final model. */
-static double fe__halfwidth_of(const fe_discover_result *r, size_t col)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (r->cols[i] == col)
-            return r->t_critical[i] * r->stderr_[i];
-    return 0.0;
-}
-
-static double fe__dof_of(const fe_discover_result *r, size_t col)
-{
-    for (size_t i = 0; i < r->ncols; i++)
-        if (r->cols[i] == col)
-            return r->dof[i];
-    return 0.0;
+    return c;
 }
 
 static void fe__json_number(FILE *f, double x)
@@ -1264,22 +1254,22 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
     fprintf(f, "], \"discovered\": [");
     for (size_t s = 0; s < r->steps; s++) {
         const fe_term *t = &o->c->terms[r->added[s]];
-        double se, coef = fe__coef_of(r, r->added[s], &se);
+        fe__coef c = fe__coef_of(r, r->added[s]);
         char words[512];
-        fe__explain(o, r->added[s], coef, se, words, sizeof words);
+        fe__explain(o, r->added[s], c.value, c.se, words, sizeof words);
         fprintf(f, "%s{\"name\": \"%s\", \"description\": ", s ? ", " : "", t->name);
         fe_cli_json_string(f, t->description);
         if (o->expression[r->added[s]] != NULL) {
             fprintf(f, ", \"expression\": ");
             fe_cli_json_string(f, o->expression[r->added[s]]);
         }
-        fe__json_pair(f, "coefficient", coef);
-        fe__json_pair(f, "stderr", se);
-        fe__json_pair(f, "dof", fe__dof_of(r, r->added[s]));
+        fe__json_pair(f, "coefficient", c.value);
+        fe__json_pair(f, "stderr", c.se);
+        fe__json_pair(f, "dof", c.dof);
         fprintf(f, ", \"interval95\": [");
-        fe__json_number(f, coef - fe__halfwidth_of(r, r->added[s]));
+        fe__json_number(f, c.value - c.halfwidth);
         fprintf(f, ", ");
-        fe__json_number(f, coef + fe__halfwidth_of(r, r->added[s]));
+        fe__json_number(f, c.value + c.halfwidth);
         fprintf(f, "], \"statistic\": ");
         fe__json_number(f, r->added_rank[s].statistic);
         fe__json_pair(f, "p_value", r->added_rank[s].p_value);
@@ -1478,14 +1468,13 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fprintf(f, "  no candidate is significant at family-wise level %.3g\n", o->alpha);
     for (size_t s = 0; s < r->steps; s++) {
         const fe_term *t = &o->c->terms[r->added[s]];
-        double se, coef = fe__coef_of(r, r->added[s], &se);
+        fe__coef c = fe__coef_of(r, r->added[s]);
         char words[512];
-        fe__explain(o, r->added[s], coef, se, words, sizeof words);
+        fe__explain(o, r->added[s], c.value, c.se, words, sizeof words);
         fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
                    "statistic %.2f, p = %.2g\n     %s\n",
-                s + 1, t->name, t->description, coef, se,
-                coef - fe__halfwidth_of(r, r->added[s]), coef + fe__halfwidth_of(r, r->added[s]),
-                r->added_rank[s].statistic,
+                s + 1, t->name, t->description, c.value, c.se, c.value - c.halfwidth,
+                c.value + c.halfwidth, r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
         if (r->nalike[s] > 0) {
             fprintf(f, "     indistinguishable on these data from:");
@@ -2860,10 +2849,9 @@ static int fe__discover_sphere(fe__sphere_args *a)
         const fe_discover_fit *b0 = &res->baseline, *b1 = &res->final;
         /* Explained when a term is named and the rows held out are not
            predicted worse with the terms than without (locate.org). */
-        fe_verdict v = res->steps == 0 ? FE_VERDICT_NO_MISMATCH
-                       : b1->heldout_n > 0 && b1->heldout_rms > b0->heldout_rms
-                           ? FE_VERDICT_HELDOUT_WORSE
-                           : FE_VERDICT_EXPLAINED;
+        fe_verdict v = res->steps == 0              ? FE_VERDICT_NO_MISMATCH
+                       : fe_discover_heldout_worse(res) ? FE_VERDICT_HELDOUT_WORSE
+                                                        : FE_VERDICT_EXPLAINED;
         const char *verdict = fe_verdict_text(v), *why = fe_verdict_why(v);
         if (a->json) {
             printf("{\"verdict\": \"%s\", \"why\": ", verdict);
