@@ -386,6 +386,36 @@ START_TEST(three_axis_gain_is_read_from_its_coefficients)
 }
 END_TEST
 
+/* Each coordinate of the centre alone not finite (NaN, then +-infinity):
+   refused, and the catalog is left as it was; the used t1 and temperature
+   at their boundary too: refused when used, ignored when not. */
+START_TEST(three_axis_centre_refused_in_each_coordinate)
+{
+    const double b[3] = {10, -20, 30};
+    const double bads[3] = {NAN, INFINITY, -INFINITY};
+    fe_catalog_axes c, before;
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, 100.0, 1, 20.0), FE_OK);
+    memcpy(&before, &c, sizeof c);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double y[3] = {b[0], b[1], b[2]};
+            y[i] = bads[k];
+            ck_assert_msg(fe_catalog_axes_init(&c, y, 0, 0, 0, 0) == FE_ENONFINITE,
+                          "coordinate %d, value %g", i, bads[k]);
+            ck_assert_int_eq(memcmp(&c, &before, sizeof c), 0);
+        }
+    ck_assert_int_eq(fe_catalog_axes_init(&c, NULL, 0, 0, 0, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, 0, 1, NAN), FE_ENONFINITE);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, -INFINITY, 0, 0), FE_ENONFINITE);
+    ck_assert_int_eq(memcmp(&c, &before, sizeof c), 0);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, NAN, 0, INFINITY), FE_OK);
+    ck_assert_uint_eq(c.ngroups, 4);
+    ck_assert_double_eq(c.centre[0], 10.0);
+    ck_assert_double_eq(c.centre[1], -20.0);
+    ck_assert_double_eq(c.centre[2], 30.0);
+}
+END_TEST
+
 Suite *fe_catalog_suite(void)
 {
     Suite *s = suite_create("catalog");
@@ -397,6 +427,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, every_coefficient_in_words);
     tcase_add_test(t, three_axis_terms_are_their_formulas);
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);
+    tcase_add_test(t, three_axis_centre_refused_in_each_coordinate);
     suite_add_tcase(s, t);
     return s;
 }

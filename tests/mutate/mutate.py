@@ -342,6 +342,10 @@ def stripped(obj, dst):
         return f.read()
 
 
+# The bounds checks of UBSan, trapping (no run-time library to link).
+BOUNDS = ["-fsanitize=bounds", "-fsanitize-undefined-trap-on-error"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--mutants", type=int, default=0,
@@ -507,11 +511,19 @@ def main():
             h.write('#line 1 "src/%s.c"\n' % m + text)
         # A file with lane kernels (lanes.h) has a four-lane kernel that
         # this processor may never run: a mutant that survives the build
-        # as it is is built again with FE_NO_CLONES (four lanes only).
-        variants = [[]] + ([["-DFE_NO_CLONES"]] if '#include "lanes.h"' in src[m] else [])
+        # as it is is built again with FE_NO_CLONES (four lanes only).  A
+        # mutant that still survives is built once more with the bounds
+        # checks of UBSan (a trap, no run-time library): an index one past
+        # an array, which the plain build reads or writes silently and
+        # `make check`'s sanitizer build reports, then fails the suite that
+        # reaches it.
+        variants = [[]] + ([["-DFE_NO_CLONES"]] if '#include "lanes.h"' in src[m] else []) + \
+            [BOUNDS]
         verdict, by, ran = None, "", False
         for vi, extra in enumerate(variants):
             key = (m, vi)
+            if extra == BOUNDS and not ran:
+                continue                # identical in the plain build: not run
             if key not in pristine:
                 pobj = os.path.join(B, "pristine%d.o" % vi)
                 if vi == 0:
@@ -519,6 +531,20 @@ def main():
                 else:
                     sh([a.cc] + cflags + extra + ["-c", "src/%s.c" % m, "-o", pobj])
                 pristine[key] = stripped(pobj, os.path.join(B, "pristine.o"))
+                if extra == BOUNDS:
+                    # The unmutated module with bounds checks must pass its
+                    # suites too, or this build proves nothing.
+                    bad = link([pobj if x == m else o for x, o in lib_objs.items()])
+                    for s in ([] if bad else suites_of(m)):
+                        if run_suite(s, max(10.0, 10 * base[s]))[0] != 0:
+                            bad = s
+                            break
+                    if bad:
+                        print("mutate: %s with bounds checks fails %s unmutated; that build "
+                              "is not used" % (m, bad), flush=True)
+                        pristine[key] = None
+            if pristine[key] is None:
+                continue
             status, out, _ = run([a.cc] + cflags + extra + ["-c", msrc, "-o", mobj], timeout=300)
             if status != 0 and vi == 0:
                 verdict = "stillborn"
@@ -536,7 +562,8 @@ def main():
                 if status != 0:
                     verdict = "killed"
                     by = s + (" (timeout)" if status is None else "") + \
-                        (" " + " ".join(extra) if extra else "")
+                        (" (bounds checks)" if extra == BOUNDS else
+                         " " + " ".join(extra) if extra else "")
                     break
             if verdict == "killed":
                 break
