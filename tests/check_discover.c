@@ -2084,6 +2084,50 @@ START_TEST(fit_columns_sandwich_errors_match_brute_force)
 }
 END_TEST
 
+START_TEST(the_widest_accumulation_folds_and_fits)
+{
+    /* FE_DISCOVER_MAX_COLUMNS columns, lagged products kept (the default),
+       folded row by row: the fit of the first and the last column equals
+       the two-by-two normal equations over the rows, and one more column
+       is refused. */
+    enum { M = FE_DISCOVER_MAX_COLUMNS, K = 4, N = 400 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static double phi[N][M], r[N];
+    const size_t cols[2] = {0, M - 1};
+    double coef[2];
+    long double s00 = 0, s01 = 0, s11 = 0, y0 = 0, y1 = 0, det;
+    fe_discover_acc a;
+    fe_discover_fit fit;
+    fe_rng g = fe_rng_seed(77);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M + 1, K, N, 0, st, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    ck_assert_uint_eq(a.lags, FE_DISCOVER_DEFAULT_LAGS);
+    for (size_t t = 0; t < N; t++) {
+        for (size_t c = 0; c < M; c++)
+            phi[t][c] = c == 0 ? 1.0 : fe_rng_normal(&g);
+        r[t] = 0.5 - 0.25 * phi[t][M - 1] + 0.1 * fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_columns(&a, cols, 2, coef, NULL, &fit, w, nw), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        long double x = phi[t][M - 1];
+        s00 += 1;
+        s01 += x;
+        s11 += x * x;
+        y0 += r[t];
+        y1 += x * r[t];
+    }
+    det = s00 * s11 - s01 * s01;
+    FE_ASSERT_REL(coef[0], (double)((s11 * y0 - s01 * y1) / det), 1e-10);
+    FE_ASSERT_REL(coef[1], (double)((s00 * y1 - s01 * y0) / det), 1e-10);
+    free(st);
+    free(w);
+}
+END_TEST
+
 Suite *fe_discover_suite(void)
 {
     Suite *s = suite_create("discover");
@@ -2118,6 +2162,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
+    tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);
