@@ -335,6 +335,26 @@ START_TEST(too_long_line_at_the_end_and_a_read_error_while_skipping)
 }
 END_TEST
 
+/* Each missing argument of the two number parsers alone. */
+START_TEST(number_parsers_refuse_each_missing_argument)
+{
+    char text[] = "1,5", dot[] = "2.5";
+    fe_csv_field f = {text, 1}, none = {NULL, 1}, g = {dot, 1};
+    double v = -7.0;
+    ck_assert_int_eq(fe_csv_number_comma(NULL, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number_comma(&none, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number_comma(&f, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(NULL, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(&none, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(&g, NULL), FE_EINVAL);
+    ck_assert_double_eq(v, -7.0);
+    ck_assert_int_eq(fe_csv_number_comma(&f, &v), FE_OK);
+    ck_assert_double_eq(v, 1.5);
+    ck_assert_int_eq(fe_csv_number(&g, &v), FE_OK);
+    ck_assert_double_eq(v, 2.5);
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -350,6 +370,7 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, byte_order_mark_semicolons_and_read_functions);
     tcase_add_test(t, strtod_extensions_are_not_numbers);
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
+    tcase_add_test(t, number_parsers_refuse_each_missing_argument);
     suite_add_tcase(s, t);
     return s;
 }
