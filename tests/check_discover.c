@@ -1848,6 +1848,203 @@ START_TEST(a_function_of_the_state_outside_the_terms_is_probed)
 }
 END_TEST
 
+/* The long-range factor of each coefficient's variance and its degrees of
+   freedom, recomputed here from the stored rows as the chapter states
+   them (white noise: an AR model of order 0, so every level's prediction
+   is 1 and the whitening changes nothing): the fine blocks' sums of the
+   residual and of each coefficient's column made orthogonal to the
+   others, their Haar energies, the levels the model takes up (the energy
+   of an orthonormal basis of its columns), the weighted line through the
+   log ratios, and Satterthwaite's degrees of freedom. */
+enum { LR_N = 4096, LR_M = 4 };
+
+static void lr_haar(const double *x, size_t n, size_t B, double *e)
+{
+    double y[FE_DISCOVER_FINE_BLOCKS] = {0};
+    size_t J = 0;
+    for (size_t t = 0; t < n; t++)
+        y[t * B / n] += x[t];
+    for (size_t k = 0; k < B; k++)
+        y[k] /= sqrt((double)n / (double)B);
+    for (size_t len = B; len > 1; len /= 2) {
+        double sum = 0.0;
+        for (size_t i = 0; i < len / 2; i++) {
+            double d = (y[2 * i] - y[2 * i + 1]) / sqrt(2.0);
+            y[i] = (y[2 * i] + y[2 * i + 1]) / sqrt(2.0);
+            sum += d * d;
+        }
+        e[J++] = sum;
+    }
+    e[J] = y[0] * y[0];
+}
+
+START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
+{
+    static double z[LR_N][LR_M + 1], q[LR_M][LR_N], x[LR_N];
+    size_t nst = fe_discover_acc_doubles(LR_M, 20), nw = fe_discover_workspace_doubles(LR_M, 20);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_group groups[LR_M] = {{"bias", 0, 1}, {"drift", 1, 1}, {"wave", 2, 1},
+                                      {"ripple", 3, 1}};
+    size_t base[LR_M] = {0, 1, 2, 3}, B = 256, J = 8;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_discover_acc a;
+    fe_rng g = fe_rng_seed(5);
+    double G[LR_M][LR_M] = {{0}}, Gi[LR_M][LR_M], used[9] = {0}, e[9], ly[8], var[8], wt[8];
+    double rss = 0.0, nu = LR_N - LR_M, sw = 0, sx = 0, sxx = 0, sy = 0, sxy = 0, det;
+    double lnv[9], coef[9][8], walk = 0.0;
+    int line, usable = 0;
+    ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, LR_N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < LR_N; t++) {
+        double u = (double)t / LR_N;
+        walk = 0.12 * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);  /* slow, not modelled */
+        z[t][0] = 1.0;
+        z[t][1] = u;
+        z[t][2] = sin(9.0 * u);
+        z[t][3] = sin(0.47 * (double)t);                /* within the blocks */
+        z[t][4] = 0.5 + 0.3 * u + fe_rng_normal(&g) + walk;
+        ck_assert_int_eq(fe_discover_add(&a, z[t], z[t][4]), FE_OK);
+    }
+    o.base = base;
+    o.nbase = LR_M;
+    o.max_steps = 0;
+    o.max_order = 0;
+    ck_assert_int_eq(fe_discover_select(&a, groups, LR_M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->noise.order, 0);
+    ck_assert_int_eq(r->noise.long_run, 0);       /* no short-lag factor here */
+    ck_assert_uint_eq(r->noise.scales, J);
+    /* The Gram matrix, its inverse (by Gauss-Jordan) and the residual. */
+    for (size_t t = 0; t < LR_N; t++)
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                G[i][j] += z[t][i] * z[t][j];
+    {
+        double aug[LR_M][2 * LR_M];
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < 2 * LR_M; j++)
+                aug[i][j] = j < LR_M ? G[i][j] : (j - LR_M == i);
+        for (size_t c = 0; c < LR_M; c++) {
+            double piv = aug[c][c];
+            for (size_t j = 0; j < 2 * LR_M; j++)
+                aug[c][j] /= piv;
+            for (size_t i = 0; i < LR_M; i++)
+                if (i != c) {
+                    double f = aug[i][c];
+                    for (size_t j = 0; j < 2 * LR_M; j++)
+                        aug[i][j] -= f * aug[c][j];
+                }
+        }
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                Gi[i][j] = aug[i][LR_M + j];
+    }
+    for (size_t t = 0; t < LR_N; t++) {
+        double fit = 0.0;
+        for (size_t i = 0; i < LR_M; i++)
+            fit += r->coef[i] * z[t][i];
+        x[t] = z[t][LR_M] - fit;
+        rss += x[t] * x[t];
+    }
+    /* The levels the model takes up: an orthonormal basis of its columns
+       (Gram-Schmidt, twice). */
+    for (size_t c = 0; c < LR_M; c++) {
+        double nrm = 0.0, eb[9];
+        for (size_t t = 0; t < LR_N; t++)
+            q[c][t] = z[t][c];
+        for (int pass = 0; pass < 2; pass++)
+            for (size_t k = 0; k < c; k++) {
+                double d = 0.0;
+                for (size_t t = 0; t < LR_N; t++)
+                    d += q[k][t] * q[c][t];
+                for (size_t t = 0; t < LR_N; t++)
+                    q[c][t] -= d * q[k][t];
+            }
+        for (size_t t = 0; t < LR_N; t++)
+            nrm += q[c][t] * q[c][t];
+        for (size_t t = 0; t < LR_N; t++)
+            q[c][t] /= sqrt(nrm);
+        lr_haar(q[c], LR_N, B, eb);
+        for (size_t l = 0; l <= J; l++)
+            used[l] += eb[l];
+    }
+    /* The residual's levels against white noise of variance RSS / n. */
+    lr_haar(x, LR_N, B, e);
+    for (size_t i = 1; i <= J; i++) {
+        double k = (double)(B >> i) - used[i - 1];
+        wt[i - 1] = 0.0;
+        ly[i - 1] = 0.0;
+        var[i - 1] = 0.0;
+        if (!(k >= 0.5) || !(e[i - 1] > 0.0))
+            continue;
+        ly[i - 1] = log(e[i - 1] / (k * rss / LR_N)) - (fe_digamma(k / 2) - log(k / 2));
+        var[i - 1] = fe_trigamma(k / 2);
+        wt[i - 1] = 1.0 / var[i - 1];
+        sw += wt[i - 1];
+        sx += wt[i - 1] * i;
+        sxx += wt[i - 1] * i * i;
+        sy += wt[i - 1] * ly[i - 1];
+        sxy += wt[i - 1] * i * ly[i - 1];
+        usable++;
+    }
+    det = sw * sxx - sx * sx;
+    line = usable >= 2 && det > 1e-12 * sw * sxx && sw * sxy - sx * sy > 0.0;
+    ck_assert(line);                                /* the slow wave: a slope */
+    for (size_t t = 1; t <= J + 1; t++) {
+        lnv[t - 1] = 0.0;
+        for (size_t i = 1; i <= J; i++) {
+            coef[t - 1][i - 1] = wt[i - 1] * ((sxx - t * sx) + (t * sw - sx) * i) / det;
+            lnv[t - 1] += coef[t - 1][i - 1] * ly[i - 1];
+        }
+        FE_ASSERT_REL(r->noise.scale_ratio[t - 1], exp(lnv[t - 1]), 1e-9);
+    }
+    ck_assert(exp(lnv[J]) > 1.5);                    /* the slow wave shows */
+    /* Each coefficient: its column made orthogonal to the others, the
+       shares of its energy in the levels, the factor, its degrees of
+       freedom and the standard error. */
+    for (size_t c = 0; c < LR_M; c++) {
+        double energy = 0.0, lam[9], total = 0.0, F = 0.0, gd[9], lnvar = 0.0;
+        double f, parts, dof, se;
+        for (size_t t = 0; t < LR_N; t++) {
+            x[t] = 0.0;
+            for (size_t k = 0; k < LR_M; k++)
+                x[t] += Gi[k][c] * z[t][k];
+            energy += x[t] * x[t];
+        }
+        lr_haar(x, LR_N, B, lam);
+        for (size_t t = 0; t <= J; t++) {
+            lam[t] /= energy;
+            total += lam[t];
+        }
+        for (size_t t = 0; t <= J; t++) {
+            if (total > 1.0)
+                lam[t] /= total;
+            F += lam[t] * (lnv[t] > 0.0 ? exp(lnv[t]) : 1.0);
+            gd[t] = lnv[t] > 0.0 ? lam[t] * exp(lnv[t]) : 0.0;
+        }
+        if (total > 1.0)
+            total = 1.0;
+        for (size_t i = 0; i < J; i++) {
+            double d = 0.0;
+            for (size_t t = 0; t <= J; t++)
+                d += gd[t] / F * coef[t][i];
+            lnvar += d * d * var[i];
+        }
+        f = (1.0 - total) + F;
+        parts = (1.0 - total) * (1.0 - total) / nu + F * F * lnvar / 2.0;
+        dof = f * f / parts < nu ? f * f / parts : nu;
+        se = sqrt(rss / nu * Gi[c][c] * f);
+        FE_ASSERT_REL(r->stderr_[c], se, 1e-8);
+        FE_ASSERT_REL(r->dof[c], dof, 1e-8);
+        FE_ASSERT_REL(r->t_critical[c], fe_student_t_quantile(0.05, dof), 1e-8);
+        /* The slow columns lean on the coarse levels; the ripple does not. */
+        ck_assert(c == 3 ? dof == nu && f < 1.01 : dof < 20.0 && f > 2.0);
+    }
+    free(r);
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
 {
     /* r = x1 + x2 + noise, and a candidate x3 = x1 + x2 + a little of its
@@ -2161,6 +2358,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, probes_are_scored_against_the_final_model_and_never_added);
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
+    tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_set_timeout(acc, 900);
