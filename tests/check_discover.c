@@ -2038,6 +2038,24 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
         FE_ASSERT_REL(r->t_critical[c], fe_student_t_quantile(0.05, dof), 1e-8);
         /* The slow columns lean on the coarse levels; the ripple does not. */
         ck_assert(c == 3 ? dof == nu && f < 1.01 : dof < 20.0 && f > 2.0);
+        if (c == 2) {
+            /* The wave as a candidate against the other three: its test
+               uses the scale fit of the residual with it in the model,
+               so its statistic is the coefficient over this standard
+               error, at these degrees of freedom. */
+            size_t others[3] = {0, 1, 3};
+            fe_discover_result *q = malloc(sizeof *q);
+            o.base = others;
+            o.nbase = 3;
+            ck_assert_int_eq(fe_discover_select(&a, groups, LR_M, &o, q, w, nw), FE_OK);
+            ck_assert_uint_eq(q->nranked[0], 1);
+            FE_ASSERT_REL(q->ranking[0][0].statistic, r->coef[2] / se, 1e-8);
+            FE_ASSERT_REL(q->ranking[0][0].p_value,
+                          fe_student_t_two_sided(r->coef[2] / se, dof), 1e-8);
+            o.base = base;
+            o.nbase = LR_M;
+            free(q);
+        }
     }
     free(r);
     free(st);
