@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <getopt.h>
+#include <pthread.h>
 #include <zlib.h>
 
 extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
@@ -465,6 +466,8 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
             line = t->scratch;
             strcpy(line, t->pending[t->next_pending]);
             t->line = t->pending_line[t->next_pending++];
+        } else if (t->drained) {
+            return FE_END;      /* the rest went to fe_cli_table_each's batches */
         } else {
             rc = fe_csv_next_line(&t->reader, &line, &len);
             if (rc == FE_END)
@@ -514,7 +517,8 @@ static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
                         size_t k, double *out, char *err, size_t errlen)
 {
     t->bad[reason]++;
-    fe__cli_bad_total[reason]++;
+    if (!t->view)               /* a worker's view: the caller adds them */
+        fe__cli_bad_total[reason]++;
     return fe_cli_table_next(t, cols, k, out, err, errlen);
 }
 
@@ -541,6 +545,8 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
     }
     t->next_pending = 0;
     t->rows = 0;
+    t->drained = 0;
+    t->at = 0;
     return FE_CLI_OK;
 }
 
@@ -576,6 +582,410 @@ void fe_cli_table_close(fe_cli_table *t)
     t->buffer = NULL;
 }
 /* Read the next row ends here */
+/* [[file:../../literate/cli.org::Parallel Pass Private Data][Parallel Pass Private Data]] */
+enum { FE__CLI_BATCH = 1 << 20, FE__CLI_BATCH_MIN = 1 << 16, FE__CLI_SLOTS = 4 };
+
+/* One batch's rows, parsed by whichever thread claimed it. */
+typedef struct fe__cli_batch {
+    double *rows;               /* n rows of k doubles */
+    size_t *line;               /* each row's line within the batch, from 2 */
+    size_t n, cap;
+    size_t lines;               /* the lines the batch holds */
+    size_t bad[FE_CLI_BAD_REASONS];
+    off_t end;                  /* the byte after its last line */
+    int status;                 /* FE_END: all read; else the error after row n */
+    int ready;
+    char err[1024];
+} fe__cli_batch;
+
+/* The state the threads share, under `lock`. */
+typedef struct fe__cli_pass {
+    const fe_cli_table *t;      /* read-only while the pass runs */
+    const size_t *cols;
+    size_t k;
+    off_t data, size, step;     /* D, the file's size, the batch size S */
+    size_t nbatches, nslots;
+    fe__cli_batch *slot;        /* batch b in slot b % nslots */
+    pthread_mutex_t lock;
+    pthread_cond_t ready, room;
+    size_t next;                /* the first batch not claimed */
+    size_t taken;               /* batches the calling thread has taken */
+    size_t failed;              /* the first batch that failed (nbatches: none) */
+    int stop;
+} fe__cli_pass;
+
+/* A thread's buffers for the view it parses through. */
+typedef struct fe__cli_worker {
+    fe__cli_pass *pass;
+    char *buffer;
+    fe_csv_field *fields;
+    pthread_t thread;
+} fe__cli_worker;
+
+/* The byte range a batch's reader reads with pread. */
+typedef struct fe__cli_range {
+    int fd;
+    off_t at, end;
+} fe__cli_range;
+/* Parallel Pass Private Data ends here */
+/* [[file:../../literate/cli.org::Find where a batch begins][Find where a batch begins]] */
+static off_t fe__cli_batch_start(const fe__cli_pass *p, size_t b)
+{
+    char buf[4096];
+    off_t at;
+    if (b == 0)
+        return p->data;
+    if (b >= p->nbatches)
+        return p->size;
+    at = p->data + (off_t)b * p->step - 1;
+    while (at < p->size) {
+        size_t want = (size_t)(p->size - at < (off_t)sizeof buf ? p->size - at : (off_t)sizeof buf);
+        ssize_t got = pread(p->t->fd, buf, want, at);
+        const char *nl;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got <= 0)
+            return -1;
+        nl = memchr(buf, '\n', (size_t)got);
+        if (nl != NULL)
+            return at + (nl - buf) + 1;
+        at += got;
+    }
+    return p->size;
+}
+
+static long fe__cli_pread(void *ctx, char *buf, size_t n)
+{
+    fe__cli_range *r = ctx;
+    ssize_t got;
+    if ((off_t)n > r->end - r->at)
+        n = (size_t)(r->end - r->at);
+    if (n == 0)
+        return 0;
+    got = pread(r->fd, buf, n, r->at);
+    if (got > 0)
+        r->at += got;
+    else if (got == 0) {        /* the file shrank under us */
+        errno = EIO;
+        return -1;
+    }
+    return (long)got;
+}
+/* Find where a batch begins ends here */
+/* [[file:../../literate/cli.org::Parse one batch on a worker][Parse one batch on a worker]] */
+static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
+                                fe__cli_batch *s)
+{
+    const fe_cli_table *t = p->t;
+    fe__cli_range range;
+    fe_cli_table v;
+    off_t start = fe__cli_batch_start(p, b), end = fe__cli_batch_start(p, b + 1);
+
+    s->n = s->lines = 0;
+    memset(s->bad, 0, sizeof s->bad);
+    s->end = end;
+    s->err[0] = '\0';
+    if (start < 0 || end < 0) {
+        s->status = fe__cli_at(t, 1, 1, FE_CLI_IO, s->err, sizeof s->err,
+                               "read error: %s", strerror(errno));
+        return;
+    }
+    memset(&v, 0, sizeof v);
+    v.name = t->name;
+    v.fd = -1;
+    v.buffer = w->buffer;
+    v.fields = w->fields;
+    v.delimiter = t->delimiter;
+    v.ncols = t->ncols;
+    v.names = t->names;
+    v.has_header = t->has_header;
+    v.decimal_comma = t->decimal_comma;
+    v.view = 1;
+    range.fd = t->fd;
+    range.at = start;
+    range.end = end > start ? end : start;
+    fe_csv_reader_init_read(&v.reader, fe__cli_pread, &range, w->buffer, FE_CLI_LINE_MAX);
+    v.reader.line = 1;          /* not the first line: no byte-order mark */
+    for (;;) {
+        int rc;
+        if (s->n == s->cap) {
+            size_t cap = s->cap ? 2 * s->cap : 4096;
+            double *rows = realloc(s->rows, cap * (p->k + 1) * sizeof *rows);
+            size_t *line = rows != NULL ? realloc(s->line, cap * sizeof *line) : NULL;
+            if (rows != NULL)
+                s->rows = rows;
+            if (line == NULL) {
+                s->status = fe__cli_at(t, v.reader.line, 1, FE_CLI_IO, s->err, sizeof s->err,
+                                       "out of memory");
+                break;
+            }
+            s->line = line;
+            s->cap = cap;
+        }
+        rc = fe_cli_table_next(&v, p->cols, p->k, s->rows + s->n * p->k, s->err, sizeof s->err);
+        if (rc == FE_OK) {
+            s->line[s->n++] = v.line;
+            continue;
+        }
+        s->status = rc;
+        if (rc == FE_END)
+            s->lines = v.reader.line - 1;
+        break;
+    }
+    memcpy(s->bad, v.bad, sizeof s->bad);
+}
+/* Parse one batch on a worker ends here */
+/* [[file:../../literate/cli.org::Claim batches until none is left][Claim batches until none is left]] */
+/* With the lock held: the batch to parse next, or nbatches for none now. */
+static size_t fe__cli_claim(fe__cli_pass *p)
+{
+    if (p->stop || p->next >= p->nbatches || p->next > p->failed
+        || p->next >= p->taken + p->nslots)
+        return p->nbatches;
+    return p->next++;
+}
+
+/* With the lock held: parse batch b without it and publish the result. */
+static void fe__cli_fill(fe__cli_pass *p, fe__cli_worker *w, size_t b)
+{
+    fe__cli_batch *s = &p->slot[b % p->nslots];
+    pthread_mutex_unlock(&p->lock);
+    fe__cli_parse_batch(p, w, b, s);
+    pthread_mutex_lock(&p->lock);
+    s->ready = 1;
+    if (s->status != FE_END && b < p->failed)
+        p->failed = b;
+    pthread_cond_broadcast(&p->ready);
+}
+
+static void *fe__cli_worker_run(void *arg)
+{
+    fe__cli_worker *w = arg;
+    fe__cli_pass *p = w->pass;
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        size_t b = fe__cli_claim(p);
+        if (b < p->nbatches) {
+            fe__cli_fill(p, w, b);
+            continue;
+        }
+        if (p->stop || p->next >= p->nbatches || p->next > p->failed)
+            break;
+        pthread_cond_wait(&p->room, &p->lock);  /* the ring is full */
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+/* Claim batches until none is left ends here */
+/* [[file:../../literate/cli.org::Give a batch's message the file's line number][Give a batch's message the file's line number]] */
+static void fe__cli_relocate(char *err, size_t errlen, const char *name, size_t base)
+{
+    size_t n = strlen(name);
+    char *end, rest[1024];
+    unsigned long long rel;
+    if (strncmp(err, name, n) != 0 || err[n] != ':' || !isdigit((unsigned char)err[n + 1]))
+        return;
+    rel = strtoull(err + n + 1, &end, 10);
+    if (*end != ':' || rel < 1)
+        return;
+    snprintf(rest, sizeof rest, "%s", end);
+    snprintf(err + n + 1, errlen - n - 1, "%zu%s", base + (size_t)rel - 1, rest);
+}
+/* Give a batch's message the file's line number ends here */
+/* [[file:../../literate/cli.org::Decide whether to cut the file][Decide whether to cut the file]] */
+static off_t fe__cli_data_offset(const fe_cli_table *t)
+{
+    char buf[1 << 16];
+    unsigned char magic[2];
+    size_t lines = 0;
+    off_t at = 0;
+    if (t->size <= 0 || t->fd < 0 || t->view
+        || pread(t->fd, magic, 2, 0) != 2 || (magic[0] == 0x1f && magic[1] == 0x8b))
+        return 0;
+    while (lines < t->look_end && at < t->size) {
+        ssize_t got = pread(t->fd, buf, sizeof buf, at);
+        const char *q, *end;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got <= 0)
+            return 0;
+        for (q = buf, end = buf + got; lines < t->look_end
+             && (q = memchr(q, '\n', (size_t)(end - q))) != NULL; q++)
+            lines++;
+        at = lines < t->look_end ? at + got : at + (q - buf);  /* q: past the LF */
+    }
+    return lines == t->look_end ? at : 0;
+}
+/* Decide whether to cut the file ends here */
+/* [[file:../../literate/cli.org::Hand the rows out in file order][Hand the rows out in file order]] */
+static int fe__cli_each_serial(fe_cli_table *t, const size_t *cols, size_t k,
+                               double *row, fe_cli_row_fn *fn, void *ctx,
+                               char *err, size_t errlen)
+{
+    int rc;
+    while ((rc = fe_cli_table_next(t, cols, k, row, err, errlen)) == FE_OK)
+        if ((rc = fn(ctx, t, row)) != 0) {
+            err[0] = '\0';
+            return rc;
+        }
+    return rc;
+}
+
+/* Take the batches in order; the exit status, FE_END when all went well. */
+static int fe__cli_take(fe__cli_pass *p, fe__cli_worker *self, fe_cli_table *t,
+                        fe_cli_row_fn *fn, void *ctx, char *err, size_t errlen)
+{
+    size_t base = t->look_end;  /* the number of the line before the batch */
+    for (size_t b = 0; b < p->nbatches; b++) {
+        fe__cli_batch *s = &p->slot[b % p->nslots];
+        int rc;
+        pthread_mutex_lock(&p->lock);
+        while (!s->ready) {
+            size_t c = fe__cli_claim(p);
+            if (c < p->nbatches)
+                fe__cli_fill(p, self, c);
+            else
+                pthread_cond_wait(&p->ready, &p->lock);
+        }
+        pthread_mutex_unlock(&p->lock);
+        for (size_t i = 0; i < s->n; i++) {
+            t->line = base + s->line[i] - 1;
+            t->rows++;
+            if ((rc = fn(ctx, t, s->rows + i * p->k)) != 0) {
+                err[0] = '\0';
+                return rc;
+            }
+        }
+        for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
+            t->bad[r] += s->bad[r];
+            fe__cli_bad_total[r] += s->bad[r];
+        }
+        if (s->status != FE_END) {
+            fe__cli_relocate(s->err, sizeof s->err, t->name, base);
+            snprintf(err, errlen, "%s", s->err);
+            return s->status;
+        }
+        base += s->lines;
+        t->at = s->end;
+        pthread_mutex_lock(&p->lock);
+        s->ready = 0;
+        p->taken++;
+        pthread_cond_broadcast(&p->room);
+        pthread_mutex_unlock(&p->lock);
+    }
+    return FE_END;
+}
+
+int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
+                      int threads, fe_cli_row_fn *fn, void *ctx,
+                      char *err, size_t errlen)
+{
+    fe__cli_pass p;
+    fe__cli_worker *w = NULL;
+    double *row = malloc((k + 1) * sizeof *row);
+    const char *env = getenv("FOLDEST_BATCH");
+    off_t data = threads > 1 && !t->drained ? fe__cli_data_offset(t) : 0;
+    size_t nworkers = 0;
+    int rc;
+
+    err[0] = '\0';
+    if (row == NULL) {
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        return FE_CLI_IO;
+    }
+    memset(&p, 0, sizeof p);
+    p.step = (data > 0 ? t->size - data : 0) / (4 * (off_t)(threads > 1 ? threads : 1));
+    p.step = p.step > FE__CLI_BATCH ? FE__CLI_BATCH : p.step;
+    if (env != NULL && atol(env) > 0)
+        p.step = (off_t)atol(env);
+    else if (p.step < FE__CLI_BATCH_MIN)
+        p.step = data > 0 && t->size - data >= 2 * FE__CLI_BATCH_MIN ? FE__CLI_BATCH_MIN : 0;
+    if (data <= 0 || p.step <= 0 || data >= t->size) {
+        rc = fe__cli_each_serial(t, cols, k, row, fn, ctx, err, errlen);
+        free(row);
+        return rc;
+    }
+    /* The looked-ahead rows, from memory; then the batches. */
+    t->drained = 1;
+    rc = fe__cli_each_serial(t, cols, k, row, fn, ctx, err, errlen);
+    free(row);
+    if (rc != FE_END)
+        return rc;
+    p.t = t;
+    p.cols = cols;
+    p.k = k;
+    p.data = data;
+    p.size = t->size;
+    p.nbatches = (size_t)((t->size - data + p.step - 1) / p.step);
+    p.failed = p.nbatches;
+    p.nslots = FE__CLI_SLOTS * (size_t)threads;
+    p.slot = calloc(p.nslots, sizeof *p.slot);
+    w = calloc((size_t)threads, sizeof *w);
+    if (p.slot == NULL || w == NULL)
+        goto out_of_memory;
+    for (int i = 0; i < threads; i++) {
+        w[i].pass = &p;
+        w[i].buffer = malloc(FE_CLI_LINE_MAX);
+        w[i].fields = malloc(FE_CLI_FIELDS_MAX * sizeof *w[i].fields);
+        if (w[i].buffer == NULL || w[i].fields == NULL)
+            goto out_of_memory;
+    }
+    pthread_mutex_init(&p.lock, NULL);
+    pthread_cond_init(&p.ready, NULL);
+    pthread_cond_init(&p.room, NULL);
+    /* w[0] is the calling thread; a thread that cannot start is not needed. */
+    for (int i = 1; i < threads; i++)
+        if (pthread_create(&w[i].thread, NULL, fe__cli_worker_run, &w[i]) == 0)
+            nworkers = (size_t)i;
+        else
+            break;
+    rc = fe__cli_take(&p, &w[0], t, fn, ctx, err, errlen);
+    pthread_mutex_lock(&p.lock);
+    p.stop = 1;
+    pthread_cond_broadcast(&p.room);
+    pthread_mutex_unlock(&p.lock);
+    for (size_t i = 1; i <= nworkers; i++)
+        pthread_join(w[i].thread, NULL);
+    pthread_cond_destroy(&p.room);
+    pthread_cond_destroy(&p.ready);
+    pthread_mutex_destroy(&p.lock);
+    if (0) {
+out_of_memory:
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        rc = FE_CLI_IO;
+    }
+    for (size_t i = 0; p.slot != NULL && i < p.nslots; i++) {
+        free(p.slot[i].rows);
+        free(p.slot[i].line);
+    }
+    for (int i = 0; w != NULL && i < threads; i++) {
+        free(w[i].buffer);
+        free(w[i].fields);
+    }
+    free(p.slot);
+    free(w);
+    return rc;
+}
+
+int fe_cli_threads_default(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > FE_CLI_THREADS_MAX ? FE_CLI_THREADS_MAX : (int)n;
+}
+
+int fe_cli_parse_threads(const char *text, int *threads, char *err, size_t errlen)
+{
+    long n;
+    if (fe_cli_parse_long("--threads", text, &n, err, errlen) != FE_CLI_OK)
+        return FE_CLI_USAGE;
+    if (n < 1 || n > FE_CLI_THREADS_MAX) {
+        snprintf(err, errlen, "--threads: from 1 to %d", FE_CLI_THREADS_MAX);
+        return FE_CLI_USAGE;
+    }
+    *threads = (int)n;
+    return FE_CLI_OK;
+}
+/* Hand the rows out in file order ends here */
 /* [[file:../../literate/cli.org::Write output atomically][Write output atomically]] */
 /* The mode a file created with 0666 gets under the current umask. */
 static mode_t fe__cli_umask_mode(void)
@@ -803,7 +1213,7 @@ void fe_cli_progress(fe_cli_table *t)
     off_t at;
     if (!t->progress || (t->rows & 0xffff) != 0)
         return;
-    at = t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
+    at = t->at > 0 ? t->at : t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
     if (at >= 0)
         fprintf(stderr, "\r%s: %3.0f%% (%zu rows)", t->name,
                 100.0 * (double)at / (double)t->size, t->rows);
