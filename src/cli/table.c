@@ -939,6 +939,9 @@ int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
             nworkers = (size_t)i;
         else
             break;
+    if (env != NULL)            /* the tests' witness that the file was cut */
+        fprintf(stderr, "foldest: %s: %zu batches of %lld bytes on %zu threads\n", t->name,
+                p.nbatches, (long long)p.step, nworkers + 1);
     rc = fe__cli_take(&p, &w[0], t, fn, ctx, err, errlen);
     pthread_mutex_lock(&p.lock);
     p.stop = 1;
