@@ -111,8 +111,8 @@ $(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -D_POSIX_C_SOURCE=200809L -O3 -march=native -g -Iinclude -Ibench $(EXT_CFLAGS) -o $@ $< $(STATIC) $(EXT_LIBS) $(BENCH_LIBS)
 
-bench: $(BENCHES)
-	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+bench: $(BENCHES) $(CLI)
+	@for b in $(BENCHES); do echo "== $$b"; FOLDEST=$(abspath $(CLI)) $$b || exit 1; done
 
 # ---------------------------------------------------------------- MPI (optional)
 # Only these targets need Open MPI (mpicc, mpirun); libfoldest never links

@@ -93,6 +93,8 @@ static const struct thr_case cases[] = {
     {"calibrate --static", "calibrate --json --static --window 10 --still-sd 0.5", 0, "\"model\""},
     {"calibrate --robust --apply", "calibrate --robust --apply /dev/null", 0, "offset"},
     {"calibrate: a malformed row", "calibrate --json", 3, "%s:253:3: 'z' in column 'my'"},
+    {"calibrate: a sample the moments refuse", "calibrate --json", 3, "%s:203:1: "},
+    {"calibrate: a refused sample before a malformed row", "calibrate", 3, "%s:203:1: "},
 };
 
 static void write_case(const char *path, size_t which)
@@ -103,8 +105,10 @@ static void write_case(const char *path, size_t which)
     if (which >= 9) {
         fprintf(f, "Fs,50.00\nmx,my,mz\n");
         for (int i = 3; i <= 302; i++) {
-            if (which == 12 && i == 253)
+            if ((which == 12 && i == 253) || (which == 14 && i == 210))
                 fprintf(f, "1,z,3\n");
+            else if ((which == 13 || which == 14) && i == 203)
+                fprintf(f, "1e100,1,3\n");
             else
                 ellipsoid_row(f, &g, ",", "\n");
         }

@@ -363,6 +363,8 @@ typedef struct fe__calibrate_rows {
     int still, ready;           /* the gate's last verdict */
     fe__calibrate_flags *fl;    /* the first pass: --robust from stdin */
     fe_quadric_blocks *q;       /* the first pass: the moments */
+    double run[3 * 512];        /* the first pass: samples not yet folded */
+    size_t run_line[512], nrun; /* and their lines */
     fe__calibrate_visit *visit; /* the walks: each sample fitted */
     void *ctx;
     struct fe__calibrate_measure *m;   /* the second pass */
@@ -389,15 +391,34 @@ static int fe__calibrate_refused_at(fe_cli_table *t, int rc)
     return FE_CLI_INPUT;
 }
 
+/* Fold the samples waiting in the run; a refused one is reported at the
+   line it came with. */
+static int fe__calibrate_fold_run(fe__calibrate_rows *r, fe_cli_table *t)
+{
+    size_t done;
+    int rc = fe_quadric_blocks_add_many(r->q, r->run, r->nrun, &done);
+    r->nrun = 0;
+    if (rc == FE_OK)
+        return 0;
+    t->line = r->run_line[done];
+    return fe__calibrate_refused_at(t, rc);
+}
+
 static int fe__calibrate_fold_row(void *ctx, fe_cli_table *t, const double *x)
 {
     fe__calibrate_rows *r = ctx;
     double y[3];
     int rc = fe__calibrate_gate(r, x, y);
-    if (rc == FE_OK && r->ready && r->still) {
+    if (rc == FE_OK && r->ready && r->still && r->fl != NULL) {
         rc = fe_quadric_blocks_add(r->q, y);
-        if (rc == FE_OK && r->fl != NULL)
+        if (rc == FE_OK)
             fe__calibrate_flag(r->fl, r->q, y);
+    } else if (rc == FE_OK && r->ready && r->still) {
+        memcpy(r->run + 3 * r->nrun, y, sizeof y);
+        r->run_line[r->nrun++] = t->line;
+        if (r->nrun == sizeof r->run_line / sizeof r->run_line[0]
+            && (rc = fe__calibrate_fold_run(r, t)) != 0)
+            return rc;
     }
     if (rc != FE_OK)
         return fe__calibrate_refused_at(t, rc);
@@ -414,9 +435,18 @@ static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncol
     char err[1024];
     double y[3];
     int rc, still = 1;
-    fe__calibrate_rows r = {ncols, gate, 1, 1, fl, q, NULL, NULL, NULL, NULL, NULL};
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.fl = fl;
+    r.q = q;
     fe_quadric_blocks_init(q);
     rc = fe_cli_table_each(t, cols, ncols, threads, fe__calibrate_fold_row, &r, err, sizeof err);
+    /* The samples still waiting come before a malformed row. */
+    if ((rc == FE_END || err[0] != '\0') && fe__calibrate_fold_run(&r, t) != 0)
+        return FE_CLI_INPUT;
     fe_cli_progress_done(t);
     if (rc != FE_END) {
         if (err[0] != '\0')
@@ -471,7 +501,13 @@ static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
     double y[3];
     fe_cli_table t;
     int rc, still;
-    fe__calibrate_rows r = {ncols, gate, 1, 1, NULL, NULL, visit, ctx, NULL, NULL, NULL};
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.visit = visit;
+    r.ctx = ctx;
     rc = fe_cli_table_open(&t, a->path, a->skip, err, sizeof err);
     if (rc != FE_CLI_OK) {
         fprintf(stderr, "foldest calibrate: %s\n", err);
@@ -603,7 +639,8 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     fe_cli_output o;
     fe_cli_table table, *t = &table;
     int rc, still = 1;
-    fe__calibrate_rows r = {ncols, gate, 1, 1, NULL, NULL, NULL, NULL, &m, fit, sc};
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
 
     memset(out, 0, sizeof *out);
     if (strcmp(a->path, "-") == 0)
@@ -642,6 +679,12 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.m = &m;
+    r.fit = fit;
+    r.sc = sc;
     rc = fe_cli_table_each(t, cols, ncols, a->threads, fe__calibrate_measure_row, &r, err,
                            sizeof err);
     fe_cli_progress_done(t);

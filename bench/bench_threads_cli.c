@@ -1,0 +1,151 @@
+/* SPDX-License-Identifier: MIT */
+/* The command on every core (issue 16, item 1): `foldest stats` and
+   `foldest calibrate` end to end on cached files, --threads 1 against
+   --threads 2, as the ratio of their wall times (the goal on this 2-core
+   machine class: 1.8 or more).  The files are generated here and read once
+   before timing so that they are cached: a CSV of 8 numeric columns of six
+   or seven significant digits for stats, and three columns of samples on
+   an ellipsoid for calibrate (its fold and its second pass both read the
+   file).  Each figure is the best of 3 runs, repeated until stable
+   (FE_BENCH_BEST); the CPU time the runs used is printed too, so that a
+   busy machine (the share of the cores other processes used, before and
+   after) can be told from a slow program.  The command is $FOLDEST
+   (`make bench` sets it), else build/bin/foldest.  The files are removed
+   at the end. */
+#include <fcntl.h>
+#include <math.h>
+#include <spawn.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "bench.h"
+#include "foldest.h"
+
+enum { STATS_ROWS = 1000000, CAL_ROWS = 1500000, REPS = 3 };
+
+extern char **environ;
+
+static double cpu_children(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_CHILDREN, &u);
+    return (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec
+           + (double)u.ru_stime.tv_sec + 1e-6 * (double)u.ru_stime.tv_usec;
+}
+
+/* Run `foldest COMMAND --threads T FILE` with its output to /dev/null;
+   0 when it exited with status 0. */
+static int run(const char *foldest, const char *command, int threads, const char *path)
+{
+    char t[16];
+    char *argv[] = {(char *)foldest, (char *)command, "--threads", t, (char *)path, NULL};
+    posix_spawn_file_actions_t fa;
+    pid_t pid;
+    int status = -1, rc;
+    snprintf(t, sizeof t, "%d", threads);
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+    rc = posix_spawn(&pid, foldest, &fa, NULL, argv, environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0 || waitpid(pid, &status, 0) != pid)
+        return -1;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? 0 : -1;
+}
+
+static int write_stats_file(const char *path, double *bytes)
+{
+    FILE *out = fopen(path, "w");
+    fe_rng rng = fe_rng_seed(16);
+    if (out == NULL)
+        return -1;
+    fprintf(out, "c0,c1,c2,c3,c4,c5,c6,c7\n");
+    for (long i = 0; i < STATS_ROWS; i++)
+        for (int c = 0; c < 8; c++) {
+            double u = fe_rng_uniform(&rng);
+            if (c % 2)
+                fprintf(out, "%.6f%c", 2.0 * u - 1.0, c == 7 ? '\n' : ',');
+            else
+                fprintf(out, "%.2f%c", 1e4 * u, c == 7 ? '\n' : ',');
+        }
+    *bytes = (double)ftell(out);
+    return fclose(out) == 0 ? 0 : -1;
+}
+
+static int write_calibrate_file(const char *path, double *bytes)
+{
+    FILE *out = fopen(path, "w");
+    fe_rng rng = fe_rng_seed(17);
+    if (out == NULL)
+        return -1;
+    fprintf(out, "mx,my,mz\n");
+    for (long i = 0; i < CAL_ROWS; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&rng);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        fprintf(out, "%.2f,%.2f,%.2f\n", 100 + 400 * v[0] / s + fe_rng_normal(&rng),
+                -50 + 380 * v[1] / s + fe_rng_normal(&rng), 30 + 420 * v[2] / s + fe_rng_normal(&rng));
+    }
+    *bytes = (double)ftell(out);
+    return fclose(out) == 0 ? 0 : -1;
+}
+
+int main(void)
+{
+    const char *foldest = getenv("FOLDEST") != NULL ? getenv("FOLDEST") : "build/bin/foldest";
+    const char *command[2] = {"stats", "calibrate"};
+    char path[2][64] = {"/tmp/foldest-bench-thr-XXXXXX", "/tmp/foldest-bench-thr-XXXXXX"};
+    double bytes[2], wall[2][2], cpu[2][2], busy_before = fe_bench_busy_fraction(), busy_after;
+    long rows[2] = {STATS_ROWS, CAL_ROWS};
+    int status = 0;
+
+    if (access(foldest, X_OK) != 0) {
+        fprintf(stderr, "bench_threads_cli: %s: no such command (make cli)\n", foldest);
+        return 1;
+    }
+    for (int c = 0; c < 2; c++) {
+        int fd = mkstemp(path[c]);
+        if (fd < 0)
+            return 1;
+        close(fd);
+    }
+    if (write_stats_file(path[0], &bytes[0]) != 0 || write_calibrate_file(path[1], &bytes[1]) != 0)
+        status = 1;
+    for (int c = 0; c < 2 && status == 0; c++) {
+        if (run(foldest, command[c], 1, path[c]) != 0) {      /* into the cache */
+            status = 1;
+            break;
+        }
+        for (int t = 0; t < 2; t++) {
+            double c0 = cpu_children(), best;
+            int runs = 0, bad = 0;
+            FE_BENCH_BEST(best, REPS, bad |= run(foldest, command[c], t + 1, path[c]); runs++);
+            wall[c][t] = best;
+            cpu[c][t] = (cpu_children() - c0) / runs;
+            status |= bad != 0;
+        }
+    }
+    busy_after = fe_bench_busy_fraction();
+    remove(path[0]);
+    remove(path[1]);
+    if (status != 0) {
+        fprintf(stderr, "bench_threads_cli: %s failed\n", foldest);
+        return 1;
+    }
+    printf("bench_threads_cli: the command end to end on a cached file, --threads 1 and 2; "
+           "machine busy %.0f%% before, %.0f%% after (other processes' share of the cores)\n",
+           100.0 * busy_before, 100.0 * busy_after);
+    printf("%-10s %8s %9s %11s %11s %9s %9s %8s\n", "command", "MB", "rows", "1 thread s",
+           "2 threads s", "cpu 1 s", "cpu 2 s", "speedup");
+    for (int c = 0; c < 2; c++)
+        printf("%-10s %8.1f %9ld %11.3f %11.3f %9.3f %9.3f %8.2f\n", command[c], bytes[c] / 1e6,
+               rows[c], wall[c][0], wall[c][1], cpu[c][0], cpu[c][1], wall[c][0] / wall[c][1]);
+    printf("goal: speedup 1.8 or more for stats and calibrate on 2 idle cores (cpu: the mean CPU "
+           "time of a run; equal CPU times and a low speedup mean the cores were busy)\n");
+    return 0;
+}
