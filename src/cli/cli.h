@@ -57,10 +57,11 @@ typedef struct fe_cli_table {
     int view;                   /* a batch's reader on a worker thread
                                    (fe_cli_table_each): it touches no
                                    global and shows no progress */
-    int drained;                /* fe_cli_table_each read every row past
-                                   the looked-ahead ones: next is FE_END */
-    off_t at;                   /* the bytes fe_cli_table_each has handed
-                                   out, for progress; 0: ask zlib */
+    int threads;                /* parse on this many threads (0, 1: one) */
+    int serial;                 /* 1: the input cannot be cut */
+    void *pass;                 /* the threads' pass, while one runs */
+    off_t at;                   /* the bytes the batches have handed out,
+                                   for progress; 0: ask zlib */
 } fe_cli_table;
 
 /* Why a row was bad (the index of fe_cli_table.bad). */
@@ -100,15 +101,22 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
 int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
                                  char *err, size_t errlen);
 
+/* Parse a regular, uncompressed file on `threads` threads (the calling
+   one included) from the next pass on: fe_cli_table_next then hands out
+   rows parsed ahead, in file order, with the one-thread rows, lines,
+   messages and bad-row counts.  Any other input, or threads <= 1: one
+   reader, as before.  A pass must ask for the same cols (the same array,
+   which the threads read until the pass ends) and k on every call;
+   fe_cli_table_rewind and fe_cli_table_close end it. */
+void fe_cli_table_threads(fe_cli_table *t, int threads);
+
 /* The rows of a table, handed one at a time and in file order to
    fn(ctx, t, row), row[0..k-1] the columns cols[0..k-1], with t->line the
-   row's line and t->rows counting it.  A regular, uncompressed file is
-   read and parsed by `threads` threads (the calling one included); any
-   other input, or threads <= 1, by the calling thread alone.  fn runs on
-   the calling thread only, so it needs no lock.  Returns FE_END after the
-   last row; an exit status with `err` = "FILE:LINE:COLUMN: message" for
-   the first malformed row in file order; or fn's nonzero return, with err
-   empty (fn said why). */
+   row's line and t->rows counting it; parsed on `threads` threads
+   (fe_cli_table_threads).  fn runs on the calling thread only, so it
+   needs no lock.  Returns FE_END after the last row; an exit status with
+   `err` = "FILE:LINE:COLUMN: message" for the first malformed row in file
+   order; or fn's nonzero return, with err empty (fn said why). */
 typedef int fe_cli_row_fn(void *ctx, fe_cli_table *t, const double *row);
 int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
                       int threads, fe_cli_row_fn *fn, void *ctx,

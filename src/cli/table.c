@@ -453,6 +453,13 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
                         size_t k, double *out, char *err, size_t errlen);
 
+/* The threads' pass ("Every core on one file"): the next row, FE_END, an
+   error, or FE__CLI_ONE when the input cannot be cut (read it here). */
+enum { FE__CLI_ONE = -1 };
+static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
+                             double *out, char *err, size_t errlen);
+static void fe__cli_pass_end(fe_cli_table *t);
+
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen)
 {
@@ -466,8 +473,9 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
             line = t->scratch;
             strcpy(line, t->pending[t->next_pending]);
             t->line = t->pending_line[t->next_pending++];
-        } else if (t->drained) {
-            return FE_END;      /* the rest went to fe_cli_table_each's batches */
+        } else if (t->threads > 1 && !t->serial && !t->view
+                   && (rc = fe__cli_pass_next(t, cols, k, out, err, errlen)) != FE__CLI_ONE) {
+            return rc;          /* a row parsed on a thread, or the end */
         } else {
             rc = fe_csv_next_line(&t->reader, &line, &len);
             if (rc == FE_END)
@@ -545,13 +553,14 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
     }
     t->next_pending = 0;
     t->rows = 0;
-    t->drained = 0;
+    fe__cli_pass_end(t);
     t->at = 0;
     return FE_CLI_OK;
 }
 
 void fe_cli_table_close(fe_cli_table *t)
 {
+    fe__cli_pass_end(t);
     size_t nbad = t->bad[0] + t->bad[1] + t->bad[2] + t->bad[3];
     if (nbad > 0)
         fprintf(stderr, "foldest: %s: skipped %zu bad rows (%zu with an empty cell, "
@@ -585,13 +594,20 @@ void fe_cli_table_close(fe_cli_table *t)
 /* [[file:../../literate/cli.org::Parallel Pass Private Data][Parallel Pass Private Data]] */
 enum { FE__CLI_BATCH = 1 << 20, FE__CLI_BATCH_MIN = 1 << 16, FE__CLI_SLOTS = 4 };
 
+/* Rows --skip-bad-rows skipped before row `row` of a batch, by reason:
+   the counts so far (bad rows are few; the list grows as needed). */
+typedef struct fe__cli_skipped {
+    size_t row, bad[FE_CLI_BAD_REASONS];
+} fe__cli_skipped;
+
 /* One batch's rows, parsed by whichever thread claimed it. */
 typedef struct fe__cli_batch {
     double *rows;               /* n rows of k doubles */
     size_t *line;               /* each row's line within the batch, from 2 */
     size_t n, cap;
     size_t lines;               /* the lines the batch holds */
-    size_t bad[FE_CLI_BAD_REASONS];
+    fe__cli_skipped *skipped;   /* where the counts of bad rows grew */
+    size_t nskipped, skipped_cap;
     off_t end;                  /* the byte after its last line */
     int status;                 /* FE_END: all read; else the error after row n */
     int ready;
@@ -612,6 +628,12 @@ typedef struct fe__cli_pass {
     size_t taken;               /* batches the calling thread has taken */
     size_t failed;              /* the first batch that failed (nbatches: none) */
     int stop;
+    /* The calling thread's side, without the lock: the batch it hands
+       out (`have`: taken from the ring), its next row, the number of the
+       line before it, the bad rows already counted, the end. */
+    size_t cur, pos, base, bad_seen, nworkers;
+    int have, done;
+    struct fe__cli_worker *w;   /* w[0]: the calling thread's buffers */
 } fe__cli_pass;
 
 /* A thread's buffers for the view it parses through. */
@@ -673,6 +695,23 @@ static long fe__cli_pread(void *ctx, char *buf, size_t n)
 }
 /* Find where a batch begins ends here */
 /* [[file:../../literate/cli.org::Parse one batch on a worker][Parse one batch on a worker]] */
+/* Note that the bad rows before row s->n now number v->bad; -1 without
+   memory. */
+static int fe__cli_note_skipped(fe__cli_batch *s, const fe_cli_table *v)
+{
+    if (s->nskipped == s->skipped_cap) {
+        size_t cap = s->skipped_cap ? 2 * s->skipped_cap : 16;
+        fe__cli_skipped *more = realloc(s->skipped, cap * sizeof *more);
+        if (more == NULL)
+            return -1;
+        s->skipped = more;
+        s->skipped_cap = cap;
+    }
+    s->skipped[s->nskipped].row = s->n;
+    memcpy(s->skipped[s->nskipped++].bad, v->bad, sizeof v->bad);
+    return 0;
+}
+
 static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
                                 fe__cli_batch *s)
 {
@@ -680,9 +719,9 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
     fe__cli_range range;
     fe_cli_table v;
     off_t start = fe__cli_batch_start(p, b), end = fe__cli_batch_start(p, b + 1);
+    size_t skipped = 0;
 
-    s->n = s->lines = 0;
-    memset(s->bad, 0, sizeof s->bad);
+    s->n = s->lines = s->nskipped = 0;
     s->end = end;
     s->err[0] = '\0';
     if (start < 0 || end < 0) {
@@ -723,6 +762,13 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
             s->cap = cap;
         }
         rc = fe_cli_table_next(&v, p->cols, p->k, s->rows + s->n * p->k, s->err, sizeof s->err);
+        if (v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3] > skipped
+            && fe__cli_note_skipped(s, &v) != 0) {
+            s->status = fe__cli_at(t, v.reader.line, 1, FE_CLI_IO, s->err, sizeof s->err,
+                                   "out of memory");
+            break;
+        }
+        skipped = v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3];
         if (rc == FE_OK) {
             s->line[s->n++] = v.line;
             continue;
@@ -732,7 +778,6 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
             s->lines = v.reader.line - 1;
         break;
     }
-    memcpy(s->bad, v.bad, sizeof s->bad);
 }
 /* Parse one batch on a worker ends here */
 /* [[file:../../literate/cli.org::Claim batches until none is left][Claim batches until none is left]] */
@@ -818,155 +863,202 @@ static off_t fe__cli_data_offset(const fe_cli_table *t)
 }
 /* Decide whether to cut the file ends here */
 /* [[file:../../literate/cli.org::Hand the rows out in file order][Hand the rows out in file order]] */
-static int fe__cli_each_serial(fe_cli_table *t, const size_t *cols, size_t k,
-                               double *row, fe_cli_row_fn *fn, void *ctx,
-                               char *err, size_t errlen)
+void fe_cli_table_threads(fe_cli_table *t, int threads)
 {
-    int rc;
-    while ((rc = fe_cli_table_next(t, cols, k, row, err, errlen)) == FE_OK)
-        if ((rc = fn(ctx, t, row)) != 0) {
-            err[0] = '\0';
-            return rc;
-        }
-    return rc;
+    t->threads = threads;
 }
 
-/* Take the batches in order; the exit status, FE_END when all went well. */
-static int fe__cli_take(fe__cli_pass *p, fe__cli_worker *self, fe_cli_table *t,
-                        fe_cli_row_fn *fn, void *ctx, char *err, size_t errlen)
+/* Stop the workers, wait for them and free the pass. */
+static void fe__cli_pass_end(fe_cli_table *t)
 {
-    size_t base = t->look_end;  /* the number of the line before the batch */
-    for (size_t b = 0; b < p->nbatches; b++) {
-        fe__cli_batch *s = &p->slot[b % p->nslots];
-        int rc;
-        pthread_mutex_lock(&p->lock);
-        while (!s->ready) {
-            size_t c = fe__cli_claim(p);
-            if (c < p->nbatches)
-                fe__cli_fill(p, self, c);
-            else
-                pthread_cond_wait(&p->ready, &p->lock);
+    fe__cli_pass *p = t->pass;
+    if (p == NULL)
+        return;
+    pthread_mutex_lock(&p->lock);
+    p->stop = 1;
+    pthread_cond_broadcast(&p->room);
+    pthread_mutex_unlock(&p->lock);
+    for (size_t i = 1; i <= p->nworkers; i++)
+        pthread_join(p->w[i].thread, NULL);
+    pthread_cond_destroy(&p->room);
+    pthread_cond_destroy(&p->ready);
+    pthread_mutex_destroy(&p->lock);
+    for (size_t i = 0; i < p->nslots; i++) {
+        free(p->slot[i].rows);
+        free(p->slot[i].line);
+        free(p->slot[i].skipped);
+    }
+    for (size_t i = 0; i < p->nslots / FE__CLI_SLOTS; i++) {     /* the threads */
+        free(p->w[i].buffer);
+        free(p->w[i].fields);
+    }
+    free(p->slot);
+    free(p->w);
+    free(p);
+    t->pass = NULL;
+}
+
+/* Cut the file and start the workers; FE__CLI_ONE when it cannot be cut
+   (t->serial is then set), FE_CLI_IO without memory. */
+static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
+                              char *err, size_t errlen)
+{
+    const char *env = getenv("FOLDEST_BATCH");
+    off_t data = fe__cli_data_offset(t), step;
+    fe__cli_pass *p;
+    step = (data > 0 ? t->size - data : 0) / (4 * (off_t)t->threads);
+    step = step > FE__CLI_BATCH ? FE__CLI_BATCH : step;
+    if (env != NULL && atol(env) > 0)
+        step = (off_t)atol(env);
+    else if (step < FE__CLI_BATCH_MIN)
+        step = data > 0 && t->size - data >= 2 * FE__CLI_BATCH_MIN ? FE__CLI_BATCH_MIN : 0;
+    if (data <= 0 || step <= 0 || data >= t->size) {
+        t->serial = 1;
+        return FE__CLI_ONE;
+    }
+    p = calloc(1, sizeof *p);
+    if (p == NULL)
+        goto out_of_memory;
+    p->t = t;
+    p->cols = cols;
+    p->k = k;
+    p->data = data;
+    p->size = t->size;
+    p->step = step;
+    p->nbatches = (size_t)((t->size - data + step - 1) / step);
+    p->failed = p->nbatches;
+    p->nslots = FE__CLI_SLOTS * (size_t)t->threads;
+    p->base = t->look_end;
+    p->slot = calloc(p->nslots, sizeof *p->slot);
+    p->w = calloc((size_t)t->threads, sizeof *p->w);
+    if (p->slot == NULL || p->w == NULL) {
+        free(p->slot);
+        free(p->w);
+        free(p);
+        goto out_of_memory;
+    }
+    pthread_mutex_init(&p->lock, NULL);
+    pthread_cond_init(&p->ready, NULL);
+    pthread_cond_init(&p->room, NULL);
+    t->pass = p;
+    for (int i = 0; i < t->threads; i++) {
+        p->w[i].pass = p;
+        p->w[i].buffer = malloc(FE_CLI_LINE_MAX);
+        p->w[i].fields = malloc(FE_CLI_FIELDS_MAX * sizeof *p->w[i].fields);
+        if (p->w[i].buffer == NULL || p->w[i].fields == NULL) {
+            fe__cli_pass_end(t);
+            goto out_of_memory;
         }
-        pthread_mutex_unlock(&p->lock);
-        for (size_t i = 0; i < s->n; i++) {
-            t->line = base + s->line[i] - 1;
-            t->rows++;
-            if ((rc = fn(ctx, t, s->rows + i * p->k)) != 0) {
-                err[0] = '\0';
-                return rc;
-            }
-        }
+    }
+    /* w[0] is the calling thread; a thread that cannot start is not needed. */
+    for (int i = 1; i < t->threads; i++)
+        if (pthread_create(&p->w[i].thread, NULL, fe__cli_worker_run, &p->w[i]) == 0)
+            p->nworkers = (size_t)i;
+        else
+            break;
+    if (env != NULL)            /* the tests' witness that the file was cut */
+        fprintf(stderr, "foldest: %s: %zu batches of %lld bytes on %zu threads\n", t->name,
+                p->nbatches, (long long)p->step, p->nworkers + 1);
+    return FE_CLI_OK;
+out_of_memory:
+    snprintf(err, errlen, "%s: out of memory", t->name);
+    return FE_CLI_IO;
+}
+
+/* Count the bad rows skipped before row `upto` of batch s (all: SIZE_MAX). */
+static void fe__cli_count_skipped(fe__cli_pass *p, fe_cli_table *t, const fe__cli_batch *s,
+                                  size_t upto)
+{
+    while (p->bad_seen < s->nskipped && s->skipped[p->bad_seen].row <= upto) {
+        const size_t *now = s->skipped[p->bad_seen].bad;
+        const size_t *before = p->bad_seen > 0 ? s->skipped[p->bad_seen - 1].bad : NULL;
         for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
-            t->bad[r] += s->bad[r];
-            fe__cli_bad_total[r] += s->bad[r];
+            size_t d = now[r] - (before != NULL ? before[r] : 0);
+            t->bad[r] += d;
+            fe__cli_bad_total[r] += d;
         }
+        p->bad_seen++;
+    }
+}
+
+static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
+                             double *out, char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s;
+    if (p == NULL) {
+        int rc = fe__cli_pass_start(t, cols, k, err, errlen);
+        if (rc != FE_CLI_OK)
+            return rc;
+        p = t->pass;
+    }
+    if (cols != p->cols || k != p->k) {
+        snprintf(err, errlen, "%s: internal error: other columns asked for in a threaded pass",
+                 t->name);
+        return FE_CLI_IO;
+    }
+    for (;;) {
+        if (p->done || p->cur >= p->nbatches)
+            return FE_END;
+        s = &p->slot[p->cur % p->nslots];
+        if (!p->have) {         /* wait for the batch, parsing others meanwhile */
+            pthread_mutex_lock(&p->lock);
+            while (!s->ready) {
+                size_t c = fe__cli_claim(p);
+                if (c < p->nbatches)
+                    fe__cli_fill(p, &p->w[0], c);
+                else
+                    pthread_cond_wait(&p->ready, &p->lock);
+            }
+            pthread_mutex_unlock(&p->lock);
+            p->have = 1;
+            p->pos = p->bad_seen = 0;
+        }
+        if (p->pos < s->n) {
+            fe__cli_count_skipped(p, t, s, p->pos);
+            memcpy(out, s->rows + p->pos * p->k, p->k * sizeof *out);
+            t->line = p->base + s->line[p->pos++] - 1;
+            t->rows++;
+            return FE_OK;
+        }
+        fe__cli_count_skipped(p, t, s, (size_t)-1);
         if (s->status != FE_END) {
-            fe__cli_relocate(s->err, sizeof s->err, t->name, base);
+            p->done = 1;
+            fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
             snprintf(err, errlen, "%s", s->err);
             return s->status;
         }
-        base += s->lines;
+        p->base += s->lines;
         t->at = s->end;
         pthread_mutex_lock(&p->lock);
         s->ready = 0;
         p->taken++;
         pthread_cond_broadcast(&p->room);
         pthread_mutex_unlock(&p->lock);
+        p->cur++;
+        p->have = 0;
     }
-    return FE_END;
 }
 
 int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
                       int threads, fe_cli_row_fn *fn, void *ctx,
                       char *err, size_t errlen)
 {
-    fe__cli_pass p;
-    fe__cli_worker *w = NULL;
     double *row = malloc((k + 1) * sizeof *row);
-    const char *env = getenv("FOLDEST_BATCH");
-    off_t data = threads > 1 && !t->drained ? fe__cli_data_offset(t) : 0;
-    size_t nworkers = 0;
     int rc;
-
     err[0] = '\0';
     if (row == NULL) {
         snprintf(err, errlen, "%s: out of memory", t->name);
         return FE_CLI_IO;
     }
-    memset(&p, 0, sizeof p);
-    p.step = (data > 0 ? t->size - data : 0) / (4 * (off_t)(threads > 1 ? threads : 1));
-    p.step = p.step > FE__CLI_BATCH ? FE__CLI_BATCH : p.step;
-    if (env != NULL && atol(env) > 0)
-        p.step = (off_t)atol(env);
-    else if (p.step < FE__CLI_BATCH_MIN)
-        p.step = data > 0 && t->size - data >= 2 * FE__CLI_BATCH_MIN ? FE__CLI_BATCH_MIN : 0;
-    if (data <= 0 || p.step <= 0 || data >= t->size) {
-        rc = fe__cli_each_serial(t, cols, k, row, fn, ctx, err, errlen);
-        free(row);
-        return rc;
-    }
-    /* The looked-ahead rows, from memory; then the batches. */
-    t->drained = 1;
-    rc = fe__cli_each_serial(t, cols, k, row, fn, ctx, err, errlen);
-    free(row);
-    if (rc != FE_END)
-        return rc;
-    p.t = t;
-    p.cols = cols;
-    p.k = k;
-    p.data = data;
-    p.size = t->size;
-    p.nbatches = (size_t)((t->size - data + p.step - 1) / p.step);
-    p.failed = p.nbatches;
-    p.nslots = FE__CLI_SLOTS * (size_t)threads;
-    p.slot = calloc(p.nslots, sizeof *p.slot);
-    w = calloc((size_t)threads, sizeof *w);
-    if (p.slot == NULL || w == NULL)
-        goto out_of_memory;
-    for (int i = 0; i < threads; i++) {
-        w[i].pass = &p;
-        w[i].buffer = malloc(FE_CLI_LINE_MAX);
-        w[i].fields = malloc(FE_CLI_FIELDS_MAX * sizeof *w[i].fields);
-        if (w[i].buffer == NULL || w[i].fields == NULL)
-            goto out_of_memory;
-    }
-    pthread_mutex_init(&p.lock, NULL);
-    pthread_cond_init(&p.ready, NULL);
-    pthread_cond_init(&p.room, NULL);
-    /* w[0] is the calling thread; a thread that cannot start is not needed. */
-    for (int i = 1; i < threads; i++)
-        if (pthread_create(&w[i].thread, NULL, fe__cli_worker_run, &w[i]) == 0)
-            nworkers = (size_t)i;
-        else
+    fe_cli_table_threads(t, threads);
+    while ((rc = fe_cli_table_next(t, cols, k, row, err, errlen)) == FE_OK)
+        if ((rc = fn(ctx, t, row)) != 0) {
+            err[0] = '\0';
             break;
-    if (env != NULL)            /* the tests' witness that the file was cut */
-        fprintf(stderr, "foldest: %s: %zu batches of %lld bytes on %zu threads\n", t->name,
-                p.nbatches, (long long)p.step, nworkers + 1);
-    rc = fe__cli_take(&p, &w[0], t, fn, ctx, err, errlen);
-    pthread_mutex_lock(&p.lock);
-    p.stop = 1;
-    pthread_cond_broadcast(&p.room);
-    pthread_mutex_unlock(&p.lock);
-    for (size_t i = 1; i <= nworkers; i++)
-        pthread_join(w[i].thread, NULL);
-    pthread_cond_destroy(&p.room);
-    pthread_cond_destroy(&p.ready);
-    pthread_mutex_destroy(&p.lock);
-    if (0) {
-out_of_memory:
-        snprintf(err, errlen, "%s: out of memory", t->name);
-        rc = FE_CLI_IO;
-    }
-    for (size_t i = 0; p.slot != NULL && i < p.nslots; i++) {
-        free(p.slot[i].rows);
-        free(p.slot[i].line);
-    }
-    for (int i = 0; w != NULL && i < threads; i++) {
-        free(w[i].buffer);
-        free(w[i].fields);
-    }
-    free(p.slot);
-    free(w);
+        }
+    fe__cli_pass_end(t);        /* cols may go once this returns */
+    free(row);
     return rc;
 }
 
