@@ -279,15 +279,59 @@ START_TEST(fewer_rows_than_threads)
 }
 END_TEST
 
-/* --threads takes 1 to 64, in both commands. */
+/* discover reads two files in several passes, pulling rows from both:
+   on 2, 3 and 7 threads, cut into batches of 1 to 4096 bytes, its JSON is
+   the one-thread JSON, and a simulation row that goes back in time is
+   reported at its line. */
+START_TEST(discover_same_on_every_cut)
+{
+    static const int threads[] = {2, 3, 7}, batch[] = {1, 97, 4096};
+    static char one[OUT], many[OUT];
+    char real[256], sim[256], cmd[2048], args[1024];
+    temp_path(real, sizeof real, ".real.csv");
+    temp_path(sim, sizeof sim, ".sim.csv");
+    snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --rows 3000 --real %s --sim %s",
+             FE_TEST_CLI, real, sim);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, one, sizeof one), 0);
+    snprintf(args, sizeof args, "discover --real %s --sim %s --channel acceleration --role "
+             "position=position --role velocity=velocity --role input=input --base bias,gain "
+             "--holdout 0.3 --json", real, sim);
+    for (int bad = 0; bad < 2; bad++) {
+        int status;
+        if (bad) {              /* line 1500 of the simulation: time 0 */
+            snprintf(cmd, sizeof cmd, "sed -i '1500s/^[^,]*,/0,/' %s", sim);
+            ck_assert_int_eq(system(cmd), 0);
+        }
+        snprintf(cmd, sizeof cmd, "%s %s --threads 1", FE_TEST_CLI, args);
+        status = fe_test_run(cmd, FE_TEST_BOTH, one, sizeof one);
+        ck_assert_int_eq(status, bad ? 3 : 0);
+        ck_assert_msg(strstr(one, bad ? ":1500: simulation time does not increase" : "\"verdict\"")
+                      != NULL, "%s", one);
+        for (size_t t = 0; t < sizeof threads / sizeof threads[0]; t++)
+            for (size_t b = 0; b < sizeof batch / sizeof batch[0]; b++) {
+                snprintf(cmd, sizeof cmd, "FOLDEST_BATCH=%d %s %s --threads %d", batch[b],
+                         FE_TEST_CLI, args, threads[t]);
+                ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, many, sizeof many), status);
+                ck_assert_msg(strip_witness(many) >= 2, "not cut: %s", many);
+                ck_assert_msg(strcmp(one, many) == 0, "--threads %d, batch %d:\n%s\none thread:\n%s",
+                              threads[t], batch[b], many, one);
+            }
+    }
+    unlink(real);
+    unlink(sim);
+}
+END_TEST
+
+/* --threads takes 1 to 64, in every command that reads tables. */
 START_TEST(threads_option_checked)
 {
     static const char *const bad[] = {"0", "-1", "x", "65", "2.5"};
     char cmd[512], out[4096];
-    for (size_t c = 0; c < 2; c++)
+    for (size_t c = 0; c < 3; c++)
         for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-            snprintf(cmd, sizeof cmd, "echo 1,2,3 | %s %s --threads %s -", FE_TEST_CLI,
-                     c ? "calibrate" : "stats", bad[i]);
+            snprintf(cmd, sizeof cmd, "echo 1,2,3 | %s %s --threads %s %s", FE_TEST_CLI,
+                     c == 2 ? "discover" : c ? "calibrate" : "stats", bad[i],
+                     c == 2 ? "--real - --sim - --channel 1" : "-");
             ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, out, sizeof out), 2);
             ck_assert_msg(strstr(out, "--threads") != NULL, "%s: %s", cmd, out);
         }
@@ -305,6 +349,7 @@ Suite *fe_threads_cli_suite(void)
     tcase_add_test(t, bit_equal_on_a_large_file);
     tcase_add_test(t, pipes_and_gzip_keep_one_reader);
     tcase_add_test(t, fewer_rows_than_threads);
+    tcase_add_test(t, discover_same_on_every_cut);
     tcase_add_test(t, threads_option_checked);
     suite_add_tcase(s, t);
     return s;

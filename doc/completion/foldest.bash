@@ -22,7 +22,7 @@ _foldest()
                          --robust-k --report --threads" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
                         --alpha --order --report --json --sphere --columns --term --terms
-                        --only --exclude" ;;
+                        --only --exclude --threads" ;;
         synth) opts="--effect --real --sim --seed --rows --order --rho" ;;
         *) return 0 ;;
     esac
