@@ -6,8 +6,9 @@
    before timing so that they are cached: a CSV of 8 numeric columns of six
    or seven significant digits for stats, and three columns of samples on
    an ellipsoid for calibrate (its fold and its second pass both read the
-   file).  Each figure is the best of 3 runs, repeated until stable
-   (FE_BENCH_BEST); the CPU time the runs used is printed too, so that a
+   file).  One thread and two run alternately; each figure is the best
+   run, in rounds of 3 of each until the bests are stable (as
+   FE_BENCH_BEST); the CPU time of a run is printed too, so that a
    busy machine (the share of the cores other processes used, before and
    after) can be told from a slow program.  The command is $FOLDEST
    (`make bench` sets it), else build/bin/foldest.  The files are removed
@@ -121,14 +122,29 @@ int main(void)
             status = 1;
             break;
         }
-        for (int t = 0; t < 2; t++) {
-            double c0 = cpu_children(), best;
-            int runs = 0, bad = 0;
-            FE_BENCH_BEST(best, REPS, bad |= run(foldest, command[c], t + 1, path[c]); runs++);
-            wall[c][t] = best;
-            cpu[c][t] = (cpu_children() - c0) / runs;
-            status |= bad != 0;
+        /* One thread and two alternately, so that a change in the load
+           weighs on both; the best of each, in rounds of REPS runs until
+           both bests move by less than 2 % (as FE_BENCH_BEST). */
+        int runs[2] = {0, 0};
+        wall[c][0] = wall[c][1] = 1e300;
+        cpu[c][0] = cpu[c][1] = 0.0;
+        for (int round = 0; round < FE_BENCH_ROUNDS && status == 0; round++) {
+            double before[2] = {wall[c][0], wall[c][1]};
+            for (int r = 0; r < REPS; r++)
+                for (int t = 0; t < 2; t++) {
+                    double c0 = cpu_children(), t0 = fe_bench_now(), dt;
+                    status |= run(foldest, command[c], t + 1, path[c]) != 0;
+                    dt = fe_bench_now() - t0;
+                    cpu[c][t] += cpu_children() - c0;
+                    runs[t]++;
+                    if (dt < wall[c][t])
+                        wall[c][t] = dt;
+                }
+            if (round > 0 && wall[c][0] >= 0.98 * before[0] && wall[c][1] >= 0.98 * before[1])
+                break;
         }
+        for (int t = 0; t < 2; t++)
+            cpu[c][t] /= runs[t] > 0 ? runs[t] : 1;
     }
     busy_after = fe_bench_busy_fraction();
     remove(path[0]);
