@@ -792,9 +792,9 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
        1/m; fall_2 names drag alone with k = 0.0301, just outside, and
        fall_7 names nothing. */
     const char *data = fe_test_data_dir("free-fall discovery");
-    static char out[131072];
+    static char out[131072], story[131072];
     char cmd[16384], sim[300];
-    int good = 0;
+    int good = 0, few = 0;
     if (data == NULL)
         return;
     make_dir();
@@ -806,7 +806,7 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
     ck_assert_int_eq(system(cmd), 0);
     for (int k = 1; k <= 12; k++) {
         const char *q, *second;
-        double coef;
+        double coef, dof;
         snprintf(cmd, sizeof cmd, "%s discover --real %s/freefall-drag/csv/fall_%d.csv "
                  "--sim %s/fall_%d_sim.csv --channel Absolute --time Time "
                  "--role velocity=velocity --base bias --holdout 0 --json",
@@ -816,12 +816,24 @@ START_TEST(free_fall_recordings_show_quadratic_drag)
         if (q == NULL)
             continue;
         coef = strtod(strstr(q, "\"coefficient\": ") + strlen("\"coefficient\": "), NULL);
+        dof = strtod(strstr(q, "\"dof\": ") + strlen("\"dof\": "), NULL);
+        /* The story says when the interval rests on less than one degree
+           of freedom (fall_2: 0.22), and only then. */
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/freefall-drag/csv/fall_%d.csv "
+                 "--sim %s/fall_%d_sim.csv --channel Absolute --time Time "
+                 "--role velocity=velocity --base bias --holdout 0",
+                 FE_TEST_CLI, data, k, dir, k);
+        ck_assert_int_eq(fe_test_run(cmd, 1, story, sizeof story), 0);
+        ck_assert_msg((strstr(story, "degrees of freedom: the record is too short") != NULL)
+                      == (dof < 1.0), "fall_%d: dof %g and the story disagree", k, dof);
+        few += dof < 1.0;
         second = strstr(q + strlen("\"discovered\": [{"), "{\"name\": ");
         /* Nothing after drag in "discovered" (the next object is in "per_recording"). */
         good += -coef >= 0.010 && -coef <= 0.030
                 && (second == NULL || second > strstr(q, "\"per_recording\""));
     }
     ck_assert_msg(good >= 10, "quadratic drag alone, k in [0.010, 0.030], in %d of 12 drops", good);
+    ck_assert_msg(few >= 1, "no drop's interval on fewer than one degree of freedom");
     fe_test_remove_dir(dir);
 }
 END_TEST

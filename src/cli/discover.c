@@ -1485,12 +1485,15 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
     for (size_t s = 0; s < r->steps; s++) {
         const fe_term *t = &o->c->terms[r->added[s]];
         fe__coef c = fe__coef_of(r, r->added[s]);
-        char words[512];
+        char words[512], few[128] = "";
         fe__explain(o, r->added[s], c.value, c.se, words, sizeof words);
-        fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g), "
+        if (c.dof < 1.0)
+            snprintf(few, sizeof few, " on %.2g degrees of freedom: the record is too short "
+                     "to bound its slow noise", c.dof);
+        fprintf(f, "  %zu. %s (%s): coefficient %.5g +/- %.2g (95%%: %.4g to %.4g%s), "
                    "statistic %.2f, p = %.2g\n     %s\n",
                 s + 1, t->name, t->description, c.value, c.se, c.value - c.halfwidth,
-                c.value + c.halfwidth, r->added_rank[s].statistic,
+                c.value + c.halfwidth, c.dof < 1.0 ? few : "", r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
         if (r->nalike[s] > 0) {
             fprintf(f, "     indistinguishable on these data from:");
