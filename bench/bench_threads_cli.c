@@ -39,8 +39,8 @@ static double cpu_children(void)
 }
 
 /* Run foldest with the arguments args[0..] (NULL-terminated, at most 24)
-   and --threads T, its output to /dev/null; 0 when it exited with
-   status 0. */
+   and --threads T (none when T is 0), its output to /dev/null; 0 when it
+   exited with status 0. */
 static int run(const char *foldest, char *const *args, int threads)
 {
     char t[16], *argv[32];
@@ -49,12 +49,12 @@ static int run(const char *foldest, char *const *args, int threads)
     int status = -1, rc, n = 0;
     snprintf(t, sizeof t, "%d", threads);
     argv[n++] = (char *)foldest;
-    while (args[n - 1] != NULL && n < 26) {
-        argv[n] = args[n - 1];
-        n++;
+    for (int i = 0; args[i] != NULL && n < 26; i++)
+        argv[n++] = args[i];
+    if (threads > 0) {
+        argv[n++] = "--threads";
+        argv[n++] = t;
     }
-    argv[n++] = "--threads";
-    argv[n++] = t;
     argv[n] = NULL;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
@@ -148,7 +148,7 @@ int main(void)
         char *synth[] = {"synth", "--effect", "viscous_friction", "--rows", rows_text, "--real",
                          path[2], "--sim", path[3], NULL};
         if (write_stats_file(path[0], &bytes[0]) != 0
-            || write_calibrate_file(path[1], &bytes[1]) != 0 || run(foldest, synth, 1) != 0)
+            || write_calibrate_file(path[1], &bytes[1]) != 0 || run(foldest, synth, 0) != 0)
             status = 1;
         bytes[2] = file_bytes(path[2]) + file_bytes(path[3]);
     }
