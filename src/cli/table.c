@@ -904,8 +904,12 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
                               char *err, size_t errlen)
 {
     const char *env = getenv("FOLDEST_BATCH");
-    off_t data = fe__cli_data_offset(t), step;
+    off_t data, step;
     fe__cli_pass *p;
+    struct stat st;
+    if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > t->size)
+        t->size = st.st_size;   /* a log that grew since it was opened */
+    data = fe__cli_data_offset(t);
     step = (data > 0 ? t->size - data : 0) / (4 * (off_t)t->threads);
     step = step > FE__CLI_BATCH ? FE__CLI_BATCH : step;
     if (env != NULL && atol(env) > 0)
