@@ -9,8 +9,9 @@
    fold and its second pass both read the file), and for discover a
    recording and its simulation written by `foldest synth`.  One thread and
    two run alternately; each figure is the best run, in rounds of 3 of each
-   until the bests are stable (as FE_BENCH_BEST); the CPU time of a run is
-   printed too, so that a busy machine (the share of the cores other
+   until the bests are stable (as FE_BENCH_BEST), and the median of the
+   ratios of a one-thread run to the two-thread run after it; the CPU time
+   of a run is printed too, so that a busy machine (the share of the cores other
    processes used, before and after) can be told from a slow program.  The
    command is $FOLDEST (`make bench` sets it), else build/bin/foldest.  The
    files are removed at the end. */
@@ -120,6 +121,12 @@ static double file_bytes(const char *path)
 
 enum { NCMD = 3 };
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
 int main(void)
 {
     const char *foldest = getenv("FOLDEST") != NULL ? getenv("FOLDEST") : "build/bin/foldest";
@@ -130,7 +137,8 @@ int main(void)
         busy_after;
     long rows[NCMD] = {STATS_ROWS, CAL_ROWS, DISCOVER_ROWS};
     char rows_text[32];
-    int status = 0;
+    double ratio[NCMD][REPS * FE_BENCH_ROUNDS];
+    int nratio[NCMD] = {0, 0, 0}, status = 0;
 
     if (access(foldest, X_OK) != 0) {
         fprintf(stderr, "bench_threads_cli: %s: no such command (make cli)\n", foldest);
@@ -171,16 +179,20 @@ int main(void)
         cpu[c][0] = cpu[c][1] = 0.0;
         for (int round = 0; round < FE_BENCH_ROUNDS && status == 0; round++) {
             double before[2] = {wall[c][0], wall[c][1]};
-            for (int r = 0; r < REPS; r++)
+            for (int r = 0; r < REPS; r++) {
+                double pair[2];
                 for (int t = 0; t < 2; t++) {
                     double c0 = cpu_children(), t0 = fe_bench_now(), dt;
                     status |= run(foldest, args, t + 1) != 0;
                     dt = fe_bench_now() - t0;
                     cpu[c][t] += cpu_children() - c0;
                     runs[t]++;
+                    pair[t] = dt;
                     if (dt < wall[c][t])
                         wall[c][t] = dt;
                 }
+                ratio[c][nratio[c]++] = pair[0] / pair[1];
+            }
             if (round > 0 && wall[c][0] >= 0.98 * before[0] && wall[c][1] >= 0.98 * before[1])
                 break;
         }
@@ -197,13 +209,17 @@ int main(void)
     printf("bench_threads_cli: the command end to end on cached files, --threads 1 and 2; "
            "machine busy %.0f%% before, %.0f%% after (other processes' share of the cores)\n",
            100.0 * busy_before, 100.0 * busy_after);
-    printf("%-10s %8s %9s %11s %11s %9s %9s %8s\n", "command", "MB", "rows", "1 thread s",
-           "2 threads s", "cpu 1 s", "cpu 2 s", "speedup");
-    for (int c = 0; c < NCMD; c++)
-        printf("%-10s %8.1f %9ld %11.3f %11.3f %9.3f %9.3f %8.2f\n", name[c], bytes[c] / 1e6,
-               rows[c], wall[c][0], wall[c][1], cpu[c][0], cpu[c][1], wall[c][0] / wall[c][1]);
+    printf("%-10s %8s %9s %11s %11s %9s %9s %8s %8s\n", "command", "MB", "rows", "1 thread s",
+           "2 threads s", "cpu 1 s", "cpu 2 s", "speedup", "median");
+    for (int c = 0; c < NCMD; c++) {
+        qsort(ratio[c], (size_t)nratio[c], sizeof ratio[c][0], cmp_double);
+        printf("%-10s %8.1f %9ld %11.3f %11.3f %9.3f %9.3f %8.2f %8.2f\n", name[c],
+               bytes[c] / 1e6, rows[c], wall[c][0], wall[c][1], cpu[c][0], cpu[c][1],
+               wall[c][0] / wall[c][1], ratio[c][nratio[c] / 2]);
+    }
     printf("goal on 2 idle cores: speedup 1.8 or more for stats and calibrate, 1.6 for discover "
-           "(cpu: the mean CPU time of a run; equal CPU times and a low speedup mean the cores "
-           "were busy)\n");
+           "(speedup: the best one-thread time over the best two-thread time; median: of the "
+           "ratios of runs made one after the other, which a load that comes and goes moves "
+           "less; cpu: the mean CPU time of a run)\n");
     return 0;
 }
