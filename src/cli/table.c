@@ -907,6 +907,7 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     off_t data, step;
     fe__cli_pass *p;
     struct stat st;
+    sigset_t all, mask;
     if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > t->size)
         t->size = st.st_size;   /* a log that grew since it was opened */
     data = fe__cli_data_offset(t);
@@ -954,12 +955,18 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
             goto out_of_memory;
         }
     }
-    /* w[0] is the calling thread; a thread that cannot start is not needed. */
+    /* w[0] is the calling thread; a thread that cannot start is not
+       needed.  The workers start with every signal blocked, so that
+       SIGINT and SIGTERM reach the calling thread, whose
+       fe_cli_signals_hold keeps them out of its critical sections. */
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &mask);
     for (int i = 1; i < t->threads; i++)
         if (pthread_create(&p->w[i].thread, NULL, fe__cli_worker_run, &p->w[i]) == 0)
             p->nworkers = (size_t)i;
         else
             break;
+    pthread_sigmask(SIG_SETMASK, &mask, NULL);
     if (env != NULL)            /* the tests' witness that the file was cut */
         fprintf(stderr, "foldest: %s: %zu batches of %lld bytes on %zu threads\n", t->name,
                 p->nbatches, (long long)p->step, p->nworkers + 1);
