@@ -85,15 +85,11 @@ int fe_csv_next_line(fe_csv_reader *r, char **line, size_t *len)
             r->skipping = 0;
         } else {
             int rc;
-            r->pos = r->len = 0;
-            if (r->eof) {
-                r->skipping = 0;
-                break;
-            }
-            rc = fe__csv_refill(r);
+            r->pos = r->len;            /* all of it is the tail: dropped */
+            rc = fe__csv_refill(r);     /* at the end of the input: nothing */
             if (rc != FE_OK)
                 return rc;
-            if (r->len == 0)
+            if (r->len == 0)            /* the input ended inside the line */
                 r->skipping = 0;
         }
     }

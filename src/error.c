@@ -25,7 +25,7 @@ static const char *const fe__messages[FE_STATUS_COUNT] = {
 
 const char *fe_strerror(int status)
 {
-    if (status < 0 || status >= FE_STATUS_COUNT || fe__messages[status] == 0)
+    if (status < 0 || status >= FE_STATUS_COUNT)
         return "unknown foldest status";
     return fe__messages[status];
 }

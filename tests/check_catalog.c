@@ -386,6 +386,88 @@ START_TEST(three_axis_gain_is_read_from_its_coefficients)
 }
 END_TEST
 
+/* Each coordinate of the centre alone not finite (NaN, then +-infinity):
+   refused, and the catalog is left as it was; the used t1 and temperature
+   at their boundary too: refused when used, ignored when not. */
+START_TEST(three_axis_centre_refused_in_each_coordinate)
+{
+    const double b[3] = {10, -20, 30};
+    const double bads[3] = {NAN, INFINITY, -INFINITY};
+    fe_catalog_axes c, before;
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, 100.0, 1, 20.0), FE_OK);
+    memcpy(&before, &c, sizeof c);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double y[3] = {b[0], b[1], b[2]};
+            y[i] = bads[k];
+            ck_assert_msg(fe_catalog_axes_init(&c, y, 0, 0, 0, 0) == FE_ENONFINITE,
+                          "coordinate %d, value %g", i, bads[k]);
+            ck_assert_int_eq(memcmp(&c, &before, sizeof c), 0);
+        }
+    ck_assert_int_eq(fe_catalog_axes_init(&c, NULL, 0, 0, 0, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, 0, 1, NAN), FE_ENONFINITE);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 1, -INFINITY, 0, 0), FE_ENONFINITE);
+    ck_assert_int_eq(memcmp(&c, &before, sizeof c), 0);
+    ck_assert_int_eq(fe_catalog_axes_init(&c, b, 0, NAN, 0, INFINITY), FE_OK);
+    ck_assert_uint_eq(c.ngroups, 4);
+    ck_assert_double_eq(c.centre[0], 10.0);
+    ck_assert_double_eq(c.centre[1], -20.0);
+    ck_assert_double_eq(c.centre[2], 30.0);
+}
+END_TEST
+
+/* The first pass's scale: the first time and temperature are the first
+   sample's, vmax the largest |velocity| wherever it comes (here in the
+   middle, negative), n the samples; and a panel with a term that has
+   neither an expression, a function nor a probe is refused. */
+START_TEST(scale_is_the_first_sample_and_the_largest_speed)
+{
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    const double v[5] = {0.5, -1.0, -7.5, 3.0, 0.25};
+    fe_catalog c;
+    double rows[2 * FE_CATALOG_VARS] = {0}, phi[2 * 32], work[64];
+    for (int i = 0; i < 5; i++) {
+        fe_sample s = {0};
+        s.t = 10.0 + i;
+        s.temperature = 30.0 - i;
+        s.velocity = v[i];
+        ck_assert_int_eq(fe_catalog_scale_add(&scale, &s), FE_OK);
+    }
+    ck_assert_uint_eq(scale.n, 5);
+    ck_assert_double_eq(scale.t_first, 10.0);
+    ck_assert_double_eq(scale.temperature_first, 30.0);
+    ck_assert_double_eq(scale.vmax, 7.5);
+    ck_assert_int_eq(fe_catalog_scale_add(&scale, NULL), FE_EINVAL);
+    ck_assert_uint_eq(scale.n, 5);
+    /* A new pass (n = 0) starts again from its first sample. */
+    scale.n = 0;
+    {
+        fe_sample s = {0};
+        s.t = 3.0;
+        s.temperature = 4.0;
+        s.velocity = -0.5;
+        ck_assert_int_eq(fe_catalog_scale_add(&scale, &s), FE_OK);
+        ck_assert_double_eq(scale.t_first, 3.0);
+        ck_assert_double_eq(scale.temperature_first, 4.0);
+        ck_assert_double_eq(scale.vmax, 0.5);
+    }
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_VELOCITY, &scale), FE_OK);
+    ck_assert_uint_le(c.count, 32);
+    ck_assert_uint_le(fe_catalog_work_doubles(2), 64);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, 2, phi, 32, work, NULL),
+                     FE_OK);
+    {
+        long j = fe_catalog_find(&c, "quadratic_drag");
+        ck_assert_int_ge(j, 0);
+        ck_assert_ptr_null(c.terms[j].expr);
+        ck_assert_int_eq(c.terms[j].probe, 0);
+        c.terms[j].eval = NULL;
+        ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, 2, phi, 32, work, NULL),
+                         FE_EINVAL);
+    }
+}
+END_TEST
+
 Suite *fe_catalog_suite(void)
 {
     Suite *s = suite_create("catalog");
@@ -397,6 +479,8 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, every_coefficient_in_words);
     tcase_add_test(t, three_axis_terms_are_their_formulas);
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);
+    tcase_add_test(t, three_axis_centre_refused_in_each_coordinate);
+    tcase_add_test(t, scale_is_the_first_sample_and_the_largest_speed);
     suite_add_tcase(s, t);
     return s;
 }

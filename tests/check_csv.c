@@ -2,6 +2,7 @@
 /* The CSV reader: lines (LF, CRLF, no final newline, too long, binary),
    fields (delimiters, quotes, white space) and numbers. */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
 #include <unistd.h>
 
 #include "foldest.h"
@@ -276,6 +277,84 @@ START_TEST(numbers_equal_strtod_bit_for_bit)
 }
 END_TEST
 
+/* A read function that gives its text in chunks, then fails (-1). */
+struct failing { const char *text; size_t at; };
+
+static long read_then_fail(void *ctx, char *buf, size_t n)
+{
+    struct failing *c = ctx;
+    size_t left = strlen(c->text) - c->at, k = left < 3 ? left : 3;
+    if (k == 0) {
+        errno = EIO;
+        return -1;
+    }
+    if (k > n)
+        k = n;
+    memcpy(buf, c->text + c->at, k);
+    c->at += k;
+    return (long)k;
+}
+
+/* A line too long whose end is the end of the input (no newline), read
+   through a pipe and in chunks of 3 bytes: reported once, then FE_END,
+   and FE_END again on every later call; the tail of a long line spread
+   over several refills is dropped, whatever is read after its newline is
+   a line; a read error while skipping is FE_EIO. */
+START_TEST(too_long_line_at_the_end_and_a_read_error_while_skipping)
+{
+    pipe_reader p;
+    char *line, buf[8];
+    size_t len;
+    fe_csv_reader r;
+    struct chunks c = {"1,2\n12345678901234567890\n5,6\n1234567890123456789", 0, 3};
+    struct failing f = {"1,2\n123456789012345678", 0};
+    open_text(&p, "1,2\n123456789012345678901234567890", 8);
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "1,2");
+    ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_ESIZE);
+    ck_assert_uint_eq(p.r.line, 2);
+    for (int i = 0; i < 3; i++)
+        ck_assert_int_eq(fe_csv_next_line(&p.r, &line, &len), FE_END);
+    ck_assert_uint_eq(p.r.line, 2);
+    close(p.fd);
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "1,2");
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_ESIZE);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "5,6");
+    ck_assert_uint_eq(r.line, 3);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_ESIZE);
+    ck_assert_uint_eq(r.line, 4);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_then_fail, &f, buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_ESIZE);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_EIO);
+}
+END_TEST
+
+/* Each missing argument of the two number parsers alone. */
+START_TEST(number_parsers_refuse_each_missing_argument)
+{
+    char text[] = "1,5", dot[] = "2.5";
+    fe_csv_field f = {text, 1}, none = {NULL, 1}, g = {dot, 1};
+    double v = -7.0;
+    ck_assert_int_eq(fe_csv_number_comma(NULL, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number_comma(&none, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number_comma(&f, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(NULL, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(&none, &v), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_number(&g, NULL), FE_EINVAL);
+    ck_assert_double_eq(v, -7.0);
+    ck_assert_int_eq(fe_csv_number_comma(&f, &v), FE_OK);
+    ck_assert_double_eq(v, 1.5);
+    ck_assert_int_eq(fe_csv_number(&g, &v), FE_OK);
+    ck_assert_double_eq(v, 2.5);
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -290,6 +369,8 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, numbers_equal_strtod_bit_for_bit);
     tcase_add_test(t, byte_order_mark_semicolons_and_read_functions);
     tcase_add_test(t, strtod_extensions_are_not_numbers);
+    tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
+    tcase_add_test(t, number_parsers_refuse_each_missing_argument);
     suite_add_tcase(s, t);
     return s;
 }

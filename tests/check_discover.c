@@ -1963,6 +1963,171 @@ START_TEST(concealed_effects_are_found_and_nulls_are_not)
 }
 END_TEST
 
+/* Solve the n x n system A x = b in place (Gauss-Jordan with partial
+   pivoting, long double; A is destroyed, b receives x), for nb right-hand
+   sides stored as the columns of b (n x nb, row-major). */
+static void solve_ld(size_t n, long double *A, long double *b, size_t nb)
+{
+    for (size_t k = 0; k < n; k++) {
+        size_t piv = k;
+        for (size_t i = k + 1; i < n; i++)
+            if (fabsl(A[i * n + k]) > fabsl(A[piv * n + k]))
+                piv = i;
+        for (size_t j = 0; j < n; j++) {
+            long double t = A[k * n + j];
+            A[k * n + j] = A[piv * n + j];
+            A[piv * n + j] = t;
+        }
+        for (size_t j = 0; j < nb; j++) {
+            long double t = b[k * nb + j];
+            b[k * nb + j] = b[piv * nb + j];
+            b[piv * nb + j] = t;
+        }
+        for (size_t i = 0; i < n; i++) {
+            long double f;
+            if (i == k)
+                continue;
+            f = A[i * n + k] / A[k * n + k];
+            for (size_t j = 0; j < n; j++)
+                A[i * n + j] -= f * A[k * n + j];
+            for (size_t j = 0; j < nb; j++)
+                b[i * nb + j] -= f * b[k * nb + j];
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < nb; j++)
+            b[i * nb + j] /= A[i * n + i];
+}
+
+START_TEST(fit_columns_sandwich_errors_match_brute_force)
+{
+    /* fe_discover_fit_columns' standard errors are the block sandwich
+       (batch means): with G = X'X over the fitted rows, beta = G^-1 X'y,
+       each block's score u_k = X_k'(y_k - X_k beta), Omega = K / (K - 1)
+       sum_k u_k u_k' and V = G^-1 Omega G^-1, se_i = sqrt(V_ii); all
+       recomputed here from the rows (block k holds rows t with
+       t K / N = k), for every column, asked in a shuffled order, and with
+       a part held out (its rows outside G and the blocks). */
+    enum { M = 4, K = 8, N = 4000 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static double phi[N][M], r[N];
+    const size_t cols[M] = {2, 0, 3, 1};
+    fe_rng g = fe_rng_seed(41);
+    double e = 0.0;
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    for (size_t t = 0; t < N; t++) {
+        /* Noise whose spread and correlation change along the record, so
+           that the sandwich differs from s^2 G^-1. */
+        e = 0.7 * e + (0.5 + (double)t / N) * fe_rng_normal(&g);
+        phi[t][0] = 1.0;
+        phi[t][1] = (double)t / N;
+        phi[t][2] = sin(0.004 * (double)t) + 0.2 * fe_rng_normal(&g);
+        phi[t][3] = cos(0.0013 * (double)t);
+        r[t] = 0.1 + 0.4 * phi[t][1] - 0.2 * phi[t][2] + 0.3 * phi[t][3] + e;
+    }
+    for (int held = 0; held < 2; held++) {
+        size_t F = held ? 3000 : N;
+        long double G[M * M] = {0}, Gi[M * M], beta[M] = {0}, u[K][M] = {{0}};
+        long double Om[M * M] = {0}, V[M * M];
+        double coef[M], se[M];
+        fe_discover_acc a;
+        fe_discover_fit fit;
+        ck_assert_int_eq(fe_discover_acc_init(&a, M, K, F, 0, st, nst), FE_OK);
+        for (size_t t = 0; t < N; t++)
+            ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+        for (size_t i = 0; i < M; i++)
+            se[i] = -1.0;
+        ck_assert_int_eq(fe_discover_fit_columns(&a, cols, M, coef, se, &fit, w, nw), FE_OK);
+        /* beta over the fitted rows, in the asked order. */
+        for (size_t t = 0; t < F; t++)
+            for (size_t i = 0; i < M; i++) {
+                for (size_t j = 0; j < M; j++)
+                    G[i * M + j] += (long double)phi[t][cols[i]] * phi[t][cols[j]];
+                beta[i] += (long double)phi[t][cols[i]] * r[t];
+            }
+        memcpy(Gi, G, sizeof Gi);
+        solve_ld(M, Gi, beta, 1);
+        for (size_t i = 0; i < M; i++)
+            FE_ASSERT_REL(coef[i], (double)beta[i], 1e-9);
+        for (size_t t = 0; t < F; t++) {
+            long double res = r[t];
+            for (size_t i = 0; i < M; i++)
+                res -= beta[i] * phi[t][cols[i]];
+            for (size_t i = 0; i < M; i++)
+                u[t * K / F][i] += phi[t][cols[i]] * res;
+        }
+        for (size_t k = 0; k < K; k++)
+            for (size_t i = 0; i < M; i++)
+                for (size_t j = 0; j < M; j++)
+                    Om[i * M + j] += u[k][i] * u[k][j] * K / (K - 1);
+        /* V = G^-1 (G^-1 Omega)^T: Omega and G symmetric. */
+        memcpy(Gi, G, sizeof Gi);
+        memcpy(V, Om, sizeof V);
+        solve_ld(M, Gi, V, M);
+        for (size_t i = 0; i < M; i++)
+            for (size_t j = i + 1; j < M; j++) {
+                long double t = V[i * M + j];
+                V[i * M + j] = V[j * M + i];
+                V[j * M + i] = t;
+            }
+        memcpy(Gi, G, sizeof Gi);
+        solve_ld(M, Gi, V, M);
+        for (size_t i = 0; i < M; i++) {
+            ck_assert_msg(se[i] > 0.0, "column %zu: se %g", i, se[i]);
+            FE_ASSERT_REL(se[i], (double)sqrtl(V[i * M + i]), 1e-7);
+        }
+    }
+    free(st);
+    free(w);
+}
+END_TEST
+
+START_TEST(the_widest_accumulation_folds_and_fits)
+{
+    /* FE_DISCOVER_MAX_COLUMNS columns, lagged products kept (the default),
+       folded row by row: the fit of the first and the last column equals
+       the two-by-two normal equations over the rows, and one more column
+       is refused. */
+    enum { M = FE_DISCOVER_MAX_COLUMNS, K = 4, N = 400 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static double phi[N][M], r[N];
+    const size_t cols[2] = {0, M - 1};
+    double coef[2];
+    long double s00 = 0, s01 = 0, s11 = 0, y0 = 0, y1 = 0, det;
+    fe_discover_acc a;
+    fe_discover_fit fit;
+    fe_rng g = fe_rng_seed(77);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M + 1, K, N, 0, st, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    ck_assert_uint_eq(a.lags, FE_DISCOVER_DEFAULT_LAGS);
+    for (size_t t = 0; t < N; t++) {
+        for (size_t c = 0; c < M; c++)
+            phi[t][c] = c == 0 ? 1.0 : fe_rng_normal(&g);
+        r[t] = 0.5 - 0.25 * phi[t][M - 1] + 0.1 * fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_columns(&a, cols, 2, coef, NULL, &fit, w, nw), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        long double x = phi[t][M - 1];
+        s00 += 1;
+        s01 += x;
+        s11 += x * x;
+        y0 += r[t];
+        y1 += x * r[t];
+    }
+    det = s00 * s11 - s01 * s01;
+    FE_ASSERT_REL(coef[0], (double)((s11 * y0 - s01 * y1) / det), 1e-10);
+    FE_ASSERT_REL(coef[1], (double)((s00 * y1 - s01 * y0) / det), 1e-10);
+    free(st);
+    free(w);
+}
+END_TEST
+
 Suite *fe_discover_suite(void)
 {
     Suite *s = suite_create("discover");
@@ -1996,6 +2161,8 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, probes_are_scored_against_the_final_model_and_never_added);
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
+    tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
+    tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

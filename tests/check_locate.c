@@ -1036,6 +1036,53 @@ START_TEST(located_regions_in_json_and_words)
 }
 END_TEST
 
+START_TEST(a_region_of_two_rows_is_tested_of_one_is_not)
+{
+    /* The residual map tests a region of at least 2 rows: 60 rows in 3
+       blocks, velocity +-0.5 with residual +-1, except rows at velocity 0
+       with residual 8.  Two such rows (10 and 41): the region v = 0 has
+       n = 2, sum 16, sum of squares 128, against all rows' mean 16/60 and
+       mean square 186/60; with worth 1, t = (8 - 16/60) / sqrt((186/60) /
+       2) and z = (64 / (186/60) - 1) / sqrt(2 / 2), both far above the
+       bound for 3 + 7 places.  One such row (10): the region has n = 1
+       and is not tested. */
+    const double lo[3] = {0, -0.5, 0}, hi[3] = {0, 0.5, 0};
+    for (int two = 0; two < 2; two++) {
+        fe_residual_map m;
+        fe_located loc[16];
+        size_t n, found = 0;
+        ck_assert_int_eq(fe_residual_map_init(&m, 3, 60, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+        ck_assert_uint_eq(m.nregions, 7);
+        for (int i = 0; i < 60; i++) {
+            fe_sample s = {0};
+            int zero = i == 10 || (two && i == 41);
+            double e = zero ? 8.0 : i % 2 ? 1.0 : -1.0;
+            if (!two && i == 41)
+                e = 1.0;
+            s.t = i;
+            s.velocity = zero ? 0.0 : i % 2 ? 0.5 : -0.5;
+            ck_assert_int_eq(fe_residual_map_add(&m, &s, e, e), FE_OK);
+        }
+        ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, loc, 16, &n), FE_OK);
+        ck_assert_uint_le(n, 16);
+        for (size_t i = 0; i < n; i++) {
+            double all_sum, msall, ws;
+            if (loc[i].region != FE_REGION_VELOCITY_ZERO)
+                continue;
+            found++;
+            ck_assert_double_eq(loc[i].n, 2.0);
+            all_sum = 16.0;
+            msall = (58.0 + 128.0) / 60.0;
+            ws = 2.0;
+            ck_assert_double_eq_tol(loc[i].t, (8.0 - all_sum / 60.0) / sqrt(msall / ws), 1e-12);
+            ck_assert_double_eq_tol(loc[i].z, (64.0 / msall - 1.0) / sqrt(2.0 / ws), 1e-12);
+            ck_assert_double_eq_tol(loc[i].mean_before, 8.0, 1e-15);
+        }
+        ck_assert_uint_eq(found, two ? 1 : 0);
+    }
+}
+END_TEST
+
 Suite *fe_locate_suite(void)
 {
     Suite *s = suite_create("locate");
@@ -1059,6 +1106,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, residual_map_refusals_at_their_edges);
     tcase_add_test(t, verdict_and_row_worth);
     tcase_add_test(t, located_regions_in_json_and_words);
+    tcase_add_test(t, a_region_of_two_rows_is_tested_of_one_is_not);
     suite_add_tcase(s, t);
     return s;
 }

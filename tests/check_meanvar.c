@@ -240,6 +240,36 @@ START_TEST(precision_at_large_offset)
 }
 END_TEST
 
+START_TEST(small_values_far_from_one)
+{
+    /* Values of 1e-6 + 1e-9 u (u uniform): the bulk path's mean and
+       variance against the two-pass formula in long double, to 1e-10
+       relative, for lengths that use the eight lanes, the tail, both and
+       several blocks.  At this scale an error of order one in a block's
+       first sum (which the corrected two-pass formula absorbs for values
+       of order one) leaves no correct digit in the variance. */
+    static const size_t sizes[] = {5, 8, 13, 512, 1000, 5003};
+    static double x[5003];
+    fe_rng r = fe_rng_seed(606);
+    for (size_t i = 0; i < 5003; i++)
+        x[i] = 1e-6 + 1e-9 * fe_rng_uniform(&r);
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        size_t n = sizes[k];
+        fe_meanvar a = FE_MEANVAR_EMPTY;
+        long double sum = 0, ss = 0, mean;
+        for (size_t i = 0; i < n; i++)
+            sum += x[i];
+        mean = sum / (long double)n;
+        for (size_t i = 0; i < n; i++)
+            ss += (x[i] - mean) * (x[i] - mean);
+        ck_assert_int_eq(fe_meanvar_add_many(&a, x, n, NULL), FE_OK);
+        ck_assert_uint_eq(a.n, n);
+        FE_ASSERT_REL(a.mean, (double)mean, 1e-12);
+        FE_ASSERT_REL(fe_meanvar_variance(&a), (double)(ss / (long double)(n - 1)), 1e-10);
+    }
+}
+END_TEST
+
 Suite *fe_meanvar_suite(void)
 {
     Suite *s = suite_create("meanvar");
@@ -255,6 +285,7 @@ Suite *fe_meanvar_suite(void)
     tcase_add_test(t, bulk_stops_exactly_at_the_bad_value);
     tcase_add_test(t, streaming_equals_batch);
     tcase_add_test(t, precision_at_large_offset);
+    tcase_add_test(t, small_values_far_from_one);
     suite_add_tcase(s, t);
     return s;
 }

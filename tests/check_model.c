@@ -573,6 +573,64 @@ START_TEST(arguments_and_failing_callbacks)
 }
 END_TEST
 
+/* A prediction that is NaN or infinite at one row only. */
+static int nan_at_two_predict(const fe_sample *s, const double *th, double *y, void *user)
+{
+    int rc = rig_predict(s, th, y, user);
+    if (s->t == 2.0)
+        *y = s->input > 0 ? NAN : INFINITY;
+    return rc;
+}
+
+/* A prediction not finite at its own row, with the Jacobian analytic
+   (finite there) and by differences: the row is refused when it is
+   added, with FE_ENONFINITE, and the accumulation is left as it was (a
+   refusal only when the row is folded, one row later, would come too
+   late to leave it so). */
+START_TEST(non_finite_prediction_refused_at_its_row)
+{
+    fe_catalog_scale sc = {0};
+    fe_catalog c;
+    fe_model_acc a, before;
+    fe_sample s = {0};
+    size_t nst;
+    double *st, *copy;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT,
+                                     &sc), FE_OK);
+    nst = fe_model_acc_doubles(3, c.count, 4);
+    st = malloc(nst * sizeof *st);
+    copy = malloc(nst * sizeof *st);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(copy);
+    for (int analytic = 0; analytic < 2; analytic++)
+        for (int k = 0; k < 2; k++) {
+            fe_model m = {3, theta0, names, nan_at_two_predict,
+                          analytic ? rig_jacobian : NULL, 0, NULL, NULL};
+            ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);
+            s.t = 1;
+            s.input = 0.5;
+            s.position = 0.1;
+            s.velocity = -0.2;
+            s.real = 0.3;
+            ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+            memcpy(&before, &a, sizeof a);
+            memcpy(copy, st, nst * sizeof *st);
+            s.t = 2;
+            s.input = k == 0 ? 0.5 : -0.5;      /* NaN, then infinity */
+            ck_assert_msg(fe_model_add(&a, &s) == FE_ENONFINITE, "analytic %d, case %d",
+                          analytic, k);
+            ck_assert_mem_eq(&a, &before, sizeof a);
+            ck_assert_mem_eq(st, copy, nst * sizeof *st);
+            s.t = 3;
+            ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+            ck_assert_int_eq(fe_model_break(&a), FE_OK);
+            ck_assert_uint_eq(a.acc.n, 2);
+        }
+    free(st);
+    free(copy);
+}
+END_TEST
+
 Suite *fe_model_suite(void)
 {
     Suite *s = suite_create("model");
@@ -582,6 +640,7 @@ Suite *fe_model_suite(void)
     tcase_add_test(t, the_fold_is_its_rows);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, arguments_and_failing_callbacks);
+    tcase_add_test(t, non_finite_prediction_refused_at_its_row);
     tcase_add_test(t, analytic_and_numerical_jacobians_discover_the_same);
     tcase_add_test(t, concealed_effects_are_found_through_the_model);
     tcase_add_test(t, a_right_model_discovers_nothing);

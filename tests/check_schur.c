@@ -293,6 +293,52 @@ START_TEST(merge_refuses_an_overflow_in_any_local_diagonal)
 }
 END_TEST
 
+/* The rank test at its edge, on 2 x 2 systems whose small pivot is known
+   in closed form: rows (1, 1) and (0, delta) give the Gram [[1, 1], [1,
+   1 + delta^2]], whose second pivot is delta^2, delta^2 / (1 + delta^2) of
+   its diagonal.  FE_LSQ_RANK_TOL is 1e-12: a pivot of 1.5e-12 of its
+   diagonal is kept (and x is the exact solution), one of 0.5e-12 is
+   singular; first as the global parameter's reduced pivot (one global,
+   one local), then inside a block (two locals). */
+START_TEST(rank_test_at_its_edge)
+{
+    double st[256], work[256], x[3], rss;
+    ck_assert_uint_le(fe_schur_storage(1, 2, 1), 256);
+    ck_assert_uint_le(fe_schur_solve_work(1, 2), 256);
+    for (int c = 0; c < 4; c++) {
+        double d2 = c % 2 == 0 ? 1.5e-12 : 0.5e-12, delta = sqrt(d2);
+        int want = c % 2 == 0 ? FE_OK : FE_ESINGULAR;
+        fe_schur a;
+        if (c < 2) {
+            /* Global x_g, local x_l: x_g + x_l = 1, delta x_l = 0. */
+            const double g1 = 1.0, l1 = 1.0, g2 = 0.0, l2 = delta;
+            ck_assert_int_eq(fe_schur_init(&a, 1, 1, 1, st), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &g1, 0, &l1, 1.0, 1.0), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &g2, 0, &l2, 0.0, 1.0), FE_OK);
+            ck_assert_msg(fe_schur_solve(&a, 0.0, x, &rss, work) == want, "global, %g", d2);
+            if (want == FE_OK) {
+                ck_assert_double_eq_tol(x[0], 1.0, 1e-3);
+                ck_assert_double_eq_tol(x[1], 0.0, 1e-3);
+            }
+        } else {
+            /* A global row x_g = 2 apart; in the block x1 + x2 = 1,
+               delta x2 = 0. */
+            const double g0 = 1.0, z = 0.0, l1[2] = {1.0, 1.0}, l2[2] = {0.0, delta};
+            ck_assert_int_eq(fe_schur_init(&a, 1, 2, 1, st), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &g0, FE_SCHUR_NONE, NULL, 2.0, 1.0), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &z, 0, l1, 1.0, 1.0), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &z, 0, l2, 0.0, 1.0), FE_OK);
+            ck_assert_msg(fe_schur_solve(&a, 0.0, x, &rss, work) == want, "block, %g", d2);
+            if (want == FE_OK) {
+                ck_assert_double_eq_tol(x[0], 2.0, 1e-9);
+                ck_assert_double_eq_tol(x[1], 1.0, 1e-3);
+                ck_assert_double_eq_tol(x[2], 0.0, 1e-3);
+            }
+        }
+    }
+}
+END_TEST
+
 Suite *fe_schur_suite(void)
 {
     Suite *s = suite_create("schur");
@@ -305,6 +351,7 @@ Suite *fe_schur_suite(void)
     tcase_add_test(t, bad_rows_are_refused_and_nothing_changes);
     tcase_add_test(t, underdetermined_blocks_are_singular_never_nan);
     tcase_add_test(t, shapes_and_degenerate_dimensions);
+    tcase_add_test(t, rank_test_at_its_edge);
     suite_add_tcase(s, t);
     return s;
 }

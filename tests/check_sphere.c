@@ -1588,6 +1588,62 @@ START_TEST(robust_scale_of_radial_errors)
 }
 END_TEST
 
+/* Folded onto one side of the centre across each axis alone: the
+   algebraic sphere refuses each with FE_SPHERE_HEMISPHERE (a check that
+   skipped an axis would take that axis's half as a whole). */
+START_TEST(algebraic_sphere_refuses_one_side_of_each_axis)
+{
+    enum { N = 4000 };
+    static double x[3 * N], y[3 * N];
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 31);
+    for (int j = 0; j < 3; j++) {
+        fe_quadric q = FE_QUADRIC_EMPTY;
+        fe_sphere_fit f;
+        memcpy(y, x, sizeof y);
+        for (size_t i = 0; i < N; i++)
+            if (y[3 * i + j] > C0[j])
+                y[3 * i + j] = 2 * C0[j] - y[3 * i + j];
+        ck_assert_int_eq(fe_quadric_add_many(&q, y, N, NULL), FE_OK);
+        f.refusal = FE_SPHERE_ACCEPTED;
+        ck_assert_msg(fe_sphere_fit_algebraic(&q, NULL, &f) == FE_EUNDETERMINED, "axis %d", j);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_HEMISPHERE);
+    }
+}
+END_TEST
+
+/* The rate's norm against max_rate, with the rate along each axis alone
+   and along a diagonal: |(1.5, 1.5, 0)| = 2.12 exceeds 2 though neither
+   component does, |(1.4, 1.4, 0)| = 1.98 does not. */
+START_TEST(still_rate_is_the_norm_of_all_three)
+{
+    enum { W = 20 };
+    double ring[7 * W], out[3], x[3] = {9.8, 0, 0};
+    fe_still_options o = fe_still_default_options();
+    int still, ready;
+    o.window = W;
+    o.max_rate = 2.0;
+    for (int c = 0; c < 5; c++) {
+        double rate[3] = {0, 0, 0};
+        fe_still s;
+        size_t want;
+        if (c < 3) {
+            rate[c] = 2.5;
+            want = 0;
+        } else {
+            rate[0] = rate[1] = c == 3 ? 1.5 : 1.4;
+            want = c == 3 ? 0 : 2 * W;
+        }
+        ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_OK);
+        for (int i = 0; i < 2 * W; i++)
+            ck_assert_int_eq(fe_still_push(&s, x, rate, out, &still, &ready), FE_OK);
+        while (fe_still_flush(&s, out, &still) == FE_OK)
+            ;
+        ck_assert_msg(s.still == want, "case %d: %llu still", c, (unsigned long long)s.still);
+        ck_assert_uint_eq(s.still + s.moving, 2 * W);
+    }
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -1618,6 +1674,8 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, refuse_one_hemisphere);
     tcase_add_test(t, refuse_a_hyperboloid);
     tcase_add_test(t, refuse_a_singular_system);
+    tcase_add_test(t, algebraic_sphere_refuses_one_side_of_each_axis);
+    tcase_add_test(t, still_rate_is_the_norm_of_all_three);
     tcase_add_test(r, real_qmc5883l_soft_iron);
     tcase_add_test(r, real_qmc5883l_halves_agree_within_their_errors);
     tcase_add_test(r, real_ck_explorer_magnetometer);

@@ -271,6 +271,40 @@ START_TEST(sources_at_their_edges)
 }
 END_TEST
 
+START_TEST(standard_input_is_a_source)
+{
+    /* Descriptor 0 is a valid source (standard input): a pipe put there
+       for the test (and standard input put back after) folds to its
+       mean; -1 is refused. */
+    int p[2], saved = dup(0);          /* -1 when standard input is closed */
+    double x[3] = {2, 4, 9}, buf[4];
+    fe_fd_source st;
+    fe_source src;
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    int rc;
+    ck_assert_int_eq(pipe(p), 0);
+    ck_assert_int_eq(write(p[1], x, sizeof x), (ssize_t)sizeof x);
+    close(p[1]);
+    ck_assert_int_eq(dup2(p[0], 0), 0);
+    if (p[0] != 0)
+        close(p[0]);
+    rc = fe_source_from_fd(&src, &st, 0, sizeof(double), buf, sizeof buf);
+    if (rc == FE_OK)
+        rc = fe_fold_source(&f, &a, &src, NULL);
+    if (saved >= 0) {
+        ck_assert_int_eq(dup2(saved, 0), 0);
+        close(saved);
+    } else {
+        close(0);
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    ck_assert_uint_eq(a.n, 3);
+    ck_assert_double_eq(a.mean, 5.0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, -1, sizeof(double), buf, sizeof buf), FE_EINVAL);
+}
+END_TEST
+
 Suite *fe_stream_suite(void)
 {
     Suite *s = suite_create("stream");
@@ -284,6 +318,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, bad_arguments_and_mismatched_sizes);
     tcase_add_test(t, sources_at_their_edges);
     tcase_add_test(t, fd_source_read_error_is_an_io_error);
+    tcase_add_test(t, standard_input_is_a_source);
     suite_add_tcase(s, t);
     return s;
 }

@@ -166,6 +166,93 @@ START_TEST(thermal_rig_follows_its_equations)
 }
 END_TEST
 
+START_TEST(mechanical_rig_follows_its_equations)
+{
+    /* The mechanical rig as literate/synth.org states it, recomputed here
+       row by row from the seeded phases phi_0..2: the input
+       u = min(t / 10, 1) (0.85 + 0.15 sin(2 pi t / (T / 3.3) + phi_2))
+           (sin(2 pi 0.17 t + phi_0) + 1.5 sin(2 pi 0.83 t + phi_1))
+       over the recording's length T, and the cart
+       a = u - w0^2 x - 2 zeta w0 v, w0 = 2 pi 0.4, zeta = 0.15, advanced
+       by semi-implicit Euler (v += a dt, then x += v dt), the channel sim
+       being a; position and velocity are the state before the step. */
+    enum { N = 6000 };
+    const double two_pi = 6.283185307179586476925286766559;
+    const double w0 = two_pi * 0.4, zeta = 0.15;
+    fe_synth g;
+    fe_synth_spec spec = fe_synth_default_spec("quadratic_drag", 5);
+    fe_sample s;
+    double dt, total, x = 0.0, v = 0.0, worst = 0.0, umax = 0.0;
+    spec.rows = N;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    ck_assert_int_eq(g.thermal, 0);
+    dt = g.dt;
+    ck_assert_double_eq_tol(dt, 0.01, 1e-15);
+    total = (double)N * dt;
+    for (size_t i = 0; i < N; i++) {
+        double t = (double)i * dt;
+        double u = (t < 10.0 ? t / 10.0 : 1.0)
+                   * (0.85 + 0.15 * sin(two_pi * t / (total / 3.3) + g.phase[2]))
+                   * (sin(two_pi * 0.17 * t + g.phase[0])
+                      + 1.5 * sin(two_pi * 0.83 * t + g.phase[1]));
+        double a = u - w0 * w0 * x - 2.0 * zeta * w0 * v;
+        ck_assert_int_eq(fe_synth_next(&g, &s), FE_OK);
+        worst = fmax(worst, fabs(s.t - t));
+        worst = fmax(worst, fabs(s.input - u));
+        worst = fmax(worst, fabs(s.position - x));
+        worst = fmax(worst, fabs(s.velocity - v));
+        worst = fmax(worst, fabs(s.sim - a));
+        umax = fmax(umax, fabs(u));
+        v += a * dt;
+        x += v * dt;
+    }
+    ck_assert_msg(worst < 1e-9, "time, input or cart off the equations by %.3g", worst);
+    ck_assert_double_gt(umax, 1.0);
+    /* The phases differ and lie in [0, 2 pi). */
+    for (int k = 0; k < 3; k++) {
+        ck_assert_double_ge(g.phase[k], 0.0);
+        ck_assert_double_lt(g.phase[k], two_pi);
+    }
+}
+END_TEST
+
+START_TEST(noise_is_its_ar1_recursion)
+{
+    /* With no effect, real - sim is the noise alone: the AR(1) recursion
+       of literate/synth.org started stationary at the first row,
+       e_0 = sigma z_0, e_i = rho e_{i-1} + sqrt(1 - rho^2) sigma z_i, the
+       z_i drawn in turn from the noise generator (seeded 2 seed + 2);
+       each rig, two values of rho; rewound, the same rows again. */
+    static const struct { const char *effect; double rho; } cases[] = {
+        {"none", 0.5}, {"none", 0.9}, {"none_thermal", 0.5}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        fe_synth g;
+        fe_synth_spec spec = fe_synth_default_spec(cases[c].effect, 13);
+        fe_rng z = fe_rng_seed(13 * 2 + 2);
+        fe_sample s;
+        double e = 0.0, worst = 0.0, first = 0.0;
+        spec.rows = 2000;
+        spec.noise_rho = cases[c].rho;
+        spec.noise_sd = 0.7;
+        ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+        ck_assert_double_eq(g.coefficient, 0.0);
+        for (size_t i = 0; i < spec.rows; i++) {
+            double zi = fe_rng_normal(&z);
+            e = i == 0 ? 0.7 * zi : cases[c].rho * e + sqrt(1.0 - cases[c].rho * cases[c].rho) * 0.7 * zi;
+            ck_assert_int_eq(fe_synth_next(&g, &s), FE_OK);
+            worst = fmax(worst, fabs((s.real - s.sim) - e));
+            if (i == 0)
+                first = s.real;
+        }
+        ck_assert_msg(worst < 1e-12, "%s rho %g: noise off its recursion by %.3g",
+                      cases[c].effect, cases[c].rho, worst);
+        fe_synth_rewind(&g);
+        ck_assert_int_eq(fe_synth_next(&g, &s), FE_OK);
+        ck_assert_double_eq(s.real, first);
+    }
+}
+END_TEST
+
 Suite *fe_synth_suite(void)
 {
     Suite *s = suite_create("synth");
@@ -173,6 +260,8 @@ Suite *fe_synth_suite(void)
     tcase_set_timeout(t, 60);           /* 10^6 rows: about 1 s, more on a busy machine */
     tcase_add_test(t, spec_refusals_at_their_edges);
     tcase_add_test(t, thermal_rig_follows_its_equations);
+    tcase_add_test(t, mechanical_rig_follows_its_equations);
+    tcase_add_test(t, noise_is_its_ar1_recursion);
     tcase_add_test(t, rows_carry_the_central_difference_of_sim);
     suite_add_tcase(s, t);
     return s;

@@ -342,6 +342,107 @@ def stripped(obj, dst):
         return f.read()
 
 
+def occurrence(text, line):
+    """Which occurrence of its text (stripped) line `line` of `text` is:
+    1 for the first line of the file that reads so, 2 for the second..."""
+    all_lines = text.splitlines()
+    want = all_lines[line - 1].strip()
+    return sum(1 for ln in all_lines[:line] if ln.strip() == want)
+
+
+def load_explained(path):
+    """The survivors explained in literate/guarantees.org, as listed in
+    `path`: blocks of three lines, `module | change | verdict` or
+    `module | change | verdict | n` (verdict equivalent or accepted; n: the
+    n-th line of the file with that text, 1 when left out), the mutated
+    source line as the report prints it (stripped), and the reason in one
+    line; blank lines and lines starting with # between blocks.  Keyed by
+    (module, change, line, n), so an entry holds while that line's text
+    does not change, whatever its number or the mutant's id; every mutant
+    of that kind on that line is meant (a line with two zeros has two
+    mutants 0 -> 1)."""
+    out = {}
+    if not path or not os.path.exists(path):
+        return out
+    with open(path, encoding="utf-8") as f:
+        lines = [ln.rstrip("\n") for ln in f if ln.strip() and not ln.startswith("#")]
+    if len(lines) % 3:
+        sys.exit("mutate: %s: entries are three lines each" % path)
+    for i in range(0, len(lines), 3):
+        head = [h.strip() for h in lines[i].split(" | ")]
+        if len(head) not in (3, 4) or head[2] not in ("equivalent", "accepted") \
+                or (len(head) == 4 and not head[3].isdigit()):
+            sys.exit("mutate: %s: bad entry: %s" % (path, lines[i]))
+        n = int(head[3]) if len(head) == 4 else 1
+        out[(head[0], head[1], lines[i + 1].strip(), n)] = head[2]
+    return out
+
+
+# The bounds checks of UBSan, trapping (no run-time library to link).
+BOUNDS = ["-fsanitize=bounds", "-fsanitize-undefined-trap-on-error"]
+
+
+def report(results, mods, seed, secs, excluded, a, B):
+    # The report.  A survivor listed in the explained file is marked
+    # equivalent or accepted; the raw kill rate counts every survivor, the
+    # last column leaves out the documented equivalent ones.
+    explained = load_explained(a.explained)
+    for x in results:
+        x["explained"] = ""
+        if x["verdict"] == "survived":
+            e = explained.get((x["module"], x["change"], x["line"], x.get("occurrence", 1)))
+            if e is not None:
+                x["explained"] = e
+    rows, tot = [], {"killed": 0, "survived": 0, "stillborn": 0, "identical": 0, "not run": 0,
+                     "equivalent": 0}
+    for m in mods:
+        r = [x for x in results if x["module"] == m]
+        if not r:
+            continue
+        c = {v: sum(1 for x in r if x["verdict"] == v) for v in tot}
+        c["equivalent"] = sum(1 for x in r if x["explained"] == "equivalent")
+        for v in tot:
+            tot[v] += c[v]
+        rows.append((m, len(r), c))
+
+    def rate(c, less=0):
+        d = c["killed"] + c["survived"] - less
+        return "%5.1f %%" % (100.0 * c["killed"] / d) if d else "    -  "
+
+    lines_out = ["", "module      mutants  killed  survived  stillborn  identical  not run   kill rate"
+                 "   equivalent   without them"]
+    for m, nm, c in rows:
+        lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s   %10d   %s" % (
+            m, nm, c["killed"], c["survived"], c["stillborn"], c["identical"], c["not run"],
+            rate(c), c["equivalent"], rate(c, c["equivalent"])))
+    lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s   %10d   %s" % (
+        "overall", len(results), tot["killed"], tot["survived"], tot["stillborn"],
+        tot["identical"], tot["not run"], rate(tot), tot["equivalent"],
+        rate(tot, tot["equivalent"])))
+    lines_out.append("(seed %d, %d mutants in %.0f s; excluded: %s; kill rate = killed / (killed"
+                     " + survived); equivalent: survivors documented as such in %s)" % (
+                         seed, len(results), secs, ", ".join(sorted(excluded)) or "none",
+                         a.explained))
+    surv = [x for x in results if x["verdict"] == "survived"]
+    if surv:
+        lines_out += ["", "surviving mutants (explained: %s):" % a.explained]
+        for x in surv:
+            lines_out.append("  %-10s %-22s %-34s %-12s | %s" % (
+                x["id"], x["where"], x["change"], x["explained"] or "UNEXPLAINED", x["line"]))
+    notrun = [x for x in results if x["verdict"] == "not run"]
+    if notrun:
+        lines_out += ["", "not run here (AVX-512 code; this processor lacks avx512f):"]
+        for x in notrun:
+            lines_out.append("  %-10s %-22s %-34s | %s" % (x["id"], x["where"], x["change"], x["line"]))
+    text = "\n".join(lines_out) + "\n"
+    print(text, end="")
+    with open(os.path.join(B, "report.txt"), "w") as h:
+        h.write(text)
+    with open(os.path.join(B, "results.json"), "w") as h:
+        json.dump(results, h, indent=1)
+    return tot
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--mutants", type=int, default=0,
@@ -354,8 +455,13 @@ def main():
                     help="suites never run for a mutant (slow; command-level)")
     ap.add_argument("--ids", default="", help="run only these mutant ids (module:number,...)")
     ap.add_argument("--list", action="store_true", help="print the mutants, run nothing")
+    ap.add_argument("--report", action="store_true",
+                    help="print the report of the last run again (results.json), with the "
+                         "explained file as it is now; run nothing")
     ap.add_argument("--min-rate", type=float, default=0.0,
                     help="exit 1 when the overall kill rate is below this (percent)")
+    ap.add_argument("--explained", default="tests/mutate/explained.txt",
+                    help="survivors explained as equivalent or accepted (see load_explained)")
     ap.add_argument("--build", default="build")
     ap.add_argument("--cc", default="cc")
     ap.add_argument("--cflags", default="-std=c11 -Wall -Wextra -pedantic -O2 -g")
@@ -405,6 +511,16 @@ def main():
     def describe(m, k):
         kind, s, e, new, line, desc = cands[m][k]
         return "src/%s.c:%d" % (m, line), desc
+
+    if a.report:
+        B = os.path.join(a.build, "mutate")
+        with open(os.path.join(B, "results.json")) as h:
+            results = json.load(h)
+        with open(os.path.join(B, "run.json")) as h:
+            run_meta = json.load(h)
+        report(results, sorted({x["module"] for x in results}), run_meta["seed"],
+               run_meta["secs"], set(run_meta["excluded"]), a, B)
+        return 0
 
     if a.list:
         for m, k in chosen:
@@ -507,11 +623,19 @@ def main():
             h.write('#line 1 "src/%s.c"\n' % m + text)
         # A file with lane kernels (lanes.h) has a four-lane kernel that
         # this processor may never run: a mutant that survives the build
-        # as it is is built again with FE_NO_CLONES (four lanes only).
-        variants = [[]] + ([["-DFE_NO_CLONES"]] if '#include "lanes.h"' in src[m] else [])
+        # as it is is built again with FE_NO_CLONES (four lanes only).  A
+        # mutant that still survives is built once more with the bounds
+        # checks of UBSan (a trap, no run-time library): an index one past
+        # an array, which the plain build reads or writes silently and
+        # `make check`'s sanitizer build reports, then fails the suite that
+        # reaches it.
+        variants = [[]] + ([["-DFE_NO_CLONES"]] if '#include "lanes.h"' in src[m] else []) + \
+            [BOUNDS]
         verdict, by, ran = None, "", False
         for vi, extra in enumerate(variants):
             key = (m, vi)
+            if extra == BOUNDS and not ran:
+                continue                # identical in the plain build: not run
             if key not in pristine:
                 pobj = os.path.join(B, "pristine%d.o" % vi)
                 if vi == 0:
@@ -519,6 +643,20 @@ def main():
                 else:
                     sh([a.cc] + cflags + extra + ["-c", "src/%s.c" % m, "-o", pobj])
                 pristine[key] = stripped(pobj, os.path.join(B, "pristine.o"))
+                if extra == BOUNDS:
+                    # The unmutated module with bounds checks must pass its
+                    # suites too, or this build proves nothing.
+                    bad = link([pobj if x == m else o for x, o in lib_objs.items()])
+                    for s in ([] if bad else suites_of(m)):
+                        if run_suite(s, max(10.0, 10 * base[s]))[0] != 0:
+                            bad = s
+                            break
+                    if bad:
+                        print("mutate: %s with bounds checks fails %s unmutated; that build "
+                              "is not used" % (m, bad), flush=True)
+                        pristine[key] = None
+            if pristine[key] is None:
+                continue
             status, out, _ = run([a.cc] + cflags + extra + ["-c", msrc, "-o", mobj], timeout=300)
             if status != 0 and vi == 0:
                 verdict = "stillborn"
@@ -536,7 +674,8 @@ def main():
                 if status != 0:
                     verdict = "killed"
                     by = s + (" (timeout)" if status is None else "") + \
-                        (" " + " ".join(extra) if extra else "")
+                        (" (bounds checks)" if extra == BOUNDS else
+                         " " + " ".join(extra) if extra else "")
                     break
             if verdict == "killed":
                 break
@@ -546,52 +685,15 @@ def main():
                 verdict = "not run"
         results.append(dict(id="%s:%d" % (m, k), module=m, where=where, kind=kind, change=desc,
                             verdict=verdict, by=by,
-                            line=src[m].splitlines()[line - 1].strip()))
+                            line=src[m].splitlines()[line - 1].strip(),
+                            occurrence=occurrence(src[m], line)))
         print("[%d/%d] %-8s %-22s %-34s %s %s" % (n, len(chosen), results[-1]["id"], where, desc,
                                                  verdict, by), flush=True)
 
-    # The report.
     secs = time.monotonic() - t_start
-    rows, tot = [], {"killed": 0, "survived": 0, "stillborn": 0, "identical": 0, "not run": 0}
-    for m in mods:
-        r = [x for x in results if x["module"] == m]
-        if not r:
-            continue
-        c = {v: sum(1 for x in r if x["verdict"] == v) for v in tot}
-        for v in tot:
-            tot[v] += c[v]
-        rows.append((m, len(r), c))
-
-    def rate(c):
-        d = c["killed"] + c["survived"]
-        return "%5.1f %%" % (100.0 * c["killed"] / d) if d else "    -  "
-
-    lines_out = ["", "module      mutants  killed  survived  stillborn  identical  not run   kill rate"]
-    for m, nm, c in rows:
-        lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s" % (
-            m, nm, c["killed"], c["survived"], c["stillborn"], c["identical"], c["not run"],
-            rate(c)))
-    lines_out.append("%-10s %8d %7d %9d %10d %10d %8d   %s" % (
-        "overall", len(results), tot["killed"], tot["survived"], tot["stillborn"],
-        tot["identical"], tot["not run"], rate(tot)))
-    lines_out.append("(seed %d, %d mutants in %.0f s; excluded: %s)" % (
-        a.seed, len(results), secs, ", ".join(sorted(excluded)) or "none"))
-    surv = [x for x in results if x["verdict"] == "survived"]
-    if surv:
-        lines_out += ["", "surviving mutants:"]
-        for x in surv:
-            lines_out.append("  %-10s %-22s %-34s | %s" % (x["id"], x["where"], x["change"], x["line"]))
-    notrun = [x for x in results if x["verdict"] == "not run"]
-    if notrun:
-        lines_out += ["", "not run here (AVX-512 code; this processor lacks avx512f):"]
-        for x in notrun:
-            lines_out.append("  %-10s %-22s %-34s | %s" % (x["id"], x["where"], x["change"], x["line"]))
-    report = "\n".join(lines_out) + "\n"
-    print(report, end="")
-    with open(os.path.join(B, "report.txt"), "w") as h:
-        h.write(report)
-    with open(os.path.join(B, "results.json"), "w") as h:
-        json.dump(results, h, indent=1)
+    with open(os.path.join(B, "run.json"), "w") as h:
+        json.dump(dict(seed=a.seed, secs=secs, excluded=sorted(excluded)), h)
+    tot = report(results, mods, a.seed, secs, excluded, a, B)
     d = tot["killed"] + tot["survived"]
     if d and 100.0 * tot["killed"] / d < a.min_rate:
         print("mutate: kill rate below %.0f %%" % a.min_rate)
