@@ -111,8 +111,8 @@ $(B)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h)
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -D_POSIX_C_SOURCE=200809L -O3 -march=native -g -Iinclude -Ibench $(EXT_CFLAGS) -o $@ $< $(STATIC) $(EXT_LIBS) $(BENCH_LIBS)
 
-bench: $(BENCHES)
-	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+bench: $(BENCHES) $(CLI)
+	@for b in $(BENCHES); do echo "== $$b"; FOLDEST=$(abspath $(CLI)) $$b || exit 1; done
 
 # ---------------------------------------------------------------- MPI (optional)
 # Only these targets need Open MPI (mpicc, mpirun); libfoldest never links
@@ -216,8 +216,20 @@ $(B)/tsan/%.o: src/%.c $(HEADERS) $(PRIV_HEADERS) $(B)/.deps
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude $(EXT_CFLAGS) -c $< -o $@
 
-$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h tests/cli_run.h $(B)/tests/suites.h $(TSAN_OBJ)
-	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
+# The command too: its tables are parsed on threads (cli.org, "Every core
+# on one file"); the tests built here run this instrumented foldest.
+TSAN_CLI_OBJ := $(patsubst src/cli/%.c,$(B)/tsan/cli/%.o,$(CLI_SRC))
+TSAN_CLI     := $(B)/tsan/bin/foldest
+$(B)/tsan/cli/%.o: src/cli/%.c $(HEADERS) $(wildcard src/cli/*.h) $(B)/.deps
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -O1 -g $(TSAN) -Iinclude -Isrc/cli -c $< -o $@
+$(TSAN_CLI): $(TSAN_CLI_OBJ) $(TSAN_OBJ)
+	@mkdir -p $(@D)
+	$(CC) $(TSAN) -o $@ $(TSAN_CLI_OBJ) $(TSAN_OBJ) $(EXT_LIBS) $(CLI_LIBS)
+
+$(B)/tests/check_foldest_tsan: $(TEST_SRC) tests/main.c tests/testutil.h tests/cli_run.h $(B)/tests/suites.h $(TSAN_OBJ) $(TSAN_CLI)
+	$(CC) $(WARN) -O1 -g $(TSAN) -DFE_TEST_CLI='"$(abspath $(TSAN_CLI))"' -DFE_TEST_SRC='"$(abspath .)"' \
+	  -Iinclude -Itests -I$(B)/tests $(CHECK_CFLAGS) -o $@ \
 	  tests/main.c $(TEST_SRC) $(TSAN_OBJ) $(CHECK_LIBS) $(EXT_LIBS)
 
 tests: $(B)/tests/check_foldest $(B)/tests/check_foldest_san
@@ -244,6 +256,8 @@ check-valgrind: $(B)/tests/check_foldest
 check-tsan: $(B)/tests/check_foldest_tsan
 	@echo "== parallel tests (ThreadSanitizer)"
 	CK_RUN_SUITE=parallel FE_TEST_QUICK=1 TSAN_OPTIONS=halt_on_error=1 $(B)/tests/check_foldest_tsan
+	@echo "== the command's threaded reading (ThreadSanitizer: a race ends the command with status 66)"
+	CK_RUN_SUITE=threads_cli FE_TEST_QUICK=1 TSAN_OPTIONS=halt_on_error=1:exitcode=66 $(B)/tests/check_foldest_tsan
 
 # Install into a scratch DESTDIR and build every example from it with
 # pkg-config; then build tests/cxx/use_from_cxx.cpp the same way as C++17

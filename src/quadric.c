@@ -772,6 +772,75 @@ int fe_quadric_blocks_add(fe_quadric_blocks *qb, const double x[3])
     return FE_OK;
 }
 
+/* Many samples: each run up to the end of the current block is folded
+   into a copy of the block and of `all` with fe_quadric_add_many; when
+   either refuses a sample, the run is folded again up to the first sample
+   both accepted, so that the blocks and `all` hold the same samples. */
+int fe_quadric_blocks_add_many(fe_quadric_blocks *qb, const double *x, size_t n,
+                               size_t *done)
+{
+    size_t i = 0;
+    if (done != NULL)
+        *done = 0;
+    if (qb == NULL || (x == NULL && n > 0))
+        return FE_EINVAL;
+    while (i < n) {
+        fe_quadric_blocks keep;
+        fe_quadric cur = FE_QUADRIC_EMPTY, all = qb->all;
+        uint64_t len = qb->block_len ? qb->block_len : 1, room;
+        size_t m, got_cur = 0, got_all = 0;
+        int fresh = qb->nblocks == 0 || qb->block[qb->nblocks - 1].m[0] >= (double)len;
+        int halved = 0, rc_cur, rc_all;
+        if (fresh && qb->nblocks == FE_QUADRIC_BLOCKS) {
+            int rc;
+            keep = *qb;
+            rc = fe__quadric_blocks_halve(qb);
+            if (rc != FE_OK) {
+                *qb = keep;
+                return rc;
+            }
+            halved = 1;
+            len = qb->block_len;
+        }
+        if (!fresh)
+            cur = qb->block[qb->nblocks - 1];
+        room = fresh ? len : len - (uint64_t)cur.m[0];
+        m = (uint64_t)(n - i) < room ? n - i : (size_t)room;
+        rc_cur = fe_quadric_add_many(&cur, x + 3 * i, m, &got_cur);
+        rc_all = fe_quadric_add_many(&all, x + 3 * i, m, &got_all);
+        if (rc_cur != FE_OK || rc_all != FE_OK) {
+            size_t d = got_cur < got_all ? got_cur : got_all;
+            int rc = rc_cur != FE_OK && got_cur == d ? rc_cur : rc_all;
+            if (d == 0) {
+                if (halved)
+                    *qb = keep;
+                if (done != NULL)
+                    *done = i;
+                return rc;
+            }
+            cur = fresh ? (fe_quadric)FE_QUADRIC_EMPTY : qb->block[qb->nblocks - 1];
+            all = qb->all;
+            fe_quadric_add_many(&cur, x + 3 * i, d, NULL);
+            fe_quadric_add_many(&all, x + 3 * i, d, NULL);
+            qb->all = all;
+            if (fresh)
+                qb->nblocks++;
+            qb->block[qb->nblocks - 1] = cur;
+            if (done != NULL)
+                *done = i + d;
+            return rc;
+        }
+        qb->all = all;
+        if (fresh)
+            qb->nblocks++;
+        qb->block[qb->nblocks - 1] = cur;
+        i += m;
+    }
+    if (done != NULL)
+        *done = n;
+    return FE_OK;
+}
+
 int fe_quadric_blocks_merge(fe_quadric_blocks *a, const fe_quadric_blocks *b)
 {
     fe_quadric_blocks x, y;

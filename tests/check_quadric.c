@@ -780,6 +780,57 @@ START_TEST(blocks_partition_the_stream_and_merge_in_time)
 }
 END_TEST
 
+/* Many samples at once, in runs of any length: the blocks, counts,
+   extremes and coverage of one sample at a time, the moments to 1e-12;
+   a refused sample stops it with exactly the samples before folded. */
+START_TEST(blocks_add_many_is_the_step_repeated)
+{
+    enum { N = 20000 + 77 };
+    static double x[3 * N];
+    static fe_quadric_blocks one, many, upto;
+    const double c[3] = {10, -20, 5}, r[3] = {30, 45, 60};
+    static const size_t runs[] = {1, 7, 512, 3, 1000, 4096, 13};
+    double apart;
+    size_t done, i = 0, k = 0;
+    fe_test_ellipsoid_points(x, N, c, r, 0.5, 4);
+    fe_quadric_blocks_init(&one);
+    fe_quadric_blocks_init(&many);
+    for (size_t j = 0; j < N; j++)
+        ck_assert_int_eq(fe_quadric_blocks_add(&one, x + 3 * j), FE_OK);
+    while (i < N) {
+        size_t m = runs[k++ % (sizeof runs / sizeof runs[0])];
+        m = m < N - i ? m : N - i;
+        ck_assert_int_eq(fe_quadric_blocks_add_many(&many, x + 3 * i, m, &done), FE_OK);
+        ck_assert_uint_eq(done, m);
+        i += m;
+    }
+    ck_assert_uint_eq(many.nblocks, one.nblocks);
+    ck_assert_uint_eq(many.block_len, one.block_len);
+    for (uint32_t b = 0; b <= many.nblocks; b++) {
+        const fe_quadric *p = b < many.nblocks ? &many.block[b] : &many.all;
+        const fe_quadric *q = b < many.nblocks ? &one.block[b] : &one.all;
+        ck_assert_double_eq(p->m[0], q->m[0]);
+        ck_assert_mem_eq(p->lo, q->lo, sizeof p->lo);
+        ck_assert_mem_eq(p->hi, q->hi, sizeof p->hi);
+        ck_assert_int_eq(fe_quadric_regions(p), fe_quadric_regions(q));
+        ck_assert_int_eq(fe_quadric_compare(p, q, &apart), FE_OK);
+        ck_assert_double_le(apart, 1e-12);
+    }
+    /* A sample whose fourth power overflows, at 3000: 3000 folded. */
+    x[3 * 3000] = 1e300;
+    fe_quadric_blocks_init(&many);
+    fe_quadric_blocks_init(&upto);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&many, x, N, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(done, 3000);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&upto, x, 3000, NULL), FE_OK);
+    ck_assert_mem_eq(&many, &upto, sizeof many);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(NULL, x, 1, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&many, NULL, 1, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&many, NULL, 0, &done), FE_OK);
+    ck_assert_uint_eq(done, 0);
+}
+END_TEST
+
 Suite *fe_quadric_suite(void)
 {
     Suite *s = suite_create("quadric");
@@ -801,6 +852,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, compare_a_box_of_one_point_absolutely);
     tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);
+    tcase_add_test(t, blocks_add_many_is_the_step_repeated);
     tcase_add_test(t, f32_step_agrees_with_the_double_step);
     tcase_add_test(t, f32_recentre_is_exact);
     tcase_add_test(t, f32_bad_samples_leave_it_unchanged);

@@ -16,13 +16,13 @@ _foldest()
         return 0
     fi
     case "$cmd" in
-        stats) opts="--columns --skip --json" ;;
+        stats) opts="--columns --skip --json --threads" ;;
         calibrate) opts="--model --columns --apply --skip --json --trace --field --export
                          --mgauss --static --window --still-sd --gyro --max-rate --robust
-                         --robust-k --report" ;;
+                         --robust-k --report --threads" ;;
         discover) opts="--real --sim --channel --time --role --base --holdout --noise --lags --blocks
                         --alpha --order --report --json --sphere --columns --term --terms
-                        --only --exclude" ;;
+                        --only --exclude --threads" ;;
         synth) opts="--effect --real --sim --seed --rows --order --rho" ;;
         *) return 0 ;;
     esac

@@ -128,6 +128,15 @@ int fe_quadric_blocks_init(fe_quadric_blocks *qb);
    at most 16 merges. */
 int fe_quadric_blocks_add(fe_quadric_blocks *qb, const double x[3]);
 
+/* fe_quadric_blocks_add_many: fold the n samples x[3k..3k+2] as n calls
+   of fe_quadric_blocks_add would: the same blocks, counts, extremes and
+   coverage, the moments equal up to rounding (each block's run and `all`
+   go through fe_quadric_add_many).  Stops at the first sample refused;
+   *done (if not NULL) receives how many were folded, and qb holds exactly
+   those.  FE_EINVAL for NULL.  No allocation; about 13 KB of stack. */
+int fe_quadric_blocks_add_many(fe_quadric_blocks *qb, const double *x, size_t n,
+                               size_t *done);
+
 /* fe_quadric_blocks_merge: a <- a followed in time by b: the blocks of the
    one with shorter blocks merge pairwise until both have the same length,
    then b's are appended (merging pairwise again while there are more than

@@ -16,7 +16,7 @@ static const char *const fe__calibrate_help[] = {
     "                         [--field F] [--export ardupilot|c|json]\n"
     "                         [--mgauss K] [--static [--window N] [--still-sd E]\n"
     "                         [--gyro a,b,c --max-rate R]] [--robust [--robust-k K]]\n"
-    "                         [--report DIR]\n"
+    "                         [--report DIR] [--threads N]\n"
     "                         FILE.csv|-\n"
     "\n"
     "Calibrate a three-axis magnetometer or accelerometer: find the offset b and\n"
@@ -30,6 +30,10 @@ static const char *const fe__calibrate_help[] = {
     "                  from 1; default: the table's columns when it has three\n"
     "  --skip N        skip N lines before the header (default: found\n"
     "                  automatically after metadata lines)\n"
+    "  --threads N     parse a regular file on N threads (default: the\n"
+    "                  processors online); the samples are folded in file\n"
+    "                  order, so the result is the same for any N; standard\n"
+    "                  input, pipes and gzip files are read by one thread\n"
     "  --json          print one JSON object: model, n, offset, offset_se,\n"
     "                  offset_se_iid, se_blocks, matrix (3x3, to the unit\n"
     "                  sphere), matrix_se, radius, axes, params,\n"
@@ -124,6 +128,7 @@ typedef struct fe__calibrate_args {
     fe_still_options still_opt;
     int export_format;          /* fe__calibrate_export */
     int json, trace;
+    int threads;                /* --threads: parsing threads for every pass */
     fe_sphere_model model;
 } fe__calibrate_args;
 
@@ -133,7 +138,7 @@ static const fe_cli_option fe__calibrate_options[] = {
     {"--model", 1}, {"--columns", 1}, {"--apply", 1}, {"--skip", 1}, {"--json", 0},
     {"--trace", 0}, {"--field", 1}, {"--export", 1}, {"--mgauss", 1}, {"--static", 0}, {"--window", 1},
     {"--still-sd", 1}, {"--gyro", 1}, {"--max-rate", 1}, {"--robust", 0},
-    {"--robust-k", 1}, {"--report", 1}, {NULL, 0}};
+    {"--robust-k", 1}, {"--report", 1}, {"--threads", 1}, {NULL, 0}};
 
 /* The number after option `name`: finite, above 0 (or at least 0 when
    zero_ok); FE_CLI_OK, or FE_CLI_USAGE after saying why. */
@@ -164,6 +169,7 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
     a->still_opt = fe_still_default_options();
     a->robust_k = 5.0;
     a->model = FE_FIT_AXIAL;
+    a->threads = fe_cli_threads_default();
     rc = fe_cli_options("calibrate", fe__calibrate_options, &argc, &argv);
     if (rc != FE_CLI_OK)
         return rc;
@@ -199,6 +205,11 @@ static int fe__calibrate_parse(int argc, char **argv, fe__calibrate_args *a)
             }
         } else if (strcmp(argv[i], "--report") == 0 && i + 1 < argc) {
             a->report = argv[++i];
+        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+            if (fe_cli_parse_threads(argv[++i], &a->threads, err, sizeof err) != FE_CLI_OK) {
+                fprintf(stderr, "foldest calibrate: %s\n", err);
+                return FE_CLI_USAGE;
+            }
         } else if (strcmp(argv[i], "--robust") == 0) {
             a->robust = 1;
         } else if (strcmp(argv[i], "--robust-k") == 0 && i + 1 < argc) {
@@ -338,37 +349,108 @@ static void fe__calibrate_flag(fe__calibrate_flags *fl, const fe_quadric_blocks 
     fe_radial_hist_add(&fl->hist, e);
 }
 
+/* What the walks of --robust do with each sample the fit used. */
+typedef int fe__calibrate_visit(void *ctx, const double x[3]);
+
+/* A pass's state for its rows, handed in file order by fe_cli_table_each
+   (cli.org, "Every core on one file"): the rows may be parsed on several
+   threads, but every sample below is folded on the calling thread, in the
+   order of the file, so every pass gives the one-thread result bit for
+   bit, the gate's and the flags' included. */
+typedef struct fe__calibrate_rows {
+    size_t ncols;
+    fe_still *gate;             /* --static, or NULL */
+    int still, ready;           /* the gate's last verdict */
+    fe__calibrate_flags *fl;    /* the first pass: --robust from stdin */
+    fe_quadric_blocks *q;       /* the first pass: the moments */
+    double run[3 * 512];        /* the first pass: samples not yet folded */
+    size_t run_line[512], nrun; /* and their lines */
+    fe__calibrate_visit *visit; /* the walks: each sample fitted */
+    void *ctx;
+    struct fe__calibrate_measure *m;   /* the second pass */
+    const fe_sphere_fit *fit;
+    const fe_sphere_scaled *sc;
+} fe__calibrate_rows;
+
+/* A row through the gate: 1 when *y is a sample to use (its verdict in
+   r->still), 0 when the gate holds it, or the library's error. */
+static int fe__calibrate_gate(fe__calibrate_rows *r, const double *x, double y[3])
+{
+    if (r->gate == NULL) {
+        memcpy(y, x, 3 * sizeof *y);
+        return FE_OK;
+    }
+    return fe_still_push(r->gate, x, r->ncols == 6 ? x + 3 : NULL, y, &r->still, &r->ready);
+}
+
+/* A sample the library refused, at its line. */
+static int fe__calibrate_refused_at(fe_cli_table *t, int rc)
+{
+    fe_cli_progress_done(t);
+    fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line, fe_strerror(rc));
+    return FE_CLI_INPUT;
+}
+
+/* Fold the samples waiting in the run; a refused one is reported at the
+   line it came with. */
+static int fe__calibrate_fold_run(fe__calibrate_rows *r, fe_cli_table *t)
+{
+    size_t done;
+    int rc = fe_quadric_blocks_add_many(r->q, r->run, r->nrun, &done);
+    r->nrun = 0;
+    if (rc == FE_OK)
+        return 0;
+    t->line = r->run_line[done];
+    return fe__calibrate_refused_at(t, rc);
+}
+
+static int fe__calibrate_fold_row(void *ctx, fe_cli_table *t, const double *x)
+{
+    fe__calibrate_rows *r = ctx;
+    double y[3];
+    int rc = fe__calibrate_gate(r, x, y);
+    if (rc == FE_OK && r->ready && r->still && r->fl != NULL) {
+        rc = fe_quadric_blocks_add(r->q, y);
+        if (rc == FE_OK)
+            fe__calibrate_flag(r->fl, r->q, y);
+    } else if (rc == FE_OK && r->ready && r->still) {
+        memcpy(r->run + 3 * r->nrun, y, sizeof y);
+        r->run_line[r->nrun++] = t->line;
+        if (r->nrun == sizeof r->run_line / sizeof r->run_line[0]
+            && (rc = fe__calibrate_fold_run(r, t)) != 0)
+            return rc;
+    }
+    if (rc != FE_OK)
+        return fe__calibrate_refused_at(t, rc);
+    fe_cli_progress(t);
+    return 0;
+}
+
 /* Fold the samples, or with a gate (--static) the still ones, which it
    hands back `window` samples late, and the rest at the end; flag them
    when asked. */
-static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncols,
+static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncols, int threads,
                               fe_still *gate, fe__calibrate_flags *fl, fe_quadric_blocks *q)
 {
     char err[1024];
-    double x[6], y[3];
-    int rc, still = 1, ready = 1;
+    double y[3];
+    int rc, still = 1;
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.fl = fl;
+    r.q = q;
     fe_quadric_blocks_init(q);
-    while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
-        if (gate != NULL)
-            rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still, &ready);
-        else
-            memcpy(y, x, sizeof y);
-        if (rc == FE_OK && ready && still) {
-            rc = fe_quadric_blocks_add(q, y);
-            if (rc == FE_OK && fl != NULL)
-                fe__calibrate_flag(fl, q, y);
-        }
-        if (rc != FE_OK) {
-            fe_cli_progress_done(t);
-            fprintf(stderr, "foldest calibrate: %s:%zu:1: %s\n", t->name, t->line,
-                    fe_strerror(rc));
-            return FE_CLI_INPUT;
-        }
-        fe_cli_progress(t);
-    }
+    rc = fe_cli_table_each(t, cols, ncols, threads, fe__calibrate_fold_row, &r, err, sizeof err);
+    /* The samples still waiting come before a malformed row. */
+    if ((rc == FE_END || err[0] != '\0') && fe__calibrate_fold_run(&r, t) != 0)
+        return FE_CLI_INPUT;
     fe_cli_progress_done(t);
     if (rc != FE_END) {
-        fprintf(stderr, "foldest calibrate: %s\n", err);
+        if (err[0] != '\0')
+            fprintf(stderr, "foldest calibrate: %s\n", err);
         return rc;
     }
     while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
@@ -398,17 +480,34 @@ typedef struct fe__calibrate_pass2 {
 } fe__calibrate_pass2;
 
 /* Read the file again and hand every sample the fit used (all, or the
-   gate's still ones) to visit; for --robust. */
-typedef int fe__calibrate_visit(void *ctx, const double x[3]);
+   gate's still ones) to visit; for --robust.  A sample visit refuses is
+   reported at its line; a malformed row (the file changed since the first
+   pass) with the reader's message. */
+static int fe__calibrate_walk_row(void *ctx, fe_cli_table *t, const double *x)
+{
+    fe__calibrate_rows *r = ctx;
+    double y[3];
+    int rc = fe__calibrate_gate(r, x, y);
+    if (rc == FE_OK && r->ready && r->still)
+        rc = r->visit(r->ctx, y);
+    return rc == FE_OK ? 0 : fe__calibrate_refused_at(t, rc);
+}
 
 static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
                               size_t ncols, fe_still *gate, fe__calibrate_visit *visit,
                               void *ctx)
 {
     char err[1024];
-    double x[6], y[3];
+    double y[3];
     fe_cli_table t;
-    int rc, still = 1, ready = 1;
+    int rc, still;
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.visit = visit;
+    r.ctx = ctx;
     rc = fe_cli_table_open(&t, a->path, a->skip, err, sizeof err);
     if (rc != FE_CLI_OK) {
         fprintf(stderr, "foldest calibrate: %s\n", err);
@@ -416,15 +515,8 @@ static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
     }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
-    while ((rc = fe_cli_table_next(&t, cols, ncols, x, err, sizeof err)) == FE_OK) {
-        if (gate != NULL && (rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still,
-                                                &ready)) != FE_OK)
-            break;
-        if (gate == NULL)
-            memcpy(y, x, sizeof y);
-        if (ready && still && (rc = visit(ctx, y)) != FE_OK)
-            break;
-    }
+    rc = fe_cli_table_each(&t, cols, ncols, a->threads, fe__calibrate_walk_row, &r, err,
+                           sizeof err);
     if (rc == FE_END) {
         rc = FE_OK;
         while (rc == FE_OK && gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
@@ -434,13 +526,13 @@ static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
             fe_cli_table_close(&t);
             return FE_CLI_OK;
         }
-        snprintf(err, sizeof err, "%s: %s", t.name, fe_strerror(rc));
-    } else if (rc > FE_END) {
-        snprintf(err, sizeof err, "%s:%zu:1: %s", t.name, t.line, fe_strerror(rc));
+        fprintf(stderr, "foldest calibrate: %s: %s\n", t.name, fe_strerror(rc));
+        rc = FE_CLI_INPUT;
+    } else if (err[0] != '\0') {
+        fprintf(stderr, "foldest calibrate: %s\n", err);
     }
-    fprintf(stderr, "foldest calibrate: %s\n", err);
     fe_cli_table_close(&t);
-    return FE_CLI_INPUT;
+    return rc;
 }
 
 /* --robust on a file: the histogram of the radial errors under the first
@@ -519,6 +611,19 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
     }
 }
 
+static int fe__calibrate_measure_row(void *ctx, fe_cli_table *t, const double *x)
+{
+    fe__calibrate_rows *r = ctx;
+    double y[3];
+    int rc = fe__calibrate_gate(r, x, y);
+    if (rc != FE_OK)
+        return fe__calibrate_refused_at(t, rc);
+    if (r->ready)
+        fe__calibrate_one(r->m, r->fit, r->sc, y, r->still);
+    fe_cli_progress(t);
+    return 0;
+}
+
 static int fe__calibrate_second_pass(const fe__calibrate_args *a,
                                      const size_t cols[6], size_t ncols,
                                      fe_still *gate, double reject, size_t rows,
@@ -529,11 +634,13 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     char err[1024];
     static const fe__calibrate_measure none;
     fe__calibrate_measure m = none;
-    double x[6], y[3];
+    double y[3];
     const char *apply = a->apply;
     fe_cli_output o;
     fe_cli_table table, *t = &table;
-    int rc, still = 1, ready = 1;
+    int rc, still = 1;
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
 
     memset(out, 0, sizeof *out);
     if (strcmp(a->path, "-") == 0)
@@ -572,22 +679,21 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
-    while ((rc = fe_cli_table_next(t, cols, ncols, x, err, sizeof err)) == FE_OK) {
-        if (gate != NULL && (rc = fe_still_push(gate, x, ncols == 6 ? x + 3 : NULL, y, &still,
-                                                &ready)) != FE_OK)
-            break;
-        if (gate == NULL)
-            memcpy(y, x, sizeof y);
-        if (ready)
-            fe__calibrate_one(&m, fit, sc, y, still);
-        fe_cli_progress(t);
-    }
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    r.m = &m;
+    r.fit = fit;
+    r.sc = sc;
+    rc = fe_cli_table_each(t, cols, ncols, a->threads, fe__calibrate_measure_row, &r, err,
+                           sizeof err);
     fe_cli_progress_done(t);
     if (rc == FE_END)
         while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
             fe__calibrate_one(&m, fit, sc, y, still);
     if (rc != FE_END) {
-        fprintf(stderr, "foldest calibrate: %s\n", err);
+        if (err[0] != '\0')
+            fprintf(stderr, "foldest calibrate: %s\n", err);
         if (apply != NULL)
             fe_cli_output_abort(&o);
         if (m.samples != NULL)
@@ -1050,7 +1156,7 @@ int fe_cli_calibrate(int argc, char **argv)
         flags = &flag_state;
     }
     if (rc == FE_CLI_OK)
-        rc = fe__calibrate_fold(&t, cols, ncols, g, flags, &q);
+        rc = fe__calibrate_fold(&t, cols, ncols, a.threads, g, flags, &q);
     if (rc != FE_CLI_OK)
         goto done;
     if (g != NULL) {

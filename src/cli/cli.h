@@ -54,6 +54,14 @@ typedef struct fe_cli_table {
     void *gz;                   /* the zlib stream everything is read through */
     int decimal_comma;          /* 1: forced; 2: a semicolon table */
     size_t bad[4];              /* rows skipped in this pass, by reason */
+    int view;                   /* a batch's reader on a worker thread
+                                   (fe_cli_table_each): it touches no
+                                   global and shows no progress */
+    int threads;                /* parse on this many threads (0, 1: one) */
+    int serial;                 /* 1: the input cannot be cut */
+    void *pass;                 /* the threads' pass, while one runs */
+    off_t at;                   /* the bytes the batches have handed out,
+                                   for progress; 0: ask zlib */
 } fe_cli_table;
 
 /* Why a row was bad (the index of fe_cli_table.bad). */
@@ -92,6 +100,35 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
    copied to an unlinked temporary file. */
 int fe_cli_table_open_rewindable(fe_cli_table *t, const char *path, long skip,
                                  char *err, size_t errlen);
+
+/* Parse a regular, uncompressed file on `threads` threads (the calling
+   one included) from the next pass on: fe_cli_table_next then hands out
+   rows parsed ahead, in file order, with the one-thread rows, lines,
+   messages and bad-row counts.  Any other input, or threads <= 1: one
+   reader, as before.  A pass must ask for the same cols (the same array,
+   which the threads read until the pass ends) and k on every call;
+   fe_cli_table_rewind and fe_cli_table_close end it. */
+void fe_cli_table_threads(fe_cli_table *t, int threads);
+
+/* The rows of a table, handed one at a time and in file order to
+   fn(ctx, t, row), row[0..k-1] the columns cols[0..k-1], with t->line the
+   row's line and t->rows counting it; parsed on `threads` threads
+   (fe_cli_table_threads).  fn runs on the calling thread only, so it
+   needs no lock.  Returns FE_END after the last row; an exit status with
+   `err` = "FILE:LINE:COLUMN: message" for the first malformed row in file
+   order; or fn's nonzero return, with err empty (fn said why). */
+typedef int fe_cli_row_fn(void *ctx, fe_cli_table *t, const double *row);
+int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
+                      int threads, fe_cli_row_fn *fn, void *ctx,
+                      char *err, size_t errlen);
+
+/* The threads to use by default: the processors online (1 when unknown;
+   at most FE_CLI_THREADS_MAX).  fe_cli_parse_threads: --threads N, N from
+   1 to FE_CLI_THREADS_MAX; FE_CLI_USAGE with a message otherwise. */
+enum { FE_CLI_THREADS_MAX = 64 };
+int fe_cli_threads_default(void);
+int fe_cli_parse_threads(const char *text, int *threads, char *err,
+                         size_t errlen);
 
 /* Rewind to the first data row (FE_CLI_IO when the input cannot seek). */
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen);

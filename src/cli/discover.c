@@ -357,6 +357,8 @@ static const char fe__discover_help[] =
     "  --lags P               lagged products kept for the noise model (default 8,\n"
     "                         at most 16; 0: none, batch means); each costs M^2 a row\n"
     "  --blocks K             time blocks for locating (and batch means) (default 20)\n"
+    "  --threads N            parse each regular file on N threads (default: the\n"
+    "                         processors online); the result is the same for any N\n"
     "  --alpha A              family-wise false discovery level (default 0.05)\n"
     "  --order K              the time derivative the missing effect enters: 0 (default)\n"
     "                         adds it to the channel (an offset, a gain, a sensor's\n"
@@ -369,7 +371,11 @@ static const char fe__discover_help[] =
     "                         K-th derivative; position and velocity (K = 2) or\n"
     "                         temperature (K = 1) default to the simulated channel\n"
     "  --report DIR           write DIR/report.md with plots (gnuplot, PNG)\n"
-    "  --json                 print one JSON object instead of the story\n"
+    "  --json                 print one JSON object instead of the story\n";
+
+/* The help's second part (C11 compilers need only take strings of 4095
+   bytes). */
+static const char fe__discover_help_more[] =
     "\n"
     "Three-axis sensors (the best sphere through the samples is the simulation):\n"
     "  foldest discover --sphere FILE.csv [--columns x,y,z] [--time NAME]\n"
@@ -389,6 +395,7 @@ typedef struct fe__discover_args {
     const char *role_column[FE__ROLES];
     double holdout, alpha;
     long blocks, lags;
+    int threads;                /* --threads: parsing threads for each file */
     int json;
     int noise;                  /* FE_DISCOVER_NOISE_AR or _BATCH */
     long order;                 /* K: the derivative the effect enters (0 additive) */
@@ -399,6 +406,7 @@ static void fe__discover_usage(FILE *out)
     size_t n;
     const fe_term *t = fe_catalog_builtin_terms(&n);
     fputs(fe__discover_help, out);
+    fputs(fe__discover_help_more, out);
     for (size_t i = 0; i < n; i++)
         fprintf(out, "  %-20s %s\n", t[i].name, t[i].description);
     fputs("\nExit status: 0 success (whatever the verdict), 1 the data cannot be\n"
@@ -415,6 +423,7 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
     a->holdout = 0.2;
     a->alpha = 0.05;
     a->blocks = 20;
+    a->threads = fe_cli_threads_default();
     a->lags = FE_DISCOVER_DEFAULT_LAGS;
     if (a->pairs == NULL) {
         snprintf(err, errlen, "out of memory");
@@ -506,6 +515,8 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
                 snprintf(err, errlen, "--blocks: %s is not in [4, %d]", v, FE_DISCOVER_MAX_BLOCKS);
                 rc = FE_CLI_USAGE;
             }
+        } else if (strcmp(o, "--threads") == 0) {
+            rc = fe_cli_parse_threads(v, &a->threads, err, errlen);
         } else if (strcmp(o, "--role") == 0) {
             const char *eq = strchr(v, '=');
             int found = 0;
@@ -566,6 +577,11 @@ static int fe__pair_open(fe__pair *p, const fe__discover_args *a, unsigned *role
     rc = fe_cli_table_open_rewindable(&p->sim, p->sim_path, -1, err, errlen);
     if (rc != FE_CLI_OK)
         return rc;
+    /* Each file parsed on --threads threads, the rows in file order
+       (cli.org, "Every core on one file"): the passes see what one
+       thread gives them. */
+    fe_cli_table_threads(&p->real, a->threads);
+    fe_cli_table_threads(&p->sim, a->threads);
     if ((rc = fe__time_column(&p->real, a->time, &p->real_cols[0], err, errlen)) != FE_CLI_OK
         || (rc = fe_cli_table_column(&p->real, a->channel, &p->real_cols[1], err, errlen)) != FE_CLI_OK
         || (rc = fe__time_column(&p->sim, a->time, &p->sim_cols[0], err, errlen)) != FE_CLI_OK
@@ -1862,7 +1878,7 @@ static const fe_cli_option fe__discover_options[] = {
     {"--real", 1}, {"--sim", 1}, {"--channel", 1}, {"--time", 1}, {"--role", 1},
     {"--base", 1}, {"--holdout", 1}, {"--noise", 1}, {"--lags", 1}, {"--blocks", 1},
     {"--alpha", 1}, {"--order", 1}, {"--term", 1}, {"--terms", 1}, {"--only", 1},
-    {"--exclude", 1},
+    {"--exclude", 1}, {"--threads", 1},
     {"--report", 1}, {"--json", 0}, {"--sphere", 1}, {"--columns", 1}, {NULL, 0}};
 
 /* Everything one run of the command holds, from the arguments to the

@@ -8,26 +8,57 @@
 #include <string.h>
 
 static const char fe__stats_help[] =
-    "usage: foldest stats [--columns a,b,...] [--skip N] [--json] FILE.csv|-\n"
+    "usage: foldest stats [--columns a,b,...] [--skip N] [--json] [--threads N]\n"
+    "                     FILE.csv|-\n"
     "\n"
     "Count, mean, standard deviation, minimum and maximum of numeric columns,\n"
     "in one pass.  Columns are named by header name or number from 1; default:\n"
     "every column.  The header is found automatically among metadata lines;\n"
-    "--skip N skips N lines first.  Malformed input: FILE:LINE:COLUMN: message.\n";
+    "--skip N skips N lines first.  Malformed input: FILE:LINE:COLUMN: message.\n"
+    "--threads N parses a regular file on N threads (default: the processors\n"
+    "online); the rows are folded in file order, so the result is the same for\n"
+    "any N.  Standard input, pipes and gzip files are read by one thread.\n";
+
+/* The fold, one row at a time in file order (fe_cli_table_each). */
+typedef struct fe__stats_fold {
+    size_t k;
+    double *lo, *hi;
+    fe_meanvar *mv;
+} fe__stats_fold;
+
+static int fe__stats_row(void *ctx, fe_cli_table *t, const double *row)
+{
+    fe__stats_fold *s = ctx;
+    for (size_t j = 0; j < s->k; j++) {
+        int rc;
+        if (s->mv[j].n == 0 || row[j] < s->lo[j])
+            s->lo[j] = row[j];
+        if (s->mv[j].n == 0 || row[j] > s->hi[j])
+            s->hi[j] = row[j];
+        rc = fe_meanvar_add(&s->mv[j], row[j]);
+        if (rc != FE_OK) {
+            fprintf(stderr, "foldest stats: %s:%zu: %s\n", t->name, t->line, fe_strerror(rc));
+            return FE_CLI_INPUT;
+        }
+    }
+    fe_cli_progress(t);
+    return 0;
+}
 
 static const fe_cli_option fe__stats_options[] = {
-    {"--columns", 1}, {"--skip", 1}, {"--json", 0}, {NULL, 0}};
+    {"--columns", 1}, {"--skip", 1}, {"--json", 0}, {"--threads", 1}, {NULL, 0}};
 
 int fe_cli_stats(int argc, char **argv)
 {
     const char *path = NULL;
     char *columns = NULL, err[1024];
     long skip = -1;
-    int json = 0, rc;
+    int json = 0, rc, threads = fe_cli_threads_default();
     fe_cli_table t;
     size_t k = 0, *cols = NULL;
     double *row = NULL, *lo = NULL, *hi = NULL;
     fe_meanvar *mv = NULL;
+    fe__stats_fold fold;
 
     rc = fe_cli_options("stats", fe__stats_options, &argc, &argv);
     if (rc != FE_CLI_OK)
@@ -40,6 +71,11 @@ int fe_cli_stats(int argc, char **argv)
             json = 1;
         } else if (strcmp(argv[i], "--columns") == 0 && i + 1 < argc) {
             columns = argv[++i];
+        } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
+            if (fe_cli_parse_threads(argv[++i], &threads, err, sizeof err) != FE_CLI_OK) {
+                fprintf(stderr, "foldest stats: %s\n", err);
+                return FE_CLI_USAGE;
+            }
         } else if (strcmp(argv[i], "--skip") == 0 && i + 1 < argc) {
             int bad = fe_cli_parse_long("--skip", argv[++i], &skip, err, sizeof err) != FE_CLI_OK;
             if (bad || skip < 0) {
@@ -95,24 +131,15 @@ int fe_cli_stats(int argc, char **argv)
     mv = calloc(k + 1, sizeof *mv);
     if (row == NULL || lo == NULL || hi == NULL || mv == NULL)
         goto out_of_memory;
-    while ((rc = fe_cli_table_next(&t, cols, k, row, err, sizeof err)) == FE_OK) {
-        for (size_t j = 0; j < k; j++) {
-            if (mv[j].n == 0 || row[j] < lo[j])
-                lo[j] = row[j];
-            if (mv[j].n == 0 || row[j] > hi[j])
-                hi[j] = row[j];
-            rc = fe_meanvar_add(&mv[j], row[j]);
-            if (rc != FE_OK) {
-                fprintf(stderr, "foldest stats: %s:%zu: %s\n", t.name, t.line, fe_strerror(rc));
-                rc = FE_CLI_INPUT;
-                goto done;
-            }
-        }
-        fe_cli_progress(&t);
-    }
+    fold.k = k;
+    fold.lo = lo;
+    fold.hi = hi;
+    fold.mv = mv;
+    rc = fe_cli_table_each(&t, cols, k, threads, fe__stats_row, &fold, err, sizeof err);
     fe_cli_progress_done(&t);
     if (rc != FE_END) {
-        fprintf(stderr, "foldest stats: %s\n", err);
+        if (err[0] != '\0')
+            fprintf(stderr, "foldest stats: %s\n", err);
         goto done;
     }
     if (t.rows == 0) {

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <getopt.h>
+#include <pthread.h>
 #include <zlib.h>
 
 extern char **environ;          /* for posix_spawnp: POSIX, undeclared */
@@ -452,6 +453,13 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
                         size_t k, double *out, char *err, size_t errlen);
 
+/* The threads' pass ("Every core on one file"): the next row, FE_END, an
+   error, or FE__CLI_ONE when the input cannot be cut (read it here). */
+enum { FE__CLI_ONE = -1 };
+static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
+                             double *out, char *err, size_t errlen);
+static void fe__cli_pass_end(fe_cli_table *t);
+
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
                       double *out, char *err, size_t errlen)
 {
@@ -465,6 +473,9 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
             line = t->scratch;
             strcpy(line, t->pending[t->next_pending]);
             t->line = t->pending_line[t->next_pending++];
+        } else if (t->threads > 1 && !t->serial && !t->view
+                   && (rc = fe__cli_pass_next(t, cols, k, out, err, errlen)) != FE__CLI_ONE) {
+            return rc;          /* a row parsed on a thread, or the end */
         } else {
             rc = fe_csv_next_line(&t->reader, &line, &len);
             if (rc == FE_END)
@@ -514,7 +525,8 @@ static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
                         size_t k, double *out, char *err, size_t errlen)
 {
     t->bad[reason]++;
-    fe__cli_bad_total[reason]++;
+    if (!t->view)               /* a worker's view: the caller adds them */
+        fe__cli_bad_total[reason]++;
     return fe_cli_table_next(t, cols, k, out, err, errlen);
 }
 
@@ -541,11 +553,14 @@ int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
     }
     t->next_pending = 0;
     t->rows = 0;
+    fe__cli_pass_end(t);
+    t->at = 0;
     return FE_CLI_OK;
 }
 
 void fe_cli_table_close(fe_cli_table *t)
 {
+    fe__cli_pass_end(t);
     size_t nbad = t->bad[0] + t->bad[1] + t->bad[2] + t->bad[3];
     if (nbad > 0)
         fprintf(stderr, "foldest: %s: skipped %zu bad rows (%zu with an empty cell, "
@@ -576,6 +591,507 @@ void fe_cli_table_close(fe_cli_table *t)
     t->buffer = NULL;
 }
 /* Read the next row ends here */
+/* [[file:../../literate/cli.org::Parallel Pass Private Data][Parallel Pass Private Data]] */
+enum { FE__CLI_BATCH = 1 << 20, FE__CLI_BATCH_MIN = 1 << 16, FE__CLI_SLOTS = 4 };
+
+/* Rows --skip-bad-rows skipped before row `row` of a batch, by reason:
+   the counts so far (bad rows are few; the list grows as needed). */
+typedef struct fe__cli_skipped {
+    size_t row, bad[FE_CLI_BAD_REASONS];
+} fe__cli_skipped;
+
+/* One batch's rows, parsed by whichever thread claimed it. */
+typedef struct fe__cli_batch {
+    double *rows;               /* n rows of k doubles */
+    size_t *line;               /* each row's line within the batch, from 2 */
+    size_t n, cap;
+    size_t lines;               /* the lines the batch holds */
+    fe__cli_skipped *skipped;   /* where the counts of bad rows grew */
+    size_t nskipped, skipped_cap;
+    off_t end;                  /* the byte after its last line */
+    int status;                 /* FE_END: all read; else the error after row n */
+    int ready;
+    char err[1024];
+} fe__cli_batch;
+
+/* The state the threads share, under `lock`. */
+typedef struct fe__cli_pass {
+    const fe_cli_table *t;      /* read-only while the pass runs */
+    const size_t *cols;
+    size_t k;
+    off_t data, size, step;     /* D, the file's size, the batch size S */
+    size_t nbatches, nslots;
+    fe__cli_batch *slot;        /* batch b in slot b % nslots */
+    pthread_mutex_t lock;
+    pthread_cond_t ready, room;
+    size_t next;                /* the first batch not claimed */
+    size_t taken;               /* batches the calling thread has taken */
+    size_t failed;              /* the first batch that failed (nbatches: none) */
+    int stop;
+    /* The calling thread's side, without the lock: the batch it hands
+       out (`have`: taken from the ring), its next row, the number of the
+       line before it, the bad rows already counted, the end. */
+    size_t cur, pos, base, bad_seen, nworkers;
+    int have, done;
+    struct fe__cli_worker *w;   /* w[0]: the calling thread's buffers */
+} fe__cli_pass;
+
+/* A thread's buffers for the view it parses through. */
+typedef struct fe__cli_worker {
+    fe__cli_pass *pass;
+    char *buffer;
+    fe_csv_field *fields;
+    pthread_t thread;
+} fe__cli_worker;
+
+/* The byte range a batch's reader reads with pread. */
+typedef struct fe__cli_range {
+    int fd;
+    off_t at, end;
+} fe__cli_range;
+/* Parallel Pass Private Data ends here */
+/* [[file:../../literate/cli.org::Find where a batch begins][Find where a batch begins]] */
+static off_t fe__cli_batch_start(const fe__cli_pass *p, size_t b)
+{
+    char buf[4096];
+    off_t at;
+    if (b == 0)
+        return p->data;
+    if (b >= p->nbatches)
+        return p->size;
+    at = p->data + (off_t)b * p->step - 1;
+    while (at < p->size) {
+        size_t want = (size_t)(p->size - at < (off_t)sizeof buf ? p->size - at : (off_t)sizeof buf);
+        ssize_t got = pread(p->t->fd, buf, want, at);
+        const char *nl;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got <= 0)
+            return -1;
+        nl = memchr(buf, '\n', (size_t)got);
+        if (nl != NULL)
+            return at + (nl - buf) + 1;
+        at += got;
+    }
+    return p->size;
+}
+
+static long fe__cli_pread(void *ctx, char *buf, size_t n)
+{
+    fe__cli_range *r = ctx;
+    ssize_t got;
+    if ((off_t)n > r->end - r->at)
+        n = (size_t)(r->end - r->at);
+    if (n == 0)
+        return 0;
+    got = pread(r->fd, buf, n, r->at);
+    if (got > 0)
+        r->at += got;
+    else if (got == 0) {        /* the file shrank under us */
+        errno = EIO;
+        return -1;
+    }
+    return (long)got;
+}
+/* Find where a batch begins ends here */
+/* [[file:../../literate/cli.org::Parse one batch on a worker][Parse one batch on a worker]] */
+/* Note that the bad rows before row s->n now number v->bad; -1 without
+   memory. */
+static int fe__cli_note_skipped(fe__cli_batch *s, const fe_cli_table *v)
+{
+    if (s->nskipped == s->skipped_cap) {
+        size_t cap = s->skipped_cap ? 2 * s->skipped_cap : 16;
+        fe__cli_skipped *more = realloc(s->skipped, cap * sizeof *more);
+        if (more == NULL)
+            return -1;
+        s->skipped = more;
+        s->skipped_cap = cap;
+    }
+    s->skipped[s->nskipped].row = s->n;
+    memcpy(s->skipped[s->nskipped++].bad, v->bad, sizeof v->bad);
+    return 0;
+}
+
+static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
+                                fe__cli_batch *s)
+{
+    const fe_cli_table *t = p->t;
+    fe__cli_range range;
+    fe_cli_table v;
+    off_t start = fe__cli_batch_start(p, b), end = fe__cli_batch_start(p, b + 1);
+    size_t skipped = 0;
+
+    s->n = s->lines = s->nskipped = 0;
+    s->end = end;
+    s->err[0] = '\0';
+    if (start < 0 || end < 0) {
+        s->status = fe__cli_at(t, 1, 1, FE_CLI_IO, s->err, sizeof s->err,
+                               "read error: %s", strerror(errno));
+        return;
+    }
+    memset(&v, 0, sizeof v);
+    v.name = t->name;
+    v.fd = -1;
+    v.buffer = w->buffer;
+    v.fields = w->fields;
+    v.delimiter = t->delimiter;
+    v.ncols = t->ncols;
+    v.names = t->names;
+    v.has_header = t->has_header;
+    v.decimal_comma = t->decimal_comma;
+    v.view = 1;
+    range.fd = t->fd;
+    range.at = start;
+    range.end = end > start ? end : start;
+    fe_csv_reader_init_read(&v.reader, fe__cli_pread, &range, w->buffer, FE_CLI_LINE_MAX);
+    v.reader.line = 1;          /* not the first line: no byte-order mark */
+    for (;;) {
+        int rc;
+        if (s->n == s->cap) {
+            size_t cap = s->cap ? 2 * s->cap : 4096;
+            double *rows = realloc(s->rows, cap * (p->k + 1) * sizeof *rows);
+            size_t *line = rows != NULL ? realloc(s->line, cap * sizeof *line) : NULL;
+            if (rows != NULL)
+                s->rows = rows;
+            if (line == NULL) {
+                s->status = fe__cli_at(t, v.reader.line, 1, FE_CLI_IO, s->err, sizeof s->err,
+                                       "out of memory");
+                break;
+            }
+            s->line = line;
+            s->cap = cap;
+        }
+        rc = fe_cli_table_next(&v, p->cols, p->k, s->rows + s->n * p->k, s->err, sizeof s->err);
+        if (v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3] > skipped
+            && fe__cli_note_skipped(s, &v) != 0) {
+            s->status = fe__cli_at(t, v.reader.line, 1, FE_CLI_IO, s->err, sizeof s->err,
+                                   "out of memory");
+            break;
+        }
+        skipped = v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3];
+        if (rc == FE_OK) {
+            s->line[s->n++] = v.line;
+            continue;
+        }
+        s->status = rc;
+        if (rc == FE_END)
+            s->lines = v.reader.line - 1;
+        break;
+    }
+}
+/* Parse one batch on a worker ends here */
+/* [[file:../../literate/cli.org::Claim batches until none is left][Claim batches until none is left]] */
+/* With the lock held: the batch to parse next, or nbatches for none now. */
+static size_t fe__cli_claim(fe__cli_pass *p)
+{
+    if (p->stop || p->next >= p->nbatches || p->next > p->failed
+        || p->next >= p->taken + p->nslots)
+        return p->nbatches;
+    return p->next++;
+}
+
+/* With the lock held: parse batch b without it and publish the result. */
+static void fe__cli_fill(fe__cli_pass *p, fe__cli_worker *w, size_t b)
+{
+    fe__cli_batch *s = &p->slot[b % p->nslots];
+    pthread_mutex_unlock(&p->lock);
+    fe__cli_parse_batch(p, w, b, s);
+    pthread_mutex_lock(&p->lock);
+    s->ready = 1;
+    if (s->status != FE_END && b < p->failed)
+        p->failed = b;
+    pthread_cond_broadcast(&p->ready);
+}
+
+static void *fe__cli_worker_run(void *arg)
+{
+    fe__cli_worker *w = arg;
+    fe__cli_pass *p = w->pass;
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        size_t b = fe__cli_claim(p);
+        if (b < p->nbatches) {
+            fe__cli_fill(p, w, b);
+            continue;
+        }
+        if (p->stop || p->next >= p->nbatches || p->next > p->failed)
+            break;
+        pthread_cond_wait(&p->room, &p->lock);  /* the ring is full */
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+/* Claim batches until none is left ends here */
+/* [[file:../../literate/cli.org::Give a batch's message the file's line number][Give a batch's message the file's line number]] */
+static void fe__cli_relocate(char *err, size_t errlen, const char *name, size_t base)
+{
+    size_t n = strlen(name);
+    char *end, rest[1024];
+    unsigned long long rel;
+    if (strncmp(err, name, n) != 0 || err[n] != ':' || !isdigit((unsigned char)err[n + 1]))
+        return;
+    rel = strtoull(err + n + 1, &end, 10);
+    if (*end != ':' || rel < 1)
+        return;
+    snprintf(rest, sizeof rest, "%s", end);
+    snprintf(err + n + 1, errlen - n - 1, "%zu%s", base + (size_t)rel - 1, rest);
+}
+/* Give a batch's message the file's line number ends here */
+/* [[file:../../literate/cli.org::Decide whether to cut the file][Decide whether to cut the file]] */
+static off_t fe__cli_data_offset(const fe_cli_table *t)
+{
+    char buf[1 << 16];
+    unsigned char magic[2];
+    size_t lines = 0;
+    off_t at = 0;
+    if (t->size <= 0 || t->fd < 0 || t->view
+        || pread(t->fd, magic, 2, 0) != 2 || (magic[0] == 0x1f && magic[1] == 0x8b))
+        return 0;
+    while (lines < t->look_end && at < t->size) {
+        ssize_t got = pread(t->fd, buf, sizeof buf, at);
+        const char *q, *end;
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got <= 0)
+            return 0;
+        for (q = buf, end = buf + got; lines < t->look_end
+             && (q = memchr(q, '\n', (size_t)(end - q))) != NULL; q++)
+            lines++;
+        at = lines < t->look_end ? at + got : at + (q - buf);  /* q: past the LF */
+    }
+    return lines == t->look_end ? at : 0;
+}
+/* Decide whether to cut the file ends here */
+/* [[file:../../literate/cli.org::Hand the rows out in file order][Hand the rows out in file order]] */
+void fe_cli_table_threads(fe_cli_table *t, int threads)
+{
+    t->threads = threads;
+}
+
+/* Stop the workers, wait for them and free the pass. */
+static void fe__cli_pass_end(fe_cli_table *t)
+{
+    fe__cli_pass *p = t->pass;
+    if (p == NULL)
+        return;
+    pthread_mutex_lock(&p->lock);
+    p->stop = 1;
+    pthread_cond_broadcast(&p->room);
+    pthread_mutex_unlock(&p->lock);
+    for (size_t i = 1; i <= p->nworkers; i++)
+        pthread_join(p->w[i].thread, NULL);
+    pthread_cond_destroy(&p->room);
+    pthread_cond_destroy(&p->ready);
+    pthread_mutex_destroy(&p->lock);
+    for (size_t i = 0; i < p->nslots; i++) {
+        free(p->slot[i].rows);
+        free(p->slot[i].line);
+        free(p->slot[i].skipped);
+    }
+    for (size_t i = 0; i < p->nslots / FE__CLI_SLOTS; i++) {     /* the threads */
+        free(p->w[i].buffer);
+        free(p->w[i].fields);
+    }
+    free(p->slot);
+    free(p->w);
+    free(p);
+    t->pass = NULL;
+}
+
+/* Cut the file and start the workers; FE__CLI_ONE when it cannot be cut
+   (t->serial is then set), FE_CLI_IO without memory. */
+static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
+                              char *err, size_t errlen)
+{
+    const char *env = getenv("FOLDEST_BATCH");
+    off_t data, step;
+    fe__cli_pass *p;
+    struct stat st;
+    sigset_t all, mask;
+    if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > t->size)
+        t->size = st.st_size;   /* a log that grew since it was opened */
+    data = fe__cli_data_offset(t);
+    step = (data > 0 ? t->size - data : 0) / (4 * (off_t)t->threads);
+    step = step > FE__CLI_BATCH ? FE__CLI_BATCH : step;
+    if (env != NULL && atol(env) > 0)
+        step = (off_t)atol(env);
+    else if (step < FE__CLI_BATCH_MIN)
+        step = data > 0 && t->size - data >= 2 * FE__CLI_BATCH_MIN ? FE__CLI_BATCH_MIN : 0;
+    if (data <= 0 || step <= 0 || data >= t->size) {
+        t->serial = 1;
+        return FE__CLI_ONE;
+    }
+    p = calloc(1, sizeof *p);
+    if (p == NULL)
+        goto out_of_memory;
+    p->t = t;
+    p->cols = cols;
+    p->k = k;
+    p->data = data;
+    p->size = t->size;
+    p->step = step;
+    p->nbatches = (size_t)((t->size - data + step - 1) / step);
+    p->failed = p->nbatches;
+    p->nslots = FE__CLI_SLOTS * (size_t)t->threads;
+    p->base = t->look_end;
+    p->slot = calloc(p->nslots, sizeof *p->slot);
+    p->w = calloc((size_t)t->threads, sizeof *p->w);
+    if (p->slot == NULL || p->w == NULL) {
+        free(p->slot);
+        free(p->w);
+        free(p);
+        goto out_of_memory;
+    }
+    pthread_mutex_init(&p->lock, NULL);
+    pthread_cond_init(&p->ready, NULL);
+    pthread_cond_init(&p->room, NULL);
+    t->pass = p;
+    for (int i = 0; i < t->threads; i++) {
+        p->w[i].pass = p;
+        p->w[i].buffer = malloc(FE_CLI_LINE_MAX);
+        p->w[i].fields = malloc(FE_CLI_FIELDS_MAX * sizeof *p->w[i].fields);
+        if (p->w[i].buffer == NULL || p->w[i].fields == NULL) {
+            fe__cli_pass_end(t);
+            goto out_of_memory;
+        }
+    }
+    /* w[0] is the calling thread; a thread that cannot start is not
+       needed.  The workers start with every signal blocked, so that
+       SIGINT and SIGTERM reach the calling thread, whose
+       fe_cli_signals_hold keeps them out of its critical sections. */
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &mask);
+    for (int i = 1; i < t->threads; i++)
+        if (pthread_create(&p->w[i].thread, NULL, fe__cli_worker_run, &p->w[i]) == 0)
+            p->nworkers = (size_t)i;
+        else
+            break;
+    pthread_sigmask(SIG_SETMASK, &mask, NULL);
+    if (env != NULL)            /* the tests' witness that the file was cut */
+        fprintf(stderr, "foldest: %s: %zu batches of %lld bytes on %zu threads\n", t->name,
+                p->nbatches, (long long)p->step, p->nworkers + 1);
+    return FE_CLI_OK;
+out_of_memory:
+    snprintf(err, errlen, "%s: out of memory", t->name);
+    return FE_CLI_IO;
+}
+
+/* Count the bad rows skipped before row `upto` of batch s (all: SIZE_MAX). */
+static void fe__cli_count_skipped(fe__cli_pass *p, fe_cli_table *t, const fe__cli_batch *s,
+                                  size_t upto)
+{
+    while (p->bad_seen < s->nskipped && s->skipped[p->bad_seen].row <= upto) {
+        const size_t *now = s->skipped[p->bad_seen].bad;
+        const size_t *before = p->bad_seen > 0 ? s->skipped[p->bad_seen - 1].bad : NULL;
+        for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
+            size_t d = now[r] - (before != NULL ? before[r] : 0);
+            t->bad[r] += d;
+            fe__cli_bad_total[r] += d;
+        }
+        p->bad_seen++;
+    }
+}
+
+static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
+                             double *out, char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s;
+    if (p == NULL) {
+        int rc = fe__cli_pass_start(t, cols, k, err, errlen);
+        if (rc != FE_CLI_OK)
+            return rc;
+        p = t->pass;
+    }
+    if (cols != p->cols || k != p->k) {
+        snprintf(err, errlen, "%s: internal error: other columns asked for in a threaded pass",
+                 t->name);
+        return FE_CLI_IO;
+    }
+    for (;;) {
+        if (p->done || p->cur >= p->nbatches)
+            return FE_END;
+        s = &p->slot[p->cur % p->nslots];
+        if (!p->have) {         /* wait for the batch, parsing others meanwhile */
+            pthread_mutex_lock(&p->lock);
+            while (!s->ready) {
+                size_t c = fe__cli_claim(p);
+                if (c < p->nbatches)
+                    fe__cli_fill(p, &p->w[0], c);
+                else
+                    pthread_cond_wait(&p->ready, &p->lock);
+            }
+            pthread_mutex_unlock(&p->lock);
+            p->have = 1;
+            p->pos = p->bad_seen = 0;
+        }
+        if (p->pos < s->n) {
+            fe__cli_count_skipped(p, t, s, p->pos);
+            memcpy(out, s->rows + p->pos * p->k, p->k * sizeof *out);
+            t->line = p->base + s->line[p->pos++] - 1;
+            t->rows++;
+            return FE_OK;
+        }
+        fe__cli_count_skipped(p, t, s, (size_t)-1);
+        if (s->status != FE_END) {
+            p->done = 1;
+            fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
+            snprintf(err, errlen, "%s", s->err);
+            return s->status;
+        }
+        p->base += s->lines;
+        t->at = s->end;
+        pthread_mutex_lock(&p->lock);
+        s->ready = 0;
+        p->taken++;
+        pthread_cond_broadcast(&p->room);
+        pthread_mutex_unlock(&p->lock);
+        p->cur++;
+        p->have = 0;
+    }
+}
+
+int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
+                      int threads, fe_cli_row_fn *fn, void *ctx,
+                      char *err, size_t errlen)
+{
+    double *row = malloc((k + 1) * sizeof *row);
+    int rc;
+    err[0] = '\0';
+    if (row == NULL) {
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        return FE_CLI_IO;
+    }
+    fe_cli_table_threads(t, threads);
+    while ((rc = fe_cli_table_next(t, cols, k, row, err, errlen)) == FE_OK)
+        if ((rc = fn(ctx, t, row)) != 0) {
+            err[0] = '\0';
+            break;
+        }
+    fe__cli_pass_end(t);        /* cols may go once this returns */
+    free(row);
+    return rc;
+}
+
+int fe_cli_threads_default(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > FE_CLI_THREADS_MAX ? FE_CLI_THREADS_MAX : (int)n;
+}
+
+int fe_cli_parse_threads(const char *text, int *threads, char *err, size_t errlen)
+{
+    long n;
+    if (fe_cli_parse_long("--threads", text, &n, err, errlen) != FE_CLI_OK)
+        return FE_CLI_USAGE;
+    if (n < 1 || n > FE_CLI_THREADS_MAX) {
+        snprintf(err, errlen, "--threads: from 1 to %d", FE_CLI_THREADS_MAX);
+        return FE_CLI_USAGE;
+    }
+    *threads = (int)n;
+    return FE_CLI_OK;
+}
+/* Hand the rows out in file order ends here */
 /* [[file:../../literate/cli.org::Write output atomically][Write output atomically]] */
 /* The mode a file created with 0666 gets under the current umask. */
 static mode_t fe__cli_umask_mode(void)
@@ -803,7 +1319,7 @@ void fe_cli_progress(fe_cli_table *t)
     off_t at;
     if (!t->progress || (t->rows & 0xffff) != 0)
         return;
-    at = t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
+    at = t->at > 0 ? t->at : t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
     if (at >= 0)
         fprintf(stderr, "\r%s: %3.0f%% (%zu rows)", t->name,
                 100.0 * (double)at / (double)t->size, t->rows);
