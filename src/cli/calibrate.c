@@ -372,6 +372,18 @@ typedef struct fe__calibrate_rows {
     const fe_sphere_scaled *sc;
 } fe__calibrate_rows;
 
+/* The rows' state at the start of a pass: every column, the gate (or
+   NULL), no verdict held back; the pass fills in what it needs. */
+static fe__calibrate_rows fe__calibrate_rows_start(size_t ncols, fe_still *gate)
+{
+    static const fe__calibrate_rows blank;
+    fe__calibrate_rows r = blank;
+    r.ncols = ncols;
+    r.gate = gate;
+    r.still = r.ready = 1;
+    return r;
+}
+
 /* A row through the gate: 1 when *y is a sample to use (its verdict in
    r->still), 0 when the gate holds it, or the library's error. */
 static int fe__calibrate_gate(fe__calibrate_rows *r, const double *x, double y[3])
@@ -435,11 +447,7 @@ static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncol
     char err[1024];
     double y[3];
     int rc, still = 1;
-    static const fe__calibrate_rows blank;
-    fe__calibrate_rows r = blank;
-    r.ncols = ncols;
-    r.gate = gate;
-    r.still = r.ready = 1;
+    fe__calibrate_rows r = fe__calibrate_rows_start(ncols, gate);
     r.fl = fl;
     r.q = q;
     fe_quadric_blocks_init(q);
@@ -501,11 +509,7 @@ static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
     double y[3];
     fe_cli_table t;
     int rc, still;
-    static const fe__calibrate_rows blank;
-    fe__calibrate_rows r = blank;
-    r.ncols = ncols;
-    r.gate = gate;
-    r.still = r.ready = 1;
+    fe__calibrate_rows r = fe__calibrate_rows_start(ncols, gate);
     r.visit = visit;
     r.ctx = ctx;
     rc = fe_cli_table_open(&t, a->path, a->skip, err, sizeof err);
@@ -639,8 +643,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     fe_cli_output o;
     fe_cli_table table, *t = &table;
     int rc, still = 1;
-    static const fe__calibrate_rows blank;
-    fe__calibrate_rows r = blank;
+    fe__calibrate_rows r;
 
     memset(out, 0, sizeof *out);
     if (strcmp(a->path, "-") == 0)
@@ -679,9 +682,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
-    r.ncols = ncols;
-    r.gate = gate;
-    r.still = r.ready = 1;
+    r = fe__calibrate_rows_start(ncols, gate);
     r.m = &m;
     r.fit = fit;
     r.sc = sc;
