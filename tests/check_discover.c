@@ -1913,30 +1913,20 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
     ck_assert_uint_eq(r->noise.order, 0);
     ck_assert_int_eq(r->noise.long_run, 0);       /* no short-lag factor here */
     ck_assert_uint_eq(r->noise.scales, J);
-    /* The Gram matrix, its inverse (by Gauss-Jordan) and the residual. */
+    /* The Gram matrix, its inverse and the residual. */
     for (size_t t = 0; t < LR_N; t++)
         for (size_t i = 0; i < LR_M; i++)
             for (size_t j = 0; j < LR_M; j++)
                 G[i][j] += z[t][i] * z[t][j];
     {
-        double aug[LR_M][2 * LR_M];
-        for (size_t i = 0; i < LR_M; i++)
-            for (size_t j = 0; j < 2 * LR_M; j++)
-                aug[i][j] = j < LR_M ? G[i][j] : (j - LR_M == i);
-        for (size_t c = 0; c < LR_M; c++) {
-            double piv = aug[c][c];
-            for (size_t j = 0; j < 2 * LR_M; j++)
-                aug[c][j] /= piv;
-            for (size_t i = 0; i < LR_M; i++)
-                if (i != c) {
-                    double f = aug[i][c];
-                    for (size_t j = 0; j < 2 * LR_M; j++)
-                        aug[i][j] -= f * aug[c][j];
-                }
-        }
+        long double Gl[LR_M * LR_M], Il[LR_M * LR_M];
         for (size_t i = 0; i < LR_M; i++)
             for (size_t j = 0; j < LR_M; j++)
-                Gi[i][j] = aug[i][LR_M + j];
+                Gl[i * LR_M + j] = G[i][j];
+        fe_test_inverse(LR_M, Gl, Il);
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                Gi[i][j] = (double)Il[i * LR_M + j];
     }
     for (size_t t = 0; t < LR_N; t++) {
         double fit = 0.0;

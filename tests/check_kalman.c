@@ -86,45 +86,6 @@ static double rel_diff(const double *a, const double *b, size_t len)
     return d / s;
 }
 
-/* Inverse by Gauss-Jordan with partial pivoting, long double. */
-static void gj_inverse(size_t n, long double *M, long double *Inv)
-{
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < n; j++)
-            Inv[i * n + j] = i == j;
-    for (size_t c = 0; c < n; c++) {
-        size_t p = c;
-        for (size_t i = c + 1; i < n; i++)
-            if (fabsl(M[i * n + c]) > fabsl(M[p * n + c]))
-                p = i;
-        for (size_t j = 0; j < n; j++) {
-            long double t = M[c * n + j];
-            M[c * n + j] = M[p * n + j];
-            M[p * n + j] = t;
-            t = Inv[c * n + j];
-            Inv[c * n + j] = Inv[p * n + j];
-            Inv[p * n + j] = t;
-        }
-        for (size_t i = 0; i < n; i++) {
-            long double f;
-            if (i == c)
-                continue;
-            f = M[i * n + c] / M[c * n + c];
-            for (size_t j = 0; j < n; j++) {
-                M[i * n + j] -= f * M[c * n + j];
-                Inv[i * n + j] -= f * Inv[c * n + j];
-            }
-        }
-        {
-            long double f = M[c * n + c];
-            for (size_t j = 0; j < n; j++) {
-                M[c * n + j] /= f;
-                Inv[c * n + j] /= f;
-            }
-        }
-    }
-}
-
 /* The textbook update with an explicit inverse, in long double. */
 static void ref_update(size_t n, size_t b, const double *x, const double *P,
                        const double *A, const double *z, const double *Z,
@@ -151,7 +112,7 @@ static void ref_update(size_t n, size_t b, const double *x, const double *P,
             s -= (long double)A[i * n + k] * x[k];
         nu[i] = s;
     }
-    gj_inverse(b, D, Di);
+    fe_test_inverse(b, D, Di);
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < b; j++) {
             long double s = 0;

@@ -96,4 +96,45 @@ static inline void fe_test_remove_dir(const char *dir)
     ck_assert_int_eq(system(cmd), 0);
 }
 
+/* Inv <- M^{-1} for an n x n row-major M (destroyed), by Gauss-Jordan
+   elimination with partial pivoting in long double: an independent
+   inverse for the tests. */
+static inline void fe_test_inverse(size_t n, long double *M, long double *Inv)
+{
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++)
+            Inv[i * n + j] = i == j;
+    for (size_t c = 0; c < n; c++) {
+        size_t p = c;
+        for (size_t i = c + 1; i < n; i++)
+            if (fabsl(M[i * n + c]) > fabsl(M[p * n + c]))
+                p = i;
+        for (size_t j = 0; j < n; j++) {
+            long double t = M[c * n + j];
+            M[c * n + j] = M[p * n + j];
+            M[p * n + j] = t;
+            t = Inv[c * n + j];
+            Inv[c * n + j] = Inv[p * n + j];
+            Inv[p * n + j] = t;
+        }
+        for (size_t i = 0; i < n; i++) {
+            long double f;
+            if (i == c)
+                continue;
+            f = M[i * n + c] / M[c * n + c];
+            for (size_t j = 0; j < n; j++) {
+                M[i * n + j] -= f * M[c * n + j];
+                Inv[i * n + j] -= f * Inv[c * n + j];
+            }
+        }
+        {
+            long double f = M[c * n + c];
+            for (size_t j = 0; j < n; j++) {
+                M[c * n + j] /= f;
+                Inv[c * n + j] /= f;
+            }
+        }
+    }
+}
+
 #endif /* FE_TESTUTIL_H */
