@@ -2168,42 +2168,6 @@ START_TEST(concealed_effects_are_found_and_nulls_are_not)
 }
 END_TEST
 
-/* Solve the n x n system A x = b in place (Gauss-Jordan with partial
-   pivoting, long double; A is destroyed, b receives x), for nb right-hand
-   sides stored as the columns of b (n x nb, row-major). */
-static void solve_ld(size_t n, long double *A, long double *b, size_t nb)
-{
-    for (size_t k = 0; k < n; k++) {
-        size_t piv = k;
-        for (size_t i = k + 1; i < n; i++)
-            if (fabsl(A[i * n + k]) > fabsl(A[piv * n + k]))
-                piv = i;
-        for (size_t j = 0; j < n; j++) {
-            long double t = A[k * n + j];
-            A[k * n + j] = A[piv * n + j];
-            A[piv * n + j] = t;
-        }
-        for (size_t j = 0; j < nb; j++) {
-            long double t = b[k * nb + j];
-            b[k * nb + j] = b[piv * nb + j];
-            b[piv * nb + j] = t;
-        }
-        for (size_t i = 0; i < n; i++) {
-            long double f;
-            if (i == k)
-                continue;
-            f = A[i * n + k] / A[k * n + k];
-            for (size_t j = 0; j < n; j++)
-                A[i * n + j] -= f * A[k * n + j];
-            for (size_t j = 0; j < nb; j++)
-                b[i * nb + j] -= f * b[k * nb + j];
-        }
-    }
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < nb; j++)
-            b[i * nb + j] /= A[i * n + i];
-}
-
 START_TEST(fit_columns_sandwich_errors_match_brute_force)
 {
     /* fe_discover_fit_columns' standard errors are the block sandwich
@@ -2253,7 +2217,7 @@ START_TEST(fit_columns_sandwich_errors_match_brute_force)
                 beta[i] += (long double)phi[t][cols[i]] * r[t];
             }
         memcpy(Gi, G, sizeof Gi);
-        solve_ld(M, Gi, beta, 1);
+        fe_test_solve(M, Gi, beta, 1);
         for (size_t i = 0; i < M; i++)
             FE_ASSERT_REL(coef[i], (double)beta[i], 1e-9);
         for (size_t t = 0; t < F; t++) {
@@ -2270,7 +2234,7 @@ START_TEST(fit_columns_sandwich_errors_match_brute_force)
         /* V = G^-1 (G^-1 Omega)^T: Omega and G symmetric. */
         memcpy(Gi, G, sizeof Gi);
         memcpy(V, Om, sizeof V);
-        solve_ld(M, Gi, V, M);
+        fe_test_solve(M, Gi, V, M);
         for (size_t i = 0; i < M; i++)
             for (size_t j = i + 1; j < M; j++) {
                 long double t = V[i * M + j];
@@ -2278,7 +2242,7 @@ START_TEST(fit_columns_sandwich_errors_match_brute_force)
                 V[j * M + i] = t;
             }
         memcpy(Gi, G, sizeof Gi);
-        solve_ld(M, Gi, V, M);
+        fe_test_solve(M, Gi, V, M);
         for (size_t i = 0; i < M; i++) {
             ck_assert_msg(se[i] > 0.0, "column %zu: se %g", i, se[i]);
             FE_ASSERT_REL(se[i], (double)sqrtl(V[i * M + i]), 1e-7);

@@ -96,45 +96,50 @@ static inline void fe_test_remove_dir(const char *dir)
     ck_assert_int_eq(system(cmd), 0);
 }
 
-/* Inv <- M^{-1} for an n x n row-major M (destroyed), by Gauss-Jordan
-   elimination with partial pivoting in long double: an independent
-   inverse for the tests. */
+/* Solve the n x n system A x = b in place (Gauss-Jordan with partial
+   pivoting, long double; A is destroyed, b receives x), for nb right-hand
+   sides stored as the columns of b (n x nb, row-major). */
+static inline void fe_test_solve(size_t n, long double *A, long double *b, size_t nb)
+{
+    for (size_t k = 0; k < n; k++) {
+        size_t piv = k;
+        for (size_t i = k + 1; i < n; i++)
+            if (fabsl(A[i * n + k]) > fabsl(A[piv * n + k]))
+                piv = i;
+        for (size_t j = 0; j < n; j++) {
+            long double t = A[k * n + j];
+            A[k * n + j] = A[piv * n + j];
+            A[piv * n + j] = t;
+        }
+        for (size_t j = 0; j < nb; j++) {
+            long double t = b[k * nb + j];
+            b[k * nb + j] = b[piv * nb + j];
+            b[piv * nb + j] = t;
+        }
+        for (size_t i = 0; i < n; i++) {
+            long double f;
+            if (i == k)
+                continue;
+            f = A[i * n + k] / A[k * n + k];
+            for (size_t j = 0; j < n; j++)
+                A[i * n + j] -= f * A[k * n + j];
+            for (size_t j = 0; j < nb; j++)
+                b[i * nb + j] -= f * b[k * nb + j];
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < nb; j++)
+            b[i * nb + j] /= A[i * n + i];
+}
+
+/* Inv <- M^{-1} for an n x n row-major M (destroyed): the system solved
+   for the columns of the identity. */
 static inline void fe_test_inverse(size_t n, long double *M, long double *Inv)
 {
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
             Inv[i * n + j] = i == j;
-    for (size_t c = 0; c < n; c++) {
-        size_t p = c;
-        for (size_t i = c + 1; i < n; i++)
-            if (fabsl(M[i * n + c]) > fabsl(M[p * n + c]))
-                p = i;
-        for (size_t j = 0; j < n; j++) {
-            long double t = M[c * n + j];
-            M[c * n + j] = M[p * n + j];
-            M[p * n + j] = t;
-            t = Inv[c * n + j];
-            Inv[c * n + j] = Inv[p * n + j];
-            Inv[p * n + j] = t;
-        }
-        for (size_t i = 0; i < n; i++) {
-            long double f;
-            if (i == c)
-                continue;
-            f = M[i * n + c] / M[c * n + c];
-            for (size_t j = 0; j < n; j++) {
-                M[i * n + j] -= f * M[c * n + j];
-                Inv[i * n + j] -= f * Inv[c * n + j];
-            }
-        }
-        {
-            long double f = M[c * n + c];
-            for (size_t j = 0; j < n; j++) {
-                M[c * n + j] /= f;
-                Inv[c * n + j] /= f;
-            }
-        }
-    }
+    fe_test_solve(n, M, Inv, n);
 }
 
 #endif /* FE_TESTUTIL_H */
