@@ -904,6 +904,7 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
                               char *err, size_t errlen)
 {
     const char *env = getenv("FOLDEST_BATCH");
+    long batch = env != NULL ? strtol(env, NULL, 10) : 0;   /* 0: not asked */
     off_t data, step;
     fe__cli_pass *p;
     struct stat st;
@@ -913,8 +914,8 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     data = fe__cli_data_offset(t);
     step = (data > 0 ? t->size - data : 0) / (4 * (off_t)t->threads);
     step = step > FE__CLI_BATCH ? FE__CLI_BATCH : step;
-    if (env != NULL && atol(env) > 0)
-        step = (off_t)atol(env);
+    if (batch > 0)
+        step = (off_t)batch;
     else if (step < FE__CLI_BATCH_MIN)
         step = data > 0 && t->size - data >= 2 * FE__CLI_BATCH_MIN ? FE__CLI_BATCH_MIN : 0;
     if (data <= 0 || step <= 0 || data >= t->size) {
