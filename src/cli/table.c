@@ -460,8 +460,12 @@ static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
                              double *out, char *err, size_t errlen);
 static void fe__cli_pass_end(fe_cli_table *t);
 
-int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
-                      double *out, char *err, size_t errlen)
+/* One line: a row, FE_END, an error, or FE__CLI_SKIPPED for a bad row
+   that --skip-bad-rows counted (the caller reads on: a loop, not a
+   recursion, so that a file of bad rows cannot exhaust the stack). */
+enum { FE__CLI_SKIPPED = -2 };
+static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
+                             double *out, char *err, size_t errlen)
 {
     char *line;
     size_t len, nf, bad = 0;
@@ -520,14 +524,24 @@ int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
     return FE_OK;
 }
 
-/* Count a bad row and go on to the next one. */
+/* Count a bad row; the caller goes on to the next one. */
 static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
                         size_t k, double *out, char *err, size_t errlen)
 {
+    (void)cols, (void)k, (void)out, (void)err, (void)errlen;
     t->bad[reason]++;
     if (!t->view)               /* a worker's view: the caller adds them */
         fe__cli_bad_total[reason]++;
-    return fe_cli_table_next(t, cols, k, out, err, errlen);
+    return FE__CLI_SKIPPED;
+}
+
+int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
+                      double *out, char *err, size_t errlen)
+{
+    int rc;
+    while ((rc = fe__cli_table_row(t, cols, k, out, err, errlen)) == FE__CLI_SKIPPED)
+        continue;
+    return rc;
 }
 
 int fe_cli_table_rewind(fe_cli_table *t, char *err, size_t errlen)
