@@ -450,8 +450,7 @@ int fe_cli_table_column(const fe_cli_table *t, const char *spec, size_t *col,
 }
 /* Find a column by name or number ends here */
 /* [[file:../../literate/cli.org::Read the next row][Read the next row]] */
-static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
-                        size_t k, double *out, char *err, size_t errlen);
+static int fe__cli_skip(fe_cli_table *t, int reason);
 
 /* The threads' pass ("Every core on one file"): the next row, FE_END, an
    error, or FE__CLI_ONE when the input cannot be cut (read it here). */
@@ -497,7 +496,7 @@ static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
                           "unterminated or misplaced quote");
     if (rc != FE_OK || nf != t->ncols) {
         if (fe__cli_skip_bad)
-            return fe__cli_skip(t, FE_CLI_BAD_FIELDS, cols, k, out, err, errlen);
+            return fe__cli_skip(t, FE_CLI_BAD_FIELDS);
         return fe__cli_at(t, t->line, 1, FE_CLI_INPUT, err, errlen,
                           "expected %zu fields, found %s%zu", t->ncols,
                           rc == FE_ESIZE ? "more than " : "", rc == FE_ESIZE ? (size_t)FE_CLI_FIELDS_MAX : nf);
@@ -511,7 +510,7 @@ static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
         reason = f->text[0] == '\0' ? FE_CLI_BAD_EMPTY
                  : rc == FE_ENONFINITE ? FE_CLI_BAD_NONFINITE : FE_CLI_BAD_TEXT;
         if (fe__cli_skip_bad)
-            return fe__cli_skip(t, reason, cols, k, out, err, errlen);
+            return fe__cli_skip(t, reason);
         if (reason == FE_CLI_BAD_EMPTY)
             return fe__cli_at(t, t->line, f->column, FE_CLI_INPUT, err, errlen,
                               "empty cell in column '%s' (--skip-bad-rows skips such rows)",
@@ -525,10 +524,8 @@ static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
 }
 
 /* Count a bad row; the caller goes on to the next one. */
-static int fe__cli_skip(fe_cli_table *t, int reason, const size_t *cols,
-                        size_t k, double *out, char *err, size_t errlen)
+static int fe__cli_skip(fe_cli_table *t, int reason)
 {
-    (void)cols, (void)k, (void)out, (void)err, (void)errlen;
     t->bad[reason]++;
     if (!t->view)               /* a worker's view: the caller adds them */
         fe__cli_bad_total[reason]++;
