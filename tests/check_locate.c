@@ -281,30 +281,51 @@ END_TEST
 START_TEST(json_of_every_length_is_whole_or_refused)
 {
     /* Every buffer shorter than the document is refused with FE_ESIZE and
-       nothing written past it; the exact length (with its NUL) is enough. */
-    fe_located l = {0};
-    char full[1024], buf[1024 + 8];
-    size_t need;
-    l.pair = 0;
-    l.pair1 = 1;
-    l.t0 = 1.5;
-    l.t1 = 2.5;
-    l.n = 10;
-    l.z = 3.25;
-    l.t = -1.5;
-    l.test = "nis";
-    l.p_value = 0.001;
-    l.mean_nis = 2.0;
-    l.lag1 = 0.25;
-    ck_assert_int_eq(fe_located_json(&l, full, sizeof full), FE_OK);
-    need = strlen(full) + 1;
-    for (size_t len = 1; len <= need; len++) {
-        memset(buf, 'X', sizeof buf);
-        ck_assert_int_eq(fe_located_json(&l, buf, len), len < need ? FE_ESIZE : FE_OK);
-        for (size_t i = len; i < sizeof buf; i++)
-            ck_assert_int_eq(buf[i], 'X');
+       nothing written past it, and holds then the header's "truncated
+       prefix": the document's first len - 1 bytes and the NUL; the exact
+       length (with its NUL) is enough.  A time window (NIS figures) and a
+       speed band (residual figures): every piece of both branches is cut
+       somewhere. */
+    fe_located l[2];
+    memset(l, 0, sizeof l);
+    l[0].pair = 0;
+    l[0].pair1 = 1;
+    l[0].t0 = 1.5;
+    l[0].t1 = 2.5;
+    l[0].n = 10;
+    l[0].z = 3.25;
+    l[0].t = -1.5;
+    l[0].test = "nis";
+    l[0].p_value = 0.001;
+    l[0].mean_nis = 2.0;
+    l[0].lag1 = 0.25;
+    l[1].region = FE_REGION_SPEED;
+    l[1].lo = 0.25;
+    l[1].hi = 0.75;
+    l[1].n = 31;
+    l[1].z = -0.5;
+    l[1].t = 4.125;
+    l[1].test = "residual_mean";
+    l[1].p_value = 3e-7;
+    l[1].mean_before = 0.0625;
+    l[1].mean_after = -0.015625;
+    l[1].ms_ratio_before = 1.75;
+    l[1].ms_ratio_after = 1.0078125;
+    for (int k = 0; k < 2; k++) {
+        char full[1024], buf[1024 + 8];
+        size_t need;
+        ck_assert_int_eq(fe_located_json(&l[k], full, sizeof full), FE_OK);
+        need = strlen(full) + 1;
+        for (size_t len = 1; len <= need; len++) {
+            memset(buf, 'X', sizeof buf);
+            ck_assert_int_eq(fe_located_json(&l[k], buf, len), len < need ? FE_ESIZE : FE_OK);
+            for (size_t i = len; i < sizeof buf; i++)
+                ck_assert_int_eq(buf[i], 'X');
+            ck_assert_uint_eq(strlen(buf), len - 1);
+            ck_assert_int_eq(memcmp(buf, full, len - 1), 0);
+        }
+        ck_assert_str_eq(buf, full);
     }
-    ck_assert_str_eq(buf, full);
 }
 END_TEST
 
@@ -1078,6 +1099,12 @@ START_TEST(a_region_of_two_rows_is_tested_of_one_is_not)
             ck_assert_double_eq_tol(loc[i].z, (64.0 / msall - 1.0) / sqrt(2.0 / ws), 1e-12);
             ck_assert_double_eq_tol(loc[i].mean_before, 8.0, 1e-15);
         }
+        /* lo and hi are a band's bounds, and 0 for every other place. */
+        for (size_t i = 0; i < n; i++)
+            if (loc[i].region != FE_REGION_SPEED && loc[i].region != FE_REGION_TEMPERATURE) {
+                ck_assert_double_eq(loc[i].lo, 0.0);
+                ck_assert_double_eq(loc[i].hi, 0.0);
+            }
         ck_assert_uint_eq(found, two ? 1 : 0);
     }
 }

@@ -17,7 +17,7 @@ extern "C" {
 
 /* Where a located place lies: a window of time, or a region of the
    state.  The bounded regions (speed, temperature) carry their bounds in
-   fe_located's lo and hi. */
+   fe_located's lo and hi; the others, and time windows, 0 and 0. */
 typedef enum fe_region {
     FE_REGION_TIME = 0,             /* consecutive time blocks */
     FE_REGION_VELOCITY_NEGATIVE,    /* v < 0 */
@@ -38,7 +38,8 @@ const char *fe_region_variable(fe_region r);
    normal scale. */
 typedef struct fe_located {
     fe_region region;           /* FE_REGION_TIME: a time window */
-    double lo, hi;              /* bounds of a speed or temperature band */
+    double lo, hi;              /* bounds of a speed or temperature band;
+                                   0 and 0 for any other place */
     const char *test;           /* what located it: "nis", "innovation_acf",
                                    "residual_mean", "residual_ms" */
     double t0, t1;              /* time of its first and last row */

@@ -378,8 +378,11 @@ def load_explained(path):
     return out
 
 
-# The bounds checks of UBSan, trapping (no run-time library to link).
-BOUNDS = ["-fsanitize=bounds", "-fsanitize-undefined-trap-on-error"]
+# Two checks of UBSan, trapping (no run-time library to link): an index
+# out of an array's bounds, and a null pointer passed where the function is
+# declared to take none (memcpy(dst, NULL, 0) is undefined, as make check's
+# UBSan build reports).
+BOUNDS = ["-fsanitize=bounds,nonnull-attribute", "-fsanitize-undefined-trap-on-error"]
 
 
 def report(results, mods, seed, secs, excluded, a, B):
@@ -624,11 +627,11 @@ def main():
         # A file with lane kernels (lanes.h) has a four-lane kernel that
         # this processor may never run: a mutant that survives the build
         # as it is is built again with FE_NO_CLONES (four lanes only).  A
-        # mutant that still survives is built once more with the bounds
-        # checks of UBSan (a trap, no run-time library): an index one past
-        # an array, which the plain build reads or writes silently and
-        # `make check`'s sanitizer build reports, then fails the suite that
-        # reaches it.
+        # mutant that still survives is built once more with the bounds and
+        # nonnull checks of UBSan (a trap, no run-time library): an index
+        # one past an array, or a null pointer given to memcpy, which the
+        # plain build lets through silently and `make check`'s sanitizer
+        # build reports, then fails the suite that reaches it.
         variants = [[]] + ([["-DFE_NO_CLONES"]] if '#include "lanes.h"' in src[m] else []) + \
             [BOUNDS]
         verdict, by, ran = None, "", False
@@ -644,7 +647,7 @@ def main():
                     sh([a.cc] + cflags + extra + ["-c", "src/%s.c" % m, "-o", pobj])
                 pristine[key] = stripped(pobj, os.path.join(B, "pristine.o"))
                 if extra == BOUNDS:
-                    # The unmutated module with bounds checks must pass its
+                    # The unmutated module with these checks must pass its
                     # suites too, or this build proves nothing.
                     bad = link([pobj if x == m else o for x, o in lib_objs.items()])
                     for s in ([] if bad else suites_of(m)):
@@ -652,7 +655,7 @@ def main():
                             bad = s
                             break
                     if bad:
-                        print("mutate: %s with bounds checks fails %s unmutated; that build "
+                        print("mutate: %s with the UBSan checks fails %s unmutated; that build "
                               "is not used" % (m, bad), flush=True)
                         pristine[key] = None
             if pristine[key] is None:
@@ -674,7 +677,7 @@ def main():
                 if status != 0:
                     verdict = "killed"
                     by = s + (" (timeout)" if status is None else "") + \
-                        (" (bounds checks)" if extra == BOUNDS else
+                        (" (UBSan checks)" if extra == BOUNDS else
                          " " + " ".join(extra) if extra else "")
                     break
             if verdict == "killed":
