@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -327,9 +328,71 @@ static int fe__csv_nonfinite_word(const char *s)
     return 0;
 }
 
+/* The decimal mark of the calling thread's locale as printf writes it
+   ("." in the C locale, "," in many others), into mark (at most len - 1
+   bytes, NUL-terminated); its length, 0 if it cannot be told. */
+static size_t fe__csv_decimal_mark(char *mark, size_t len)
+{
+    char text[16];
+    int n = snprintf(text, sizeof text, "%.1f", 1.5);  /* "1" mark "5" */
+    size_t k = n > 2 && (size_t)n < sizeof text ? (size_t)n - 2 : 0;
+    if (k == 0 || k >= len || text[0] != '1' || text[n - 1] != '5')
+        return 0;
+    memcpy(mark, text + 1, k);
+    mark[k] = '\0';
+    return k;
+}
+
+/* *out <- s written for strtod in the calling thread's locale: s itself
+   when the mark is '.' or s has no point, else a copy in buf with the
+   point made the locale's mark.  FE_EPARSE when the copy does not fit or
+   the mark cannot be told. */
+static int fe__csv_c_locale(const char *s, char *buf, size_t len, const char **out)
+{
+    char mark[8];
+    size_t k = fe__csv_decimal_mark(mark, sizeof mark), at, n;
+    const char *point = strchr(s, '.');
+    *out = s;
+    if (point == NULL || (k == 1 && mark[0] == '.'))
+        return FE_OK;
+    n = strlen(s);
+    if (k == 0 || n + k > len)
+        return FE_EPARSE;
+    at = (size_t)(point - s);
+    memcpy(buf, s, at);
+    memcpy(buf + at, mark, k);
+    memcpy(buf + at + k, point + 1, n - at);      /* the rest and its NUL */
+    *out = buf;
+    return FE_OK;
+}
+
+int fe_csv_format_double(double v, char *buf, size_t len)
+{
+    char mark[8], *at;
+    size_t k;
+    if (buf == NULL)
+        return FE_EINVAL;
+    if (len < FE_CSV_DOUBLE_TEXT)
+        return FE_ESIZE;
+    buf[0] = '\0';
+    if (!isfinite(v))
+        return FE_ENONFINITE;
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(buf, len, "%.*g", digits, v);
+        if (strtod(buf, NULL) == v)     /* in the same locale as the text */
+            break;
+    }
+    k = fe__csv_decimal_mark(mark, sizeof mark);
+    if (k > 0 && !(k == 1 && mark[0] == '.') && (at = strstr(buf, mark)) != NULL) {
+        *at = '.';
+        memmove(at + 1, at + k, strlen(at + k) + 1);
+    }
+    return FE_OK;
+}
+
 int fe_csv_number(const fe_csv_field *field, double *value)
 {
-    char *end;
+    char *end, copy[FE_CSV_NUMBER_MAX];
     double v;
     const char *s;
 
@@ -342,6 +405,8 @@ int fe_csv_number(const fe_csv_field *field, double *value)
         return FE_OK;
     if (!fe__csv_plain(s, '.'))
         return fe__csv_nonfinite_word(s) ? FE_ENONFINITE : FE_EPARSE;
+    if (fe__csv_c_locale(s, copy, sizeof copy, &s) != FE_OK)
+        return FE_EPARSE;
     errno = 0;
     v = strtod(s, &end);
     if (end == s || *end != '\0')

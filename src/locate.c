@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "foldest/csv.h"
 #include "foldest/error.h"
 #include "foldest/locate.h"
 #include "foldest/special.h"
@@ -302,14 +303,9 @@ static int fe__append(char *buf, size_t len, size_t *at, const char *fmt, ...)
 
 static int fe__json_num(char *buf, size_t len, size_t *at, const char *key, double v)
 {
-    char text[32];
-    if (!isfinite(v))
+    char text[FE_CSV_DOUBLE_TEXT];
+    if (fe_csv_format_double(v, text, sizeof text) != FE_OK)
         return fe__append(buf, len, at, ", \"%s\": null", key);
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(text, sizeof text, "%.*g", digits, v);
-        if (strtod(text, NULL) == v)
-            break;
-    }
     return fe__append(buf, len, at, ", \"%s\": %s", key, text);
 }
 

@@ -3,6 +3,7 @@
    fields (delimiters, quotes, white space) and numbers. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <locale.h>
 #include <unistd.h>
 
 #include "foldest.h"
@@ -355,6 +356,105 @@ START_TEST(number_parsers_refuse_each_missing_argument)
 }
 END_TEST
 
+/* A locale whose decimal mark is a comma, built with localedef into a
+   temporary folder `dir` and set for LC_NUMERIC; 0 with a message when
+   this machine cannot build one (no localedef or no de_DE source). */
+static int set_german_numbers(char *dir)
+{
+    char cmd[256], one[16];
+    if (mkdtemp(dir) == NULL)
+        return 0;
+    snprintf(cmd, sizeof cmd, "localedef -i de_DE -f UTF-8 %s/de_DE.UTF-8 >/dev/null 2>&1", dir);
+    if (system(cmd) == -1 || setenv("LOCPATH", dir, 1) != 0
+        || setlocale(LC_NUMERIC, "de_DE.UTF-8") == NULL) {
+        printf("numbers_read_and_written_alike_in_any_locale: skipped, no locale with a "
+               "decimal comma could be built (localedef -i de_DE; Debian's package locales)\n");
+        return 0;
+    }
+    snprintf(one, sizeof one, "%.1f", 1.5);
+    ck_assert_str_eq(one, "1,5");               /* the locale writes a comma */
+    ck_assert_double_eq(strtod("1.5", NULL), 1.0);      /* and strtod stops at a point */
+    return 1;
+}
+
+START_TEST(numbers_read_and_written_alike_in_any_locale)
+{
+    /* A program that links the library may set a locale whose decimal
+       mark is a comma.  The fields the fast path leaves to strtod (over
+       19 digits, an exponent past 10^22, a value past 2^53), and plain
+       ones, read as in the C locale, bit for bit; numbers written for a
+       machine (fe_csv_format_double, fe_located_json) keep their point. */
+    static const char *const fields[] = {"0.12345678901234567891", "1.7976931348623157e308",
+                                         "123456789012345678901.5", "2.5e-30",
+                                         "9007199254740993.5", "-0.5", "12", "7e40"};
+    static const double figures[] = {0.04, -1.5e-7, 123456.789, 1e300, 0.1, 2.5};
+    enum { NF = sizeof fields / sizeof *fields, NG = sizeof figures / sizeof *figures };
+    char dir[] = "/tmp/fe_locale_XXXXXX", copy[64], comma[] = "1,5";
+    char written[NG][FE_CSV_DOUBLE_TEXT], text[FE_CSV_DOUBLE_TEXT], json[512], cmd[64];
+    double want[NF], got, long_want[2];
+    char longest[FE_CSV_NUMBER_MAX + 1];
+    fe_csv_field lf = {longest, 1};
+    fe_csv_field f = {copy, 1}, c = {comma, 1};
+    fe_located l;
+    memset(&l, 0, sizeof l);
+    l.region = FE_REGION_TIME;
+    l.test = "residual_mean";
+    l.t0 = 1.5;
+    l.t1 = 2.5;
+    l.p_value = 0.25;
+    for (size_t i = 0; i < NF; i++) {
+        strcpy(copy, fields[i]);
+        ck_assert_int_eq(fe_csv_number(&f, &want[i]), FE_OK);
+    }
+    for (size_t i = 0; i < NG; i++) {
+        ck_assert_int_eq(fe_csv_format_double(figures[i], written[i], sizeof written[i]), FE_OK);
+        ck_assert_double_eq(strtod(written[i], NULL), figures[i]);
+    }
+    ck_assert_str_eq(written[0], "0.04");
+    ck_assert_int_eq(fe_csv_format_double(NAN, text, sizeof text), FE_ENONFINITE);
+    ck_assert_str_eq(text, "");
+    ck_assert_int_eq(fe_csv_format_double(1.0, text, FE_CSV_DOUBLE_TEXT - 1), FE_ESIZE);
+    ck_assert_int_eq(fe_csv_format_double(1.0, NULL, FE_CSV_DOUBLE_TEXT), FE_EINVAL);
+    memset(longest, '3', sizeof longest - 1);
+    longest[1] = '.';
+    longest[FE_CSV_NUMBER_MAX - 1] = '\0';
+    ck_assert_int_eq(fe_csv_number(&lf, &long_want[0]), FE_OK);
+    longest[FE_CSV_NUMBER_MAX - 1] = '3';
+    longest[FE_CSV_NUMBER_MAX] = '\0';
+    ck_assert_int_eq(fe_csv_number(&lf, &long_want[1]), FE_OK);
+    if (!set_german_numbers(dir))
+        return;
+    for (size_t i = 0; i < NF; i++) {
+        strcpy(copy, fields[i]);
+        got = -1.0;
+        ck_assert_msg(fe_csv_number(&f, &got) == FE_OK, "%s", fields[i]);
+        ck_assert_msg(memcmp(&got, &want[i], sizeof got) == 0, "%s: %.17g, C locale %.17g",
+                      fields[i], got, want[i]);
+    }
+    ck_assert_int_eq(fe_csv_number_comma(&c, &got), FE_OK);
+    ck_assert_double_eq(got, 1.5);
+    /* The copy's bound: FE_CSV_NUMBER_MAX - 1 characters read (with the
+       NUL, the copy is full), one more refused (the C locale reads both). */
+    memset(longest, '3', sizeof longest - 1);
+    longest[1] = '.';
+    longest[FE_CSV_NUMBER_MAX - 1] = '\0';
+    ck_assert_int_eq(fe_csv_number(&lf, &got), FE_OK);
+    ck_assert_double_eq(got, long_want[0]);
+    longest[FE_CSV_NUMBER_MAX - 1] = '3';
+    longest[FE_CSV_NUMBER_MAX] = '\0';
+    ck_assert_int_eq(fe_csv_number(&lf, &got), FE_EPARSE);
+    for (size_t i = 0; i < NG; i++) {
+        ck_assert_int_eq(fe_csv_format_double(figures[i], text, sizeof text), FE_OK);
+        ck_assert_str_eq(text, written[i]);
+    }
+    ck_assert_int_eq(fe_located_json(&l, json, sizeof json), FE_OK);
+    ck_assert_msg(strstr(json, "\"start\": 1.5,") != NULL && strstr(json, "\"end\": 2.5")
+                  && strstr(json, "\"p_value\": 0.25") != NULL, "%s", json);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -371,6 +471,7 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, strtod_extensions_are_not_numbers);
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
     tcase_add_test(t, number_parsers_refuse_each_missing_argument);
+    tcase_add_test(t, numbers_read_and_written_alike_in_any_locale);
     suite_add_tcase(s, t);
     return s;
 }

@@ -78,6 +78,24 @@ int fe_csv_number(const fe_csv_field *field, double *value);
    point is not accepted.  A field of more than 255 bytes is FE_EPARSE. */
 int fe_csv_number_comma(const fe_csv_field *field, double *value);
 
+/* Both read the same numbers whatever locale the calling program set
+   (setlocale's LC_NUMERIC): a recording's decimal mark is the file's, not
+   the reader's.  In a locale whose decimal mark is not '.', a decimal
+   that the fast path does not take (over 19 digits, or an exponent past
+   10^22) and that does not fit in FE_CSV_NUMBER_MAX bytes with that mark
+   for its point and a NUL (FE_CSV_NUMBER_MAX - 1 characters for a
+   one-byte mark) is FE_EPARSE. */
+#define FE_CSV_NUMBER_MAX 512
+
+/* fe_csv_format_double: v as the shortest of 15, 16 and 17 significant
+   digits (printf's %.*g) that reads back as v, with '.' as its decimal
+   mark whatever the locale: the text a JSON document or a CSV file needs.
+   buf holds at least FE_CSV_DOUBLE_TEXT bytes.  FE_EINVAL for a NULL buf,
+   FE_ESIZE for a shorter one, FE_ENONFINITE for NaN or an infinity (buf
+   then holds ""). */
+#define FE_CSV_DOUBLE_TEXT 32
+int fe_csv_format_double(double v, char *buf, size_t len);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1588,18 +1588,9 @@ void fe_cli_json_string(FILE *out, const char *s)
 
 void fe_cli_json_number(FILE *out, double x)
 {
-    char text[32];
-    if (!isfinite(x)) {
-        fputs("null", out);
-        return;
-    }
+    char text[FE_CSV_DOUBLE_TEXT];
     /* The shortest of 15, 16 and 17 significant digits that reads back as
        x: 0.04, not 0.040000000000000001. */
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(text, sizeof text, "%.*g", digits, x);
-        if (strtod(text, NULL) == x)
-            break;
-    }
-    fputs(text, out);
+    fputs(fe_csv_format_double(x, text, sizeof text) == FE_OK ? text : "null", out);
 }
 /* Show progress ends here */
