@@ -6,7 +6,18 @@
 #include "testutil.h"
 
 #include <float.h>
-#include <quadmath.h>
+/* libquadmath, declared here rather than through <quadmath.h>: that header
+   lies in GCC's own include directory, where clang does not look. */
+__float128 acosq(__float128);
+__float128 atanq(__float128);
+__float128 cosq(__float128);
+__float128 expq(__float128);
+__float128 fabsq(__float128);
+__float128 lgammaq(__float128);
+__float128 log1pq(__float128);
+__float128 logq(__float128);
+__float128 sinq(__float128);
+__float128 sqrtq(__float128);
 
 START_TEST(student_t_table_values)
 {
