@@ -31,7 +31,8 @@ EXT_CFLAGS    = $(shell pkg-config --cflags lapacke blas)
 EXT_LIBS      = $(shell pkg-config --libs lapacke blas) -lm -pthread
 BENCH_LIBS    = $(shell pkg-config --libs gsl)
 CHECK_CFLAGS  = $(shell pkg-config --cflags check)
-CHECK_LIBS    = $(shell pkg-config --libs check)
+# The special functions' tests integrate densities in __float128 (libquadmath).
+CHECK_LIBS    = $(shell pkg-config --libs check) -lquadmath
 # The command (never the library) reads gzip-compressed tables with zlib.
 CLI_LIBS     := -lz
 

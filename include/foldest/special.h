@@ -9,7 +9,11 @@ extern "C" {
 #endif
 
 /* fe_beta_inc: the regularised incomplete beta function I_x(a, b) for
-   a, b > 0 and 0 <= x <= 1; NaN for other arguments. */
+   a, b > 0 and 0 <= x <= 1; NaN for other arguments, and NaN when its
+   continued fraction does not converge within 500 + 16 sqrt(max(a, b))
+   + 200 / min(a, b) steps, at most 1e8 (none found for a, b from 1e-3 to
+   1e12).
+   The tails of t and F below inherit this. */
 double fe_beta_inc(double a, double b, double x);
 
 /* fe_log_gamma: log Gamma(x) for x > 0 (Lanczos; thread-safe, unlike
