@@ -60,7 +60,7 @@ export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: all deps lib cli examples tests check check-plain check-san check-valgrind \
         check-install check-tangle tangle doc figures check-doc demo run-examples bench size install uninstall clean \
-        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate
+        check-tsan check-mpi bench-mpi lint fuzz fuzz-build coverage accept accept-dynamics mutate audit
 
 all: lib cli examples
 
@@ -322,6 +322,11 @@ MUTANTS        ?= 0
 SEED           ?= 1
 MUTATE_EXCLUDE ?=
 MUTATE_MIN     ?= 0
+# Every documented error code of every public function is produced by a
+# test statement, or explained in tests/audit/codes_explained.txt.
+audit:
+	python3 tests/audit/codes.py
+
 mutate: lib cli $(B)/tests/suites.h
 	python3 tests/mutate/mutate.py --mutants $(MUTANTS) --seed $(SEED) --exclude '$(MUTATE_EXCLUDE)' \
 	  --min-rate $(MUTATE_MIN) $(if $(MUTANT_IDS),--ids '$(MUTANT_IDS)') --build $(B) --cc '$(CC)' \

@@ -317,6 +317,48 @@ START_TEST(special_function_domains)
 }
 END_TEST
 
+/* Codes of the newer modules at their edges: a catalog takes user terms
+   up to FE_DISCOVER_MAX_GROUPS in all and refuses the next, unchanged; a
+   region is described only into a buffer; an information filter refuses
+   a packet with a NaN, unchanged. */
+START_TEST(catalog_region_and_information_codes)
+{
+    static char names[FE_DISCOVER_MAX_GROUPS][24];
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_expr e;
+    fe_located l;
+    char words[64];
+    double mem[128], snap[6], A[2] = {1, 0}, z[1] = {NAN}, Z[1] = {1};
+    fe_kalman_obs o = {1, A, z, Z};
+    fe_kalman_info s;
+    size_t i = 0;
+    ck_assert_int_eq(fe_catalog_init(&c, 0, &scale), FE_OK);
+    ck_assert_int_eq(fe_expr_compile(&e, "1", NULL, 0, NULL, NULL, 0), FE_OK);
+    while (c.count < FE_DISCOVER_MAX_GROUPS) {
+        snprintf(names[i], sizeof names[i], "u%zu", i);
+        ck_assert_int_eq(fe_catalog_add_expr(&c, names[i], NULL, &e), FE_OK);
+        i++;
+    }
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "extra", NULL, &e), FE_ESIZE);
+    ck_assert_uint_eq(c.count, FE_DISCOVER_MAX_GROUPS);
+    memset(&l, 0, sizeof l);
+    ck_assert_int_eq(fe_region_describe(NULL, words, sizeof words), FE_EINVAL);
+    ck_assert_int_eq(fe_region_describe(&l, NULL, sizeof words), FE_EINVAL);
+    ck_assert_int_eq(fe_kalman_info_init(&s, 2, 1, mem, 128), FE_OK);
+    ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s, NULL, 1.0), FE_OK);
+    memcpy(snap, s.eta, 2 * sizeof *snap);
+    memcpy(snap + 2, s.Lambda, 4 * sizeof *snap);
+    ck_assert_int_eq(fe_kalman_info_update(&s, &o), FE_ENONFINITE);
+    ck_assert(memcmp(snap, s.eta, 2 * sizeof *snap) == 0);
+    ck_assert(memcmp(snap + 2, s.Lambda, 4 * sizeof *snap) == 0);
+    ck_assert_uint_eq(s.count, 0);
+    z[0] = 2.0;
+    ck_assert_int_eq(fe_kalman_info_update(&s, &o), FE_OK);
+    ck_assert_uint_eq(s.count, 1);
+}
+END_TEST
+
 Suite *fe_arguments_suite(void)
 {
     Suite *s = suite_create("arguments");
@@ -326,6 +368,7 @@ Suite *fe_arguments_suite(void)
     tcase_add_test(t, schur_and_lm_arguments);
     tcase_add_test(t, fold_stream_and_csv_arguments);
     tcase_add_test(t, special_function_domains);
+    tcase_add_test(t, catalog_region_and_information_codes);
     suite_add_tcase(s, t);
     return s;
 }

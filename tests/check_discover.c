@@ -2297,6 +2297,70 @@ START_TEST(the_widest_accumulation_folds_and_fits)
 }
 END_TEST
 
+/* The documented refusals of the constructors and of fe_discover_add_row
+   at their edges: fit_rows 2 per block (8 of 4 blocks) is enough and 7
+   is not; base_cols == m is a full accumulation and m + 1 is refused; a
+   row is the part's next (index row0 + n) or refused, one behind or one
+   ahead, with the accumulation unchanged to the byte. */
+START_TEST(documented_refusals_at_their_edges)
+{
+    enum { M = 3, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *copy = malloc(nst * sizeof *st);
+    double phi[M] = {1, 2, 3}, bad[M] = {1, NAN, 3};
+    fe_discover_acc a, before;
+    fe_discover_row row = {5, phi, 0.5, 0};
+    ck_assert_int_eq(fe_discover_acc_init(NULL, M, K, 100, 0, st, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, NULL, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 2 * K - 1, 0, st, nst), FE_ETOOFEW);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 2 * K, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_screen_init(NULL, M, M, K, 100, 0, st, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_screen_init(&a, M, M, K, 100, 0, NULL, nst), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_screen_init(&a, M, M + 1, K, 100, 0, st, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_screen_init(&a, M, M, K, 100, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_rebind(NULL, st), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_rebind(&a, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_reset(NULL), FE_EINVAL);
+    /* A part that starts at row 5: row 5 first, then only row 6. */
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 5, st, nst), FE_OK);
+    row.index = 4;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_EINVAL);
+    row.index = 6;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_EINVAL);
+    ck_assert_uint_eq(a.n, 0);
+    row.index = 5;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    before = a;
+    memcpy(copy, st, nst * sizeof *st);
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_EINVAL);           /* one behind */
+    row.index = 7;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_EINVAL);           /* one ahead */
+    row.index = FE_DISCOVER_ROW_UNKNOWN;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_add_row(NULL, &row), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_add_row(&a, NULL), FE_EINVAL);
+    row.index = 6;
+    row.phi = bad;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
+    row.phi = phi;
+    row.r = INFINITY;
+    row.starts_recording = 1;                   /* refused before the break */
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    row.r = 0.5;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    ck_assert_uint_eq(a.n, 2);
+    /* After a reset the part takes any index again. */
+    ck_assert_int_eq(fe_discover_reset(&a), FE_OK);
+    row.index = 40;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    ck_assert_uint_eq(a.row0, 40);
+    free(st);
+    free(copy);
+}
+END_TEST
+
 Suite *fe_discover_suite(void)
 {
     Suite *s = suite_create("discover");
@@ -2333,6 +2397,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
+    tcase_add_test(t, documented_refusals_at_their_edges);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

@@ -711,6 +711,61 @@ START_TEST(a_missing_viscous_friction_is_named_with_its_coefficient)
 }
 END_TEST
 
+/* The codes no other test names: an order one above the largest (3) and
+   one below the smallest (0) against 1 and 2; a NULL at each place; a
+   deviation step whose Jacobian or time is not finite refused with the
+   state unchanged, and the same step finite accepted. */
+START_TEST(documented_refusals_by_order_and_value)
+{
+    fe_sample s;
+    fe_dynamics_span sp;
+    fe_dynamics_ident id;
+    fe_dynamics_deviation dv, dcopy;
+    double a[2] = {0.0, 0.0}, d[2], force = 1.0, ak[1] = {-0.5};
+    memset(&s, 0, sizeof s);
+    s.position = 1.0;
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 0, &s, a), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 3, &s, a), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(NULL, NULL, 2, &s, a), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 2, NULL, a), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 2, &s, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(spring, NULL, 2, &s, a), FE_OK);
+    ck_assert_double_eq_tol(a[0], -4.0, 1e-6);
+    ck_assert_int_eq(fe_dynamics_jacobian_fd(lag, NULL, 1, &s, a), FE_OK);
+    ck_assert_int_eq(fe_dynamics_span_init(NULL, 2), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 3), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, 2), FE_OK);
+    ck_assert_int_eq(fe_dynamics_span_add(NULL, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_span_add(&sp, NULL), FE_EINVAL);
+    ck_assert(sp.n == 0.0);
+    ck_assert_int_eq(fe_dynamics_span_add(&sp, &s), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_init(NULL, &sp), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_OK);
+    ck_assert_int_eq(fe_dynamics_deviation_init(NULL, 1), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 1), FE_OK);
+    memset(&s, 0, sizeof s);
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_OK);
+    s.t = 0.5;
+    dcopy = dv;
+    ak[0] = NAN;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_ENONFINITE);
+    ak[0] = -0.5;
+    s.t = INFINITY;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_ENONFINITE);
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) == 0);
+    s.t = 0.5;
+    ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, ak, lag, NULL, constant_force, &force,
+                                                d), FE_OK);
+    ck_assert(memcmp(&dv, &dcopy, sizeof dv) != 0);
+}
+END_TEST
+
 Suite *fe_dynamics_suite(void)
 {
     Suite *s = suite_create("dynamics");
@@ -729,6 +784,7 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, an_identification_split_at_a_break_merges_to_the_whole);
     tcase_add_test(t, the_dynamics_catalog_and_its_words);
     tcase_add_test(t, a_missing_viscous_friction_is_named_with_its_coefficient);
+    tcase_add_test(t, documented_refusals_by_order_and_value);
     suite_add_tcase(s, t);
     return s;
 }

@@ -1091,6 +1091,76 @@ START_TEST(magnetometer_sessions_real)
 }
 END_TEST
 
+/* fe_lm_emit at its edges, inside a model: weight 0 and the last block
+   accepted, a weight one step below 0 and the block one past the last
+   refused (FE_EINVAL); a residual of 1e150 accepted (w f^2 = 1e300) and
+   1e200 refused (w f^2 overflows), as a NaN is (FE_ENONFINITE).  The sink
+   remembers the first refusal, so fe_lm_solve returns it even though the
+   model returns FE_OK.  `ctx` selects the refusal; it is not modified. */
+static int emit_edges(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const int *which = ctx;
+    const double jg[1] = {1.0}, jl[1] = {1.0};
+    (void)x;
+    ck_assert_int_eq(fe_lm_emit(s, 1.0, 0.0, jg, 1, jl), FE_OK);
+    ck_assert_int_eq(fe_lm_emit(s, 1e150, 1.0, jg, 0, jl), FE_OK);
+    ck_assert_int_eq(fe_lm_emit(s, 1.0, 1.0, jg, FE_SCHUR_NONE, NULL), FE_OK);
+    if (*which == 0)
+        ck_assert_int_eq(fe_lm_emit(s, 1.0, -DBL_TRUE_MIN, jg, 0, jl), FE_EINVAL);
+    else if (*which == 1)
+        ck_assert_int_eq(fe_lm_emit(s, 1.0, 1.0, jg, 2, jl), FE_EINVAL);
+    else if (*which == 2)
+        ck_assert_int_eq(fe_lm_emit(s, NAN, 1.0, jg, 0, jl), FE_ENONFINITE);
+    else
+        ck_assert_int_eq(fe_lm_emit(s, 1e200, 1.0, jg, 0, jl), FE_ENONFINITE);
+    return FE_OK;
+}
+
+/* fe_sessions_model at a point whose offset is a reading: refused. */
+static int sessions_at_a_reading(const double *x, fe_lm_sink *s, void *ctx)
+{
+    ck_assert_int_eq(fe_sessions_model(x, s, ctx), FE_ENONFINITE);
+    return FE_ENONFINITE;
+}
+
+START_TEST(emit_and_sessions_refusals_at_their_edges)
+{
+    static const int expect[4] = {FE_EINVAL, FE_EINVAL, FE_ENONFINITE, FE_ENONFINITE};
+    const double reading[3] = {1, 2, 3};
+    double *w, x[9] = {1, 0, 0, 1, 0, 1, 1, 2, 3};
+    fe_sessions c;
+    fe_lm_problem sp;
+    for (int which = 0; which < 4; which++) {
+        fe_lm_problem p = {1, 1, 2, emit_edges, NULL};
+        double y[3] = {0, 0, 0};
+        p.ctx = (void *)&which;
+        w = lm_work(&p, FE_LM_SCHUR);
+        ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, y, w, NULL, NULL, NULL),
+                         expect[which]);
+        free(w);
+    }
+    memset(&c, 0, sizeof c);
+    c.count = 1;
+    c.m[0] = reading;
+    c.n[0] = 1;
+    sp = fe_sessions_problem(&c);
+    sp.model = sessions_at_a_reading;
+    w = lm_work(&sp, FE_LM_SCHUR);
+    ck_assert_int_eq(fe_lm_solve(&sp, FE_LM_SCHUR, NULL, x, w, NULL, NULL, NULL),
+                     FE_ENONFINITE);
+    /* The session count: 0 and FE_SESSIONS_MAX + 1 are refused. */
+    c.count = 0;
+    ck_assert_int_eq(fe_sessions_fit(&c, x, w, NULL), FE_EINVAL);
+    c.count = FE_SESSIONS_MAX + 1;
+    ck_assert_int_eq(fe_sessions_fit(&c, x, w, NULL), FE_EINVAL);
+    c.count = 1;
+    ck_assert_int_eq(fe_sessions_fit(NULL, x, w, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_sessions_fit(&c, NULL, w, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_sessions_fit(&c, x, NULL, NULL), FE_EINVAL);
+    free(w);
+}
+END_TEST
+
 Suite *fe_lm_suite(void)
 {
     Suite *s = suite_create("lm");
@@ -1112,6 +1182,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, undamped_rank_test_is_relative_to_the_diagonal);
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
+    tcase_add_test(t, emit_and_sessions_refusals_at_their_edges);
     suite_add_tcase(s, t);
     return s;
 }

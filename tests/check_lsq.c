@@ -646,6 +646,27 @@ START_TEST(blocked_rows_stop_exactly_at_the_bad_row)
 }
 END_TEST
 
+/* A merge whose diagonal sum would pass DBL_MAX / 4 (the room the
+   library keeps for the solve) is refused with `a` unchanged; one that
+   reaches it exactly is taken. */
+START_TEST(merge_overflow_at_its_edge)
+{
+    double ga[16], gb[16], keep[16];
+    const double j[3] = {1, 0, 0};
+    fe_lsq a, b;
+    ck_assert_int_eq(fe_lsq_init(&a, 3, ga), FE_OK);
+    ck_assert_int_eq(fe_lsq_init(&b, 3, gb), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 0.0, DBL_MAX / 8), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&b, j, 0.0, DBL_MAX / 8), FE_OK);
+    ck_assert_int_eq(fe_lsq_merge(&a, &b), FE_OK);
+    ck_assert_double_eq(ga[0], DBL_MAX / 4);
+    memcpy(keep, ga, sizeof ga);
+    ck_assert_int_eq(fe_lsq_merge(&a, &b), FE_ENONFINITE);
+    ck_assert_mem_eq(ga, keep, sizeof ga);
+    ck_assert_uint_eq(a.n, 2);
+}
+END_TEST
+
 Suite *fe_lsq_suite(void)
 {
     Suite *s = suite_create("lsq");
@@ -666,6 +687,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, exact_fit_has_zero_rss);
     tcase_add_test(t, sparse_rows_equal_dense_rows);
     tcase_add_test(t, blocked_rows_stop_exactly_at_the_bad_row);
+    tcase_add_test(t, merge_overflow_at_its_edge);
     suite_add_tcase(s, t);
     return s;
 }

@@ -270,6 +270,22 @@ START_TEST(small_values_far_from_one)
 }
 END_TEST
 
+/* A merge whose squared difference of means overflows is refused, `a`
+   unchanged; one a factor 2 inside (difference 1e154) is taken. */
+START_TEST(merge_overflow_at_its_edge)
+{
+    fe_meanvar a = FE_MEANVAR_EMPTY, b = FE_MEANVAR_EMPTY, c = FE_MEANVAR_EMPTY, before;
+    ck_assert_int_eq(fe_meanvar_add(&a, 0.0), FE_OK);
+    ck_assert_int_eq(fe_meanvar_add(&b, 2e154), FE_OK);
+    ck_assert_int_eq(fe_meanvar_add(&c, 1e154), FE_OK);
+    before = a;
+    ck_assert_int_eq(fe_meanvar_merge(&a, &b), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_int_eq(fe_meanvar_merge(&a, &c), FE_OK);
+    ck_assert_double_eq(fe_meanvar_mean(&a), 0.5e154);
+}
+END_TEST
+
 Suite *fe_meanvar_suite(void)
 {
     Suite *s = suite_create("meanvar");
@@ -286,6 +302,7 @@ Suite *fe_meanvar_suite(void)
     tcase_add_test(t, streaming_equals_batch);
     tcase_add_test(t, precision_at_large_offset);
     tcase_add_test(t, small_values_far_from_one);
+    tcase_add_test(t, merge_overflow_at_its_edge);
     suite_add_tcase(s, t);
     return s;
 }

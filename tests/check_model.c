@@ -631,6 +631,58 @@ START_TEST(non_finite_prediction_refused_at_its_row)
 }
 END_TEST
 
+/* Two parameters whose Jacobian columns are equal ((theta1 + theta2) t):
+   the data cannot tell them apart, and fe_model_select says so with
+   FE_ESINGULAR; the same rows with the columns t and t^2 are selected. */
+static int sum_predict(const fe_sample *s, const double *th, double *y, void *user)
+{
+    *y = th[0] * s->t + th[1] * (*(const int *)user ? s->t * s->t : s->t);
+    return 0;
+}
+
+static int sum_jacobian(const fe_sample *s, const double *th, double *jac, void *user)
+{
+    (void)th;
+    jac[0] = s->t;
+    jac[1] = *(const int *)user ? s->t * s->t : s->t;
+    return 0;
+}
+
+START_TEST(collinear_parameters_are_singular)
+{
+    enum { N = 2000, K = 4 };
+    static const double th0[2] = {0.5, 0.25};
+    for (int apart = 0; apart < 2; apart++) {
+        fe_synth_spec spec = fe_synth_default_spec("bias", 5);
+        fe_model m = {2, th0, NULL, sum_predict, sum_jacobian, 0, NULL, NULL};
+        fe_synth g;
+        fe_catalog c;
+        fe_model_acc a;
+        fe_sample s;
+        fe_discover_result *r = malloc(sizeof *r);
+        double *st, *work;
+        size_t nst, nwork;
+        m.user = &apart;
+        spec.rows = N;
+        ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+        ck_assert_int_eq(fe_catalog_init(&c, g.roles, &g.scale), FE_OK);
+        nst = fe_model_acc_doubles(2, c.count, K);
+        st = malloc(nst * sizeof *st);
+        ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, K, N, st, nst), FE_OK);
+        while (fe_synth_next(&g, &s) == FE_OK)
+            ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+        ck_assert_int_eq(fe_model_break(&a), FE_OK);
+        nwork = fe_model_workspace_doubles(&a);
+        work = malloc(nwork * sizeof *work);
+        ck_assert_int_eq(fe_model_select(&a, NULL, r, work, nwork),
+                         apart ? FE_OK : FE_ESINGULAR);
+        free(work);
+        free(st);
+        free(r);
+    }
+}
+END_TEST
+
 Suite *fe_model_suite(void)
 {
     Suite *s = suite_create("model");
@@ -644,6 +696,7 @@ Suite *fe_model_suite(void)
     tcase_add_test(t, analytic_and_numerical_jacobians_discover_the_same);
     tcase_add_test(t, concealed_effects_are_found_through_the_model);
     tcase_add_test(t, a_right_model_discovers_nothing);
+    tcase_add_test(t, collinear_parameters_are_singular);
     suite_add_tcase(s, t);
     return s;
 }

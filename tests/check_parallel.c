@@ -6,6 +6,7 @@
 #include <float.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <unistd.h>
 
 #include "foldest.h"
 #include "testutil.h"
@@ -1384,6 +1385,41 @@ START_TEST(pipeline_bad_arguments_read_nothing)
 }
 END_TEST
 
+/* A source's own error is a refusal like a step's: an fd source whose
+   last record lacks 4 of its 8 bytes gives FE_EPARSE after the records
+   before it, with `*done` and the accumulation those of the whole records;
+   the same stream without the partial record folds to the end. */
+START_TEST(a_source_error_is_a_refusal)
+{
+    const double x[3] = {1, 2, 3}, y[2] = {10, 20};
+    double buf[4];
+    for (int partial = 0; partial < 2; partial++) {
+        fe_array_source sta;
+        fe_fd_source stf;
+        fe_source src[2], *sp[2] = {&src[0], &src[1]};
+        fe_accumulator f = fe_meanvar_accumulator();
+        fe_meanvar a = FE_MEANVAR_EMPTY, part = FE_MEANVAR_EMPTY;
+        void *pp[1] = {&part};
+        size_t done = 0;
+        int fds[2];
+        ck_assert_int_eq(pipe(fds), 0);
+        ck_assert_int_eq(write(fds[1], y, sizeof y), (int)sizeof y);
+        if (partial)
+            ck_assert_int_eq(write(fds[1], x, 4), 4);
+        close(fds[1]);
+        ck_assert_int_eq(fe_source_from_array(&src[0], &sta, x, 3, sizeof x[0]), FE_OK);
+        ck_assert_int_eq(fe_source_from_fd(&src[1], &stf, fds[0], sizeof y[0], buf, sizeof buf),
+                         FE_OK);
+        ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, 2, pp, &done),
+                         partial ? FE_EPARSE : FE_OK);
+        ck_assert_uint_eq(done, 5);
+        ck_assert_uint_eq(a.n, 5);
+        ck_assert_double_eq(a.mean, 36.0 / 5.0);
+        close(fds[0]);
+    }
+}
+END_TEST
+
 Suite *fe_parallel_suite(void)
 {
     Suite *s = suite_create("parallel");
@@ -1404,6 +1440,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, bad_arguments_fold_nothing);
     tcase_add_test(t, chunks_cover_the_array);
     tcase_add_test(t, sources_fold_their_concatenation);
+    tcase_add_test(t, a_source_error_is_a_refusal);
     tcase_add_test(t, generators_per_thread_equal_one_generator);
     tcase_add_test(t, a_failing_source_is_a_refusal);
     tcase_add_test(t, pipeline_is_exactly_the_serial_fold);

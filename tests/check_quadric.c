@@ -831,6 +831,33 @@ START_TEST(blocks_add_many_is_the_step_repeated)
 }
 END_TEST
 
+/* fe_quadric_init refuses a NULL accumulation; a blocked merge whose
+   binomial shift overflows (a reference at 1e90 against one near 0) is
+   refused with `a` unchanged to the byte, and the same merge of b with a
+   reference near a's is accepted. */
+START_TEST(blocks_merge_overflow_and_init_null)
+{
+    const double far[3] = {1e90, 0, 0}, near[3] = {1, 0, 0}, centre[3] = {0, 0, 0};
+    fe_quadric_blocks a, b, c, before;
+    ck_assert_int_eq(fe_quadric_init(NULL, centre), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_init(&a), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_init(&b), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_init(&c), FE_OK);
+    for (int i = 0; i < 10; i++) {
+        const double x[3] = {1.0 + 0.1 * i, 0.5, -0.25 * i};
+        ck_assert_int_eq(fe_quadric_blocks_add(&a, x), FE_OK);
+    }
+    ck_assert_int_eq(fe_quadric_blocks_add(&b, far), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_add(&c, near), FE_OK);
+    before = a;
+    ck_assert_int_eq(fe_quadric_blocks_merge(&a, &b), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_int_eq(fe_quadric_blocks_merge(NULL, &b), FE_EINVAL);
+    ck_assert_int_eq(fe_quadric_blocks_merge(&a, &c), FE_OK);
+    ck_assert(a.all.m[0] == 11.0);
+}
+END_TEST
+
 Suite *fe_quadric_suite(void)
 {
     Suite *s = suite_create("quadric");
@@ -856,6 +883,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, f32_step_agrees_with_the_double_step);
     tcase_add_test(t, f32_recentre_is_exact);
     tcase_add_test(t, f32_bad_samples_leave_it_unchanged);
+    tcase_add_test(t, blocks_merge_overflow_and_init_null);
     suite_add_tcase(s, t);
     return s;
 }

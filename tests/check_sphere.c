@@ -1644,6 +1644,54 @@ START_TEST(still_rate_is_the_norm_of_all_three)
 }
 END_TEST
 
+/* The gate with a window of 3: three samples held, the fourth hands the
+   first back; at the end exactly three flushes give FE_OK and the fourth
+   FE_END.  A NULL at any place is refused with the gate unchanged; a
+   histogram merge refuses NULL and leaves a unchanged. */
+START_TEST(still_and_histogram_refusals_at_their_edges)
+{
+    enum { W = 3 };
+    double ring[7 * W], x[3] = {0, 0, 9.8}, out[3];
+    fe_still_options o = fe_still_default_options();
+    fe_still s, before;
+    fe_radial_hist h, copy;
+    int still, ready;
+    o.window = W;
+    ck_assert_int_eq(fe_still_init(&s, &o, ring, 7 * W), FE_OK);
+    ck_assert_int_eq(fe_still_flush(&s, out, &still), FE_END);
+    before = s;
+    ck_assert_int_eq(fe_still_push(NULL, x, NULL, out, &still, &ready), FE_EINVAL);
+    ck_assert_int_eq(fe_still_push(&s, NULL, NULL, out, &still, &ready), FE_EINVAL);
+    ck_assert_int_eq(fe_still_push(&s, x, NULL, NULL, &still, &ready), FE_EINVAL);
+    ck_assert_int_eq(fe_still_push(&s, x, NULL, out, NULL, &ready), FE_EINVAL);
+    ck_assert_int_eq(fe_still_push(&s, x, NULL, out, &still, NULL), FE_EINVAL);
+    ck_assert_mem_eq(&s, &before, sizeof s);
+    for (int i = 0; i < W; i++) {
+        x[0] = i;
+        ck_assert_int_eq(fe_still_push(&s, x, NULL, out, &still, &ready), FE_OK);
+        ck_assert_int_eq(ready, 0);
+    }
+    x[0] = W;
+    ck_assert_int_eq(fe_still_push(&s, x, NULL, out, &still, &ready), FE_OK);
+    ck_assert_int_eq(ready, 1);
+    ck_assert_double_eq(out[0], 0.0);
+    for (int i = 1; i <= W; i++) {
+        ck_assert_int_eq(fe_still_flush(&s, out, &still), FE_OK);
+        ck_assert_double_eq(out[0], (double)i);
+    }
+    ck_assert_int_eq(fe_still_flush(&s, out, &still), FE_END);
+    ck_assert_int_eq(fe_still_flush(&s, out, &still), FE_END);
+    memset(&h, 0, sizeof h);
+    ck_assert_int_eq(fe_radial_hist_add(&h, 0.01), FE_OK);
+    copy = h;
+    ck_assert_int_eq(fe_radial_hist_merge(NULL, &copy), FE_EINVAL);
+    ck_assert_int_eq(fe_radial_hist_merge(&h, NULL), FE_EINVAL);
+    ck_assert_mem_eq(&h, &copy, sizeof h);
+    ck_assert_int_eq(fe_radial_hist_merge(&h, &copy), FE_OK);
+    ck_assert(h.n == 2.0);
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -1683,6 +1731,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(r, real_mpu6050_static_poses);
     tcase_add_test(r, real_ximu3_one_hemisphere_is_refused);
     tcase_add_test(r, real_recordings_f32_step_agrees);
+    tcase_add_test(t, still_and_histogram_refusals_at_their_edges);
     suite_add_tcase(s, t);
     suite_add_tcase(s, r);
     return s;
