@@ -2361,6 +2361,47 @@ START_TEST(documented_refusals_at_their_edges)
 }
 END_TEST
 
+/* fe_discover_select's FE_ENONFINITE, "sums too large to whiten": a
+   residual of AR(1) noise (phi = 0.9) whose sum of squares is finite
+   (1.5e308 < DBL_MAX) but whose prewhitened Gram matrix, (1 + phi^2) times
+   it and more, is not; the same rows at half their size (a quarter of the
+   sums) fit. */
+START_TEST(sums_too_large_to_whiten_are_refused)
+{
+    enum { N = 200, K = 4 };
+    size_t nst = fe_discover_acc_doubles(1, K), nw = fe_discover_workspace_doubles(1, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), x[N], ss = 0.0;
+    fe_discover_group groups[1] = {{"bias", 0, 1}};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_rng g = fe_rng_seed(23);
+    size_t base[1] = {0};
+    o.base = base;
+    o.nbase = 1;
+    o.max_steps = 0;
+    x[0] = fe_rng_normal(&g);
+    for (size_t t = 1; t < N; t++)
+        x[t] = 0.9 * x[t - 1] + fe_rng_normal(&g);
+    for (size_t t = 0; t < N; t++)
+        ss += x[t] * x[t];
+    for (double scale = 1.0; scale >= 0.5; scale -= 0.5) {
+        double s = scale * sqrt(1.5e308 / ss);
+        fe_discover_acc a;
+        ck_assert_int_eq(fe_discover_acc_init(&a, 1, K, N, 0, st, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_set_lags(&a, 8), FE_OK);
+        for (size_t t = 0; t < N; t++) {
+            double phi[1] = {1.0};
+            ck_assert_int_eq(fe_discover_add(&a, phi, s * x[t]), FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_select(&a, groups, 1, &o, r, w, nw),
+                         scale == 1.0 ? FE_ENONFINITE : FE_OK);
+    }
+    free(r);
+    free(st);
+    free(w);
+}
+END_TEST
+
 Suite *fe_discover_suite(void)
 {
     Suite *s = suite_create("discover");
@@ -2398,6 +2439,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, documented_refusals_at_their_edges);
+    tcase_add_test(t, sums_too_large_to_whiten_are_refused);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);

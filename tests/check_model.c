@@ -361,6 +361,43 @@ START_TEST(finite_difference_steps_and_calls)
 }
 END_TEST
 
+/* fe_model_break's FE_ENONFINITE: the held row is folded with a
+   one-sided difference of the simulation, here a step of 1 over 1e-310 of
+   time, which overflows (the delay term carries it); the row is dropped
+   and the recording ends.  Over 1e-150 the difference is finite and the
+   row folds.  (The row before it, folded with the central difference
+   across both neighbours, sees no step.) */
+START_TEST(a_held_row_whose_difference_overflows_is_dropped)
+{
+    fe_catalog_scale sc = {0};
+    fe_catalog c;
+    fe_model m = {3, theta0, NULL, rig_predict, rig_jacobian, 0, NULL, NULL};
+    fe_model_acc a;
+    size_t nst;
+    double *st;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT,
+                                     &sc), FE_OK);
+    nst = fe_model_acc_doubles(3, c.count, 4);
+    st = malloc(nst * sizeof *st);
+    for (int k = 0; k < 2; k++) {
+        fe_sample s = {0};
+        double rows_before;
+        ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);
+        s.real = 0.3;
+        for (int i = 0; i < 3; i++) {       /* the simulation 1.5, 0.5, 1.5 */
+            s.t = i == 0 ? -1.0 : i == 1 ? 0.0 : k == 0 ? 1e-310 : 1e-150;
+            s.input = i == 1 ? 0.5 : 1.5;
+            ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+        }
+        rows_before = a.acc.counts[0];
+        ck_assert_int_eq(fe_model_break(&a), k == 0 ? FE_ENONFINITE : FE_OK);
+        ck_assert_double_eq(a.acc.counts[0], rows_before + (k == 0 ? 0.0 : 1.0));
+        ck_assert_int_eq(a.have_pend, 0);    /* no row held either way */
+    }
+    free(st);
+}
+END_TEST
+
 START_TEST(refusals_leave_the_accumulation_unchanged)
 {
     fe_catalog_scale sc = {0};
@@ -691,6 +728,7 @@ Suite *fe_model_suite(void)
     tcase_add_test(t, finite_difference_steps_and_calls);
     tcase_add_test(t, the_fold_is_its_rows);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, a_held_row_whose_difference_overflows_is_dropped);
     tcase_add_test(t, arguments_and_failing_callbacks);
     tcase_add_test(t, non_finite_prediction_refused_at_its_row);
     tcase_add_test(t, analytic_and_numerical_jacobians_discover_the_same);
