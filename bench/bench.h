@@ -3,8 +3,11 @@
 #ifndef FE_BENCH_H
 #define FE_BENCH_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <time.h>
+
+#include "foldest.h"
 
 static inline double fe_bench_now(void)
 {
@@ -40,6 +43,25 @@ static inline double fe_bench_now(void)
                 break;                                                       \
         }                                                                    \
     } while (0)
+
+/* The table the reading benchmarks share: a header and `rows` records of
+   eight numeric columns of six or seven significant digits ("2201.72",
+   "-0.764163"), drawn from `seed`, written to `out`.  Returns the bytes
+   written (ftell), negative on an error. */
+static inline double fe_bench_write_table8(FILE *out, long rows, uint64_t seed)
+{
+    fe_rng rng = fe_rng_seed(seed);
+    fprintf(out, "c0,c1,c2,c3,c4,c5,c6,c7\n");
+    for (long i = 0; i < rows; i++)
+        for (int c = 0; c < 8; c++) {
+            double u = fe_rng_uniform(&rng);
+            if (c % 2)
+                fprintf(out, "%.6f%c", 2.0 * u - 1.0, c == 7 ? '\n' : ',');
+            else
+                fprintf(out, "%.2f%c", 1e4 * u, c == 7 ? '\n' : ',');
+        }
+    return (double)ftell(out);
+}
 
 /* Keep the optimiser from deleting a computation whose result is unused. */
 static inline void fe_bench_keep(double x)

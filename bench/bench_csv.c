@@ -75,23 +75,13 @@ int main(void)
     char *buf = malloc(BUF);
     double busy = fe_bench_busy_fraction(), t_floor, t[3], sum = 0.0, bytes;
     long lines = 0, rows[3] = {0, 0, 0};
-    fe_rng rng = fe_rng_seed(1);
     const char *stage_name[3] = {"lines (fe_csv_next_line)", "+ fields (fe_csv_split)",
                                  "+ numbers (fe_csv_number)"};
     int fd = mkstemp(path);
     FILE *out;
     if (buf == NULL || fd < 0 || (out = fdopen(fd, "w")) == NULL)
         return 1;
-    fprintf(out, "c0,c1,c2,c3,c4,c5,c6,c7\n");
-    for (long i = 0; i < N; i++)
-        for (int c = 0; c < COLS; c++) {
-            double u = fe_rng_uniform(&rng);
-            if (c % 2)
-                fprintf(out, "%.6f%c", 2.0 * u - 1.0, c == COLS - 1 ? '\n' : ',');
-            else
-                fprintf(out, "%.2f%c", 1e4 * u, c == COLS - 1 ? '\n' : ',');
-        }
-    bytes = (double)ftell(out);
+    bytes = fe_bench_write_table8(out, N, 1);
     fclose(out);
     read_floor(path, buf);                              /* into the cache */
     FE_BENCH_BEST(t_floor, NS, lines = read_floor(path, buf));

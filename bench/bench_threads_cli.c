@@ -70,20 +70,10 @@ static int run(const char *foldest, char *const *args, int threads)
 static int write_stats_file(const char *path, double *bytes)
 {
     FILE *out = fopen(path, "w");
-    fe_rng rng = fe_rng_seed(16);
     if (out == NULL)
         return -1;
-    fprintf(out, "c0,c1,c2,c3,c4,c5,c6,c7\n");
-    for (long i = 0; i < STATS_ROWS; i++)
-        for (int c = 0; c < 8; c++) {
-            double u = fe_rng_uniform(&rng);
-            if (c % 2)
-                fprintf(out, "%.6f%c", 2.0 * u - 1.0, c == 7 ? '\n' : ',');
-            else
-                fprintf(out, "%.2f%c", 1e4 * u, c == 7 ? '\n' : ',');
-        }
-    *bytes = (double)ftell(out);
-    return fclose(out) == 0 ? 0 : -1;
+    *bytes = fe_bench_write_table8(out, STATS_ROWS, 16);
+    return fclose(out) == 0 && *bytes >= 0.0 ? 0 : -1;
 }
 
 static int write_calibrate_file(const char *path, double *bytes)
