@@ -455,6 +455,8 @@ static const struct usage_case usage_cases[] = {
     {"-V", 0, "foldest 0."},
     {"stats -V", 0, "foldest 0."},
     {"discover --version", 0, "foldest 0."},
+    {"calibrate --version a.csv", 0, "foldest " FE_VERSION "\n"},
+    {"synth --version --effect drift", 0, "foldest " FE_VERSION "\n"},
     {"stats -h", 0, "usage: foldest stats"},
     {"synth -h", 0, "usage: foldest synth"},
     {"discover -h --real x", 0, "usage: foldest discover"},
