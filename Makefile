@@ -323,9 +323,12 @@ SEED           ?= 1
 MUTATE_EXCLUDE ?=
 MUTATE_MIN     ?= 0
 # Every documented error code of every public function is produced by a
-# test statement, or explained in tests/audit/codes_explained.txt.
+# test statement, or explained in tests/audit/codes_explained.txt; every
+# option of every command is used by a test that runs the command, or
+# explained in tests/audit/options_explained.txt.
 audit:
 	python3 tests/audit/codes.py
+	python3 tests/audit/options.py
 
 mutate: lib cli $(B)/tests/suites.h
 	python3 tests/mutate/mutate.py --mutants $(MUTANTS) --seed $(SEED) --exclude '$(MUTATE_EXCLUDE)' \

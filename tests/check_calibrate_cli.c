@@ -502,6 +502,75 @@ START_TEST(report_with_plots)
 }
 END_TEST
 
+/* The reader's options, which calibrate takes as every command does
+   (cli.org).  --decimal-comma: the recording with tabs and decimal commas
+   gives the fit of the one with points, and is refused without it.
+   --skip-bad-rows: a row with an empty cell, which stops the command
+   without it, is skipped; the fit is the one without that row, and the row
+   is counted once, in the JSON and on standard error, though a file is
+   read in two passes (four with --robust). */
+static int occurrences(const char *text, const char *part)
+{
+    int n = 0;
+    for (const char *at = strstr(text, part); at != NULL; at = strstr(at + 1, part))
+        n++;
+    return n;
+}
+
+START_TEST(reader_options)
+{
+    static const char *const fits[] = {"", "--robust"};
+    char path[] = "/tmp/foldest-cal-XXXXXX", bad[64], out[8192], want[8192], cmd[512];
+    int fd = mkstemp(path), status;
+    ck_assert_int_ge(fd, 0);
+    close(fd);
+    write_recording(path, 1000, WHOLE, NULL);
+    ck_assert_int_eq(run("%1$s calibrate --columns mx,my,mz --json %2$s", path, want,
+                         sizeof want), 0);
+    ck_assert_ptr_nonnull(strstr(want, "\"model\""));
+
+    /* Tabs for the commas, then commas for the points. */
+    status = run("sed 's/,/\\t/g; s/\\./,/g' %2$s > %2$s.tab && "
+                 "%1$s calibrate --decimal-comma --columns mx,my,mz --json %2$s.tab 2>&1",
+                 path, out, sizeof out);
+    ck_assert_msg(status == 0, "status %d: %s", status, out);
+    ck_assert_ptr_nonnull(strstr(out, "\"model\""));
+    ck_assert_str_eq(strstr(out, "\"model\""), strstr(want, "\"model\""));
+    status = run("%1$s calibrate --columns mx,my,mz --json %2$s.tab 2>/dev/null", path, out,
+                 sizeof out);
+    ck_assert_msg(status != 0 && out[0] == '\0', "read without --decimal-comma: status %d: %s",
+                  status, out);
+
+    /* An empty cell in the row after sample 500: line 505. */
+    snprintf(bad, sizeof bad, "%s.bad", path);
+    write_recording(bad, 1000, WHOLE, "9.99,1,,3\n");
+    status = run("%1$s calibrate --columns mx,my,mz --json %2$s.bad 2>&1", path, out, sizeof out);
+    ck_assert_int_eq(status, 3);
+    ck_assert_msg(strstr(out, ".bad:505:8: empty cell in column 'my' (--skip-bad-rows skips "
+                              "such rows)") != NULL, "%s", out);
+    for (size_t k = 0; k < sizeof fits / sizeof fits[0]; k++) {
+        snprintf(cmd, sizeof cmd, "%%1$s calibrate --columns mx,my,mz --json %s %%2$s", fits[k]);
+        ck_assert_int_eq(run(cmd, path, want, sizeof want), 0);
+        snprintf(cmd, sizeof cmd, "%%1$s calibrate --skip-bad-rows --columns mx,my,mz --json %s "
+                 "%%2$s.bad 2>&1", fits[k]);
+        status = run(cmd, path, out, sizeof out);
+        ck_assert_msg(status == 0, "%s: status %d: %s", fits[k], status, out);
+        for (int i = 0; i < 3; i++)
+            ck_assert_double_eq(json_number(out, "offset", i), json_number(want, "offset", i));
+        ck_assert_double_eq(json_number(out, "n", 0), json_number(want, "n", 0));
+        ck_assert_msg(strstr(out, "\"bad_rows\": {\"total\": 1, \"empty_cell\": 1, \"not_finite\": "
+                                  "0, \"not_a_number\": 0, \"field_count\": 0}") != NULL,
+                      "%s: %s", fits[k], out);
+        ck_assert_msg(occurrences(out, ": skipped 1 bad rows (1 with an empty cell,") == 1,
+                      "%s: %s", fits[k], out);
+    }
+    unlink(bad);
+    snprintf(bad, sizeof bad, "%s.tab", path);
+    unlink(bad);
+    unlink(path);
+}
+END_TEST
+
 START_TEST(help_documents_everything)
 {
     char out[8192];
@@ -644,6 +713,7 @@ Suite *fe_calibrate_cli_suite(void)
     tcase_add_test(t, report_with_plots);
     tcase_add_test(t, robust_rejects_outliers);
     tcase_add_test(t, export_for_firmware);
+    tcase_add_test(t, reader_options);
     tcase_add_test(t, help_documents_everything);
     tcase_add_test(t, real_recording_from_the_command_line);
     tcase_add_test(t, static_poses_of_the_ferraris_session);

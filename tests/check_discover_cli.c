@@ -94,6 +94,92 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* The reader's options, which discover takes as every command does
+   (cli.org).  --decimal-comma: the pair with tabs and decimal commas gives
+   the JSON of the pair with points, byte for byte, and is refused without
+   it.  --skip-bad-rows: an empty cell and a NaN in the recording stop the
+   command without it; with it the JSON is the clean pair's but for
+   bad_rows, which counts each row once though discover reads the files in
+   several passes, and standard error says so once. */
+START_TEST(reader_options)
+{
+    static char want[65536], out[65536], expect[65536];
+    static const char clean[] = "\"bad_rows\": {\"total\": 0, \"empty_cell\": 0, \"not_finite\": 0, "
+                                "\"not_a_number\": 0, \"field_count\": 0}";
+    static const char two[] = "\"bad_rows\": {\"total\": 2, \"empty_cell\": 1, \"not_finite\": 1, "
+                              "\"not_a_number\": 0, \"field_count\": 0}";
+    const char *roles = "--channel acceleration --role position=position "
+                        "--role velocity=velocity --role input=input --base bias,gain --json";
+    char cmd[2048];
+    const char *at;
+    int status;
+    make_dir();
+    snprintf(cmd, sizeof cmd, "%s synth --effect quadratic_drag --seed 3 --rows 3000 "
+             "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv %s", FE_TEST_CLI, dir,
+             dir, roles);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, want, sizeof want), 0);
+
+    /* Tabs for the commas, then commas for the points. */
+    snprintf(cmd, sizeof cmd, "for f in r s; do sed 's/,/\\t/g; s/\\./,/g' %s/$f.csv > %s/$f.tab; "
+             "done", dir, dir);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --decimal-comma --real %s/r.tab --sim %s/s.tab %s",
+             FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+    ck_assert_str_eq(out, want);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.tab --sim %s/s.tab %s", FE_TEST_CLI, dir,
+             dir, roles);
+    status = fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out);
+    ck_assert_msg(status != 0 && out[0] == '\0', "read without --decimal-comma: status %d: %s",
+                  status, out);
+
+    /* Lines 1001 and 2001 of the recording: an empty cell, a NaN. */
+    snprintf(cmd, sizeof cmd, "awk 'NR == 1001 {print \"10.005,\"} NR == 2001 "
+             "{print \"20.005,NaN\"} {print}' %s/r.csv > %s/rb.csv", dir, dir);
+    ck_assert_int_eq(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/rb.csv --sim %s/s.csv %s", FE_TEST_CLI, dir,
+             dir, roles);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, out, sizeof out), 3);
+    ck_assert_msg(strstr(out, "rb.csv:1001:8: empty cell in column 'acceleration'") != NULL, "%s",
+                  out);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/rb.csv --skip-bad-rows --sim %s/s.csv %s",
+             FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+    at = strstr(want, clean);
+    ck_assert_ptr_nonnull(at);
+    snprintf(expect, sizeof expect, "%.*s%s%s", (int)(at - want), want, two, at + strlen(clean));
+    ck_assert_str_eq(out, expect);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/rb.csv --skip-bad-rows --sim %s/s.csv %s "
+             "2>&1 >/dev/null", FE_TEST_CLI, dir, dir, roles);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_AS_GIVEN, out, sizeof out), 0);
+    at = strstr(out, "rb.csv: skipped 2 bad rows (1 with an empty cell, 1 with NaN or infinity,");
+    ck_assert_msg(at != NULL && strstr(at + strlen("rb.csv: skipped"), "skipped") == NULL, "%s",
+                  out);
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
+/* synth reads no table: the reader's options, which every command takes,
+   are accepted anywhere among its options and change nothing in the pair
+   it writes. */
+START_TEST(synth_takes_the_reader_options)
+{
+    static char out[8192];
+    char cmd[2048];
+    make_dir();
+    snprintf(cmd, sizeof cmd, "%s synth --effect drift --seed 4 --rows 500 --real %s/r.csv "
+             "--sim %s/s.csv", FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%s synth --decimal-comma --effect drift --seed 4 --skip-bad-rows "
+             "--rows 500 --real %s/r2.csv --sim %s/s2.csv && cmp %s/r.csv %s/r2.csv && "
+             "cmp %s/s.csv %s/s2.csv", FE_TEST_CLI, dir, dir, dir, dir, dir, dir);
+    ck_assert_msg(fe_test_run(cmd, FE_TEST_BOTH, out, sizeof out) == 0, "%s", out);
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
 /* synth --rho sets the noise's colour and nothing else: the same truth
    (coefficient and noise sd) for white noise and for an AR(1) with lag-one
    correlation 0.9, and discover's baseline residual has the lag-one
@@ -921,7 +1007,9 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, reader_options);
     tcase_add_test(t, synth_rho_sets_the_noise_colour);
+    tcase_add_test(t, synth_takes_the_reader_options);
     tcase_add_test(t, output_error_is_named_in_the_derivative_it_enters);
     tcase_add_test(t, a_function_of_the_state_left_is_not_explained);
     tcase_add_test(t, inputs_from_a_pipe_and_compressed);

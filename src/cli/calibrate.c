@@ -517,6 +517,7 @@ static int fe__calibrate_walk(const fe__calibrate_args *a, const size_t cols[6],
         fprintf(stderr, "foldest calibrate: %s\n", err);
         return rc;
     }
+    fe_cli_table_reread(&t);
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
     rc = fe_cli_table_each(&t, cols, ncols, a->threads, fe__calibrate_walk_row, &r, err,
@@ -653,6 +654,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
         fprintf(stderr, "foldest calibrate: %s\n", err);
         return rc;
     }
+    fe_cli_table_reread(t);
     if (apply != NULL) {
         rc = fe_cli_output_open(&o, apply, err, sizeof err);
         if (rc != FE_CLI_OK) {

@@ -54,6 +54,7 @@ typedef struct fe_cli_table {
     void *gz;                   /* the zlib stream everything is read through */
     int decimal_comma;          /* 1: forced; 2: a semicolon table */
     size_t bad[4];              /* rows skipped in this pass, by reason */
+    int reread;                 /* fe_cli_table_reread: they are counted */
     int view;                   /* a batch's reader on a worker thread
                                    (fe_cli_table_each): it touches no
                                    global and shows no progress */
@@ -84,6 +85,12 @@ void fe_cli_json_bad_rows(FILE *out);
    message and the return value is an exit status. */
 int fe_cli_table_open(fe_cli_table *t, const char *path, long skip,
                       char *err, size_t errlen);
+
+/* Say that t reads again a file another table of this run has read (a
+   later pass of calibrate, which opens the file anew): the rows it skips
+   were counted and reported by that table, so they are neither added to
+   fe_cli_bad_rows nor reported again when t is closed. */
+void fe_cli_table_reread(fe_cli_table *t);
 
 /* Find the column `spec` (name, case-insensitive name, unique prefix, or
    number from 1); FE_CLI_USAGE with a message listing the columns if none. */

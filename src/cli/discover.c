@@ -3022,6 +3022,10 @@ static int fe__discover_sphere_main(int argc, char **argv)
             }
         } else if (strcmp(o, "--alpha") == 0) {
             rc = fe_cli_parse_double(o, v, &a.alpha, err, sizeof err);
+            if (rc == FE_CLI_OK && !(a.alpha > 0.0 && a.alpha < 0.5)) {
+                snprintf(err, sizeof err, "--alpha: %s is not in (0, 0.5)", v);
+                rc = FE_CLI_USAGE;
+            }
         } else if (strcmp(o, "--blocks") == 0) {
             rc = fe_cli_parse_long(o, v, &a.blocks, err, sizeof err);
             if (rc == FE_CLI_OK && (a.blocks < 4 || a.blocks > FE_DISCOVER_MAX_BLOCKS)) {

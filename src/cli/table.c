@@ -527,9 +527,14 @@ static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
 static int fe__cli_skip(fe_cli_table *t, int reason)
 {
     t->bad[reason]++;
-    if (!t->view)               /* a worker's view: the caller adds them */
+    if (!t->view && !t->reread) /* a worker's view: the caller adds them */
         fe__cli_bad_total[reason]++;
     return FE__CLI_SKIPPED;
+}
+
+void fe_cli_table_reread(fe_cli_table *t)
+{
+    t->reread = 1;
 }
 
 int fe_cli_table_next(fe_cli_table *t, const size_t *cols, size_t k,
@@ -573,7 +578,7 @@ void fe_cli_table_close(fe_cli_table *t)
 {
     fe__cli_pass_end(t);
     size_t nbad = t->bad[0] + t->bad[1] + t->bad[2] + t->bad[3];
-    if (nbad > 0)
+    if (nbad > 0 && !t->reread)
         fprintf(stderr, "foldest: %s: skipped %zu bad rows (%zu with an empty cell, "
                         "%zu with NaN or infinity, %zu with text, %zu with a wrong number "
                         "of fields)\n", t->name, nbad, t->bad[FE_CLI_BAD_EMPTY],
@@ -998,7 +1003,8 @@ static void fe__cli_count_skipped(fe__cli_pass *p, fe_cli_table *t, const fe__cl
         for (int r = 0; r < FE_CLI_BAD_REASONS; r++) {
             size_t d = now[r] - (before != NULL ? before[r] : 0);
             t->bad[r] += d;
-            fe__cli_bad_total[r] += d;
+            if (!t->reread)
+                fe__cli_bad_total[r] += d;
         }
         p->bad_seen++;
     }
