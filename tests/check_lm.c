@@ -1223,6 +1223,45 @@ START_TEST(parameters_at_their_edges)
 }
 END_TEST
 
+/* Issue 20: the session count at its edges from inside: one session and
+   FE_SESSIONS_MAX sessions (their readings on spheres of radius 1 about
+   offsets of their own, through one S = I) are fitted; 0 and one more
+   are refused (emit_and_sessions_refusals_at_their_edges). */
+START_TEST(one_and_the_most_sessions_are_fitted)
+{
+    enum { R = 20 };
+    static double m[FE_SESSIONS_MAX][3 * R];
+    fe_sessions c;
+    fe_rng g = fe_rng_seed(64);
+    memset(&c, 0, sizeof c);
+    for (size_t s = 0; s < FE_SESSIONS_MAX; s++) {
+        for (size_t i = 0; i < R; i++) {
+            double u[3];
+            fe_rng_unit_vector(&g, u);
+            for (int j = 0; j < 3; j++)
+                m[s][3 * i + j] = (double)(s % 4) + (double)j * (double)s / 16.0 + u[j];
+        }
+        c.m[s] = m[s];
+        c.n[s] = R;
+    }
+    for (size_t count = 1; count <= FE_SESSIONS_MAX; count += FE_SESSIONS_MAX - 1) {
+        double *x = malloc(fe_sessions_params(&(fe_sessions){count, {0}, {0}, 0}) * sizeof *x);
+        fe_lm_result res;
+        double S[3][3];
+        c.count = count;
+        ck_assert_int_eq(magcal_fit(&c, x, &res), FE_OK);
+        fe_sessions_matrix(x, S);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                ck_assert_double_eq_tol(fabs(S[i][j]), i == j ? 1.0 : 0.0, 1e-6);
+        for (size_t s = 0; s < count; s++)
+            ck_assert_double_eq_tol(x[6 + 3 * s + 2], (double)(s % 4) + 2.0 * (double)s / 16.0,
+                                    1e-6);
+        free(x);
+    }
+}
+END_TEST
+
 Suite *fe_lm_suite(void)
 {
     Suite *s = suite_create("lm");
@@ -1246,6 +1285,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, magnetometer_sessions_real);
     tcase_add_test(t, emit_and_sessions_refusals_at_their_edges);
     tcase_add_test(t, parameters_at_their_edges);
+    tcase_add_test(t, one_and_the_most_sessions_are_fitted);
     suite_add_tcase(s, t);
     return s;
 }
