@@ -775,6 +775,12 @@ int fe_kalman_info_set_prior_scaled(fe_kalman_info *s, const double *x0,
         return FE_ENONFINITE;
     if (!(p0 > 0.0))
         return FE_ENOTPD;
+    /* A variance so small that its inverse overflows is no prior. */
+    if (!isfinite(1.0 / p0))
+        return FE_ENONFINITE;
+    for (size_t i = 0; x0 != NULL && i < n; i++)
+        if (!isfinite(x0[i] / p0))
+            return FE_ENONFINITE;
     memset(s->Lambda, 0, n * n * sizeof *s->Lambda);
     for (size_t i = 0; i < n; i++) {
         s->Lambda[i * n + i] = 1.0 / p0;
@@ -1031,7 +1037,9 @@ int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
                                double *lo, double *hi)
 {
     double nu, steps;
-    if (m == NULL || lo == NULL || hi == NULL || !(prob > 0.0 && prob < 1.0))
+    /* The upper level (1 + prob) / 2 must stay below 1: for the largest
+       double below 1 it rounds to 1, whose quantile is infinite. */
+    if (m == NULL || lo == NULL || hi == NULL || !(prob > 0.0 && 0.5 * (1.0 + prob) < 1.0))
         return FE_EINVAL;
     if (m->steps == 0)
         return FE_ETOOFEW;

@@ -468,6 +468,43 @@ START_TEST(scale_is_the_first_sample_and_the_largest_speed)
 }
 END_TEST
 
+/* Issue 20: fe_catalog_eval_rows' strides at their edges: ldphi equal to
+   the number of terms is enough and one less refused, as is a row stride
+   of FE_CATALOG_VARS and one less (phi untouched when refused). */
+START_TEST(row_and_term_strides_at_their_edges)
+{
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_sample s;
+    double rows[2 * FE_CATALOG_VARS], *phi, work[64];
+    size_t nt;
+    memset(&s, 0, sizeof s);
+    s.velocity = 2.0;
+    s.sim = 3.0;
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_VELOCITY, &scale), FE_OK);
+    nt = c.count;
+    ck_assert_uint_gt(nt, 1);
+    fe_catalog_row(&s, rows);
+    fe_catalog_row(&s, rows + FE_CATALOG_VARS);
+    ck_assert_uint_ge(sizeof work / sizeof work[0], fe_catalog_work_doubles(2));
+    phi = malloc(2 * nt * sizeof *phi);
+    ck_assert_ptr_nonnull(phi);
+    for (size_t i = 0; i < 2 * nt; i++)
+        phi[i] = -7.0;
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, 2, phi, nt - 1, work, NULL),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS - 1, 2, phi, nt, work, NULL),
+                     FE_EINVAL);
+    for (size_t i = 0; i < 2 * nt; i++)
+        ck_assert_double_eq(phi[i], -7.0);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, 2, phi, nt, work, NULL),
+                     FE_OK);
+    ck_assert_double_eq(phi[(size_t)fe_catalog_find(&c, "gain")], 3.0);
+    ck_assert_double_eq(phi[nt + (size_t)fe_catalog_find(&c, "quadratic_drag")], 4.0);
+    free(phi);
+}
+END_TEST
+
 Suite *fe_catalog_suite(void)
 {
     Suite *s = suite_create("catalog");
@@ -481,6 +518,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);
     tcase_add_test(t, three_axis_centre_refused_in_each_coordinate);
     tcase_add_test(t, scale_is_the_first_sample_and_the_largest_speed);
+    tcase_add_test(t, row_and_term_strides_at_their_edges);
     suite_add_tcase(s, t);
     return s;
 }

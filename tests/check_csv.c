@@ -461,6 +461,70 @@ START_TEST(numbers_read_and_written_alike_in_any_locale)
 }
 END_TEST
 
+/* Issue 20: the reader's buffer at its edge.  A buffer of 8 bytes reads
+   at most 7, which must hold the line and its newline: 6 characters and
+   LF are read, 7 refused (and skipped); with CRLF 5 characters are read
+   and 6 refused; a last line without a newline is read at 6 and refused
+   at 7, as the buffer cannot tell it from a longer one.  Each input in
+   one chunk and one byte at a time. */
+START_TEST(a_line_two_bytes_shorter_than_its_buffer_is_the_longest_read)
+{
+    static const struct { const char *text; int rc; size_t len; } cases[] = {
+        {"123456\nab\n", FE_OK, 6},   {"1234567\nab\n", FE_ESIZE, 0},
+        {"12345\r\nab\n", FE_OK, 5},  {"123456\r\nab\n", FE_ESIZE, 0},
+        {"ab\n123456", FE_OK, 6},     {"ab\n1234567", FE_ESIZE, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        for (size_t step = 1; step <= 64; step += 63) {
+            struct chunks c = {cases[i].text, 0, step};
+            fe_csv_reader r;
+            char buf[8], *line;
+            size_t len = 99, lineno = cases[i].text[0] == 'a' ? 2 : 1;
+            ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, buf, sizeof buf), FE_OK);
+            if (lineno == 2) {
+                ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+                ck_assert_str_eq(line, "ab");
+            }
+            ck_assert_msg(fe_csv_next_line(&r, &line, &len) == cases[i].rc, "case %zu", i);
+            ck_assert_uint_eq(r.line, lineno);
+            if (cases[i].rc == FE_OK) {
+                ck_assert_uint_eq(len, cases[i].len);
+                ck_assert_uint_eq(strlen(line), cases[i].len);
+                ck_assert_int_eq(strncmp(line, "1234567", len), 0);
+            }
+            if (lineno == 1) {                  /* the next line is read either way */
+                ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+                ck_assert_str_eq(line, "ab");
+            }
+            ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+        }
+}
+END_TEST
+
+/* Issue 20: a decimal-comma field of 255 bytes is read, one of 256 is
+   FE_EPARSE (a leading run of zeros keeps the value 1.5); fe_csv_number
+   reads the same 256 bytes with a point. */
+START_TEST(a_decimal_comma_field_of_255_bytes_is_read_and_256_refused)
+{
+    char text[257];
+    fe_csv_field f = {text, 1};
+    double v = -1.0;
+    memset(text, '0', sizeof text);
+    text[252] = '1', text[253] = ',', text[254] = '5', text[255] = '\0';
+    ck_assert_uint_eq(strlen(text), 255);
+    ck_assert_int_eq(fe_csv_number_comma(&f, &v), FE_OK);
+    ck_assert_double_eq(v, 1.5);
+    memset(text, '0', sizeof text);
+    text[253] = '1', text[254] = ',', text[255] = '5', text[256] = '\0';
+    v = -1.0;
+    ck_assert_int_eq(fe_csv_number_comma(&f, &v), FE_EPARSE);
+    ck_assert_double_eq(v, -1.0);
+    text[254] = '.';                            /* the point reader has no such bound */
+    ck_assert_int_eq(fe_csv_number(&f, &v), FE_OK);
+    ck_assert_double_eq(v, 1.5);
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -478,6 +542,8 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
     tcase_add_test(t, number_parsers_refuse_each_missing_argument);
     tcase_add_test(t, numbers_read_and_written_alike_in_any_locale);
+    tcase_add_test(t, a_line_two_bytes_shorter_than_its_buffer_is_the_longest_read);
+    tcase_add_test(t, a_decimal_comma_field_of_255_bytes_is_read_and_256_refused);
     suite_add_tcase(s, t);
     return s;
 }

@@ -2402,6 +2402,127 @@ START_TEST(sums_too_large_to_whiten_are_refused)
 }
 END_TEST
 
+/* Issue 20: the shapes, counts and workspaces of discovery at their edges.
+   Blocks 2 and FE_DISCOVER_MAX_BLOCKS are taken, 1 and one more refused
+   (FE_ESIZE); FE_DISCOVER_LAGS lags are kept and one more refused; the
+   fine blocks go up to fit_rows / FE_DISCOVER_FINE_ROWS exactly (512 of
+   8192 rows, not of 8191) and FE_DISCOVER_FINE_BLOCKS; the noise model
+   of a series of 2 rows and of order FE_DISCOVER_LAGS - 1 is fitted;
+   a panel of one row needs no stride, of columns a stride of nrows; the
+   selection's workspace at fe_discover_workspace_doubles and one less,
+   FE_DISCOVER_MAX_GROUPS candidates and one more, a block of one row and
+   one of none; the GLS fit's order at FE_DISCOVER_EDGE (and lags - 1)
+   and one more. */
+START_TEST(shapes_counts_and_workspaces_at_their_edges)
+{
+    enum { M = 2, K = 4, N = 100 };
+    size_t nst = fe_discover_acc_doubles(M, FE_DISCOVER_MAX_BLOCKS);
+    size_t nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), coef[2], se[2];
+    double phi[M], r, col[2 * M] = {1, 1, 0, 1}, rr[2] = {0.5, 0.25};
+    static fe_discover_group g[FE_DISCOVER_MAX_GROUPS + 1];
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *res = malloc(sizeof *res);
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    fe_discover_acc a;
+    fe_rng rng = fe_rng_seed(20);
+    const size_t cols[2] = {0, 1};
+    size_t done = 9;
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, 1, N, 0, st, nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, 2, N, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, FE_DISCOVER_MAX_BLOCKS + 1, 1000, 0, st, nst),
+                     FE_ESIZE);
+    ck_assert_int_eq(fe_discover_screen_init(&a, M, 1, FE_DISCOVER_MAX_BLOCKS + 1, 1000, 0, st,
+                                             nst), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, FE_DISCOVER_MAX_BLOCKS,
+                                          2 * FE_DISCOVER_MAX_BLOCKS, 0, st, nst), FE_OK);
+    ck_assert_uint_eq(a.blocks, FE_DISCOVER_MAX_BLOCKS);
+    ck_assert_int_eq(fe_discover_set_lags(&a, FE_DISCOVER_LAGS + 1), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_set_lags(&a, FE_DISCOVER_LAGS), FE_OK);
+    ck_assert_uint_eq(a.lags, FE_DISCOVER_LAGS);
+    /* Fine blocks: 512 x 16 = 8192 rows. */
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 8191, 0, st, nst), FE_OK);
+    ck_assert_uint_eq(a.fine, 256);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 512), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 256), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 8192, 0, st, nst), FE_OK);
+    ck_assert_uint_eq(a.fine, FE_DISCOVER_FINE_BLOCKS);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 1), FE_OK);
+    ck_assert_int_eq(fe_discover_set_fine(&a, FE_DISCOVER_FINE_BLOCKS), FE_OK);
+    ck_assert_int_eq(fe_discover_set_fine(&a, 2 * FE_DISCOVER_FINE_BLOCKS), FE_ESIZE);
+    {   /* The noise model: n = 2 and the highest order are fitted. */
+        double q[FE_DISCOVER_LAGS + 1];
+        for (size_t l = 0; l <= FE_DISCOVER_LAGS; l++)
+            q[l] = 100.0 * pow(0.5, (double)l);
+        ck_assert_int_eq(fe_discover_noise_fit(q, nextafter(2.0, 0.0), 1, &nz), FE_EINVAL);
+        ck_assert_int_eq(fe_discover_noise_fit(q, 2.0, 1, &nz), FE_OK);
+        ck_assert_int_eq(fe_discover_noise_fit(q, 1000.0, FE_DISCOVER_LAGS, &nz), FE_EINVAL);
+        ck_assert_int_eq(fe_discover_noise_fit(q, 1000.0, FE_DISCOVER_LAGS - 1, &nz), FE_OK);
+        ck_assert_uint_le(nz.order, FE_DISCOVER_LAGS - 1);
+        FE_ASSERT_REL(nz.phi[0], 0.5, 1e-12);       /* AR(1), phi 1/2 */
+    }
+    /* Panels: one row needs no stride; columns need ldphi >= nrows. */
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add_rows(&a, col, 0, rr, 1, &done), FE_OK);
+    ck_assert_uint_eq(done, 1);
+    ck_assert_int_eq(fe_discover_add_rows(&a, col, M - 1, rr, 2, &done), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_add_columns(&a, col, 1, rr, 2, &done), FE_EINVAL);
+    ck_assert_uint_eq(a.n, 1);
+    ck_assert_int_eq(fe_discover_add_columns(&a, col, 2, rr, 2, &done), FE_OK);
+    ck_assert_uint_eq(a.n, 3);
+    /* Rows 3 .. 75 fill blocks 0 .. 2 of 25 rows each: block 3 is empty. */
+    for (int t = 3; t < 75; t++) {
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&rng);
+        r = 0.5 * phi[1] + fe_rng_normal(&rng);
+        ck_assert_int_eq(fe_discover_add(&a, phi, r), FE_OK);
+    }
+    for (size_t i = 0; i <= FE_DISCOVER_MAX_GROUPS; i++)
+        g[i] = (fe_discover_group){i % 2 ? "x" : "one", i % 2, 1};
+    o.max_steps = 1;
+    ck_assert_int_eq(fe_discover_select(&a, g, 2, &o, res, w, nw), FE_ETOOFEW);
+    phi[0] = 1.0;
+    phi[1] = fe_rng_normal(&rng);
+    ck_assert_int_eq(fe_discover_add(&a, phi, 0.5 * phi[1]), FE_OK);     /* block 3: one row */
+    ck_assert_int_eq(fe_discover_select(&a, g, 2, &o, res, w, nw - 1), FE_ESIZE);
+    ck_assert_int_eq(fe_discover_select(&a, g, 2, &o, res, w, nw), FE_OK);
+    ck_assert_int_eq(fe_discover_select(&a, g, FE_DISCOVER_MAX_GROUPS + 1, &o, res, w, nw),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_discover_select(&a, g, FE_DISCOVER_MAX_GROUPS, &o, res, w, nw), FE_OK);
+    ck_assert_uint_eq(res->nranked[0], FE_DISCOVER_MAX_GROUPS);    /* every one ranked */
+    /* The GLS fit's order: at most FE_DISCOVER_EDGE, and below the lags. */
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, FE_DISCOVER_EDGE + 1, coef, se, &fit, &nz,
+                                           w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, FE_DISCOVER_EDGE, coef, se, &fit, &nz, w,
+                                           nw), FE_OK);
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, 1, coef, se, &fit, &nz, w, nw - 1),
+                     FE_ESIZE);
+    {
+        fe_discover_acc b;
+        double *sb = malloc(nst * sizeof *sb);
+        ck_assert_int_eq(fe_discover_acc_init(&b, M, K, N, 0, sb, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_set_lags(&b, 2), FE_OK);
+        for (int t = 0; t < N; t++) {
+            phi[0] = 1.0;
+            phi[1] = fe_rng_normal(&rng);
+            ck_assert_int_eq(fe_discover_add(&b, phi, phi[1] + fe_rng_normal(&rng)), FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_fit_noise(&b, cols, 2, 2, coef, se, &fit, &nz, w, nw),
+                         FE_EINVAL);
+        ck_assert_int_eq(fe_discover_fit_noise(&b, cols, 2, 1, coef, se, &fit, &nz, w, nw),
+                         FE_OK);
+        ck_assert_uint_le(nz.order, 1);
+        free(sb);
+    }
+    free(st);
+    free(w);
+    free(res);
+}
+END_TEST
+
 Suite *fe_discover_suite(void)
 {
     Suite *s = suite_create("discover");
@@ -2438,6 +2559,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
+    tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
     tcase_add_test(t, documented_refusals_at_their_edges);
     tcase_add_test(t, sums_too_large_to_whiten_are_refused);
     tcase_set_timeout(acc, 900);

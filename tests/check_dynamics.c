@@ -766,6 +766,63 @@ START_TEST(documented_refusals_by_order_and_value)
 }
 END_TEST
 
+/* Issue 20: the identification needs twice as many folded rows as basis
+   functions (12 for order 2, 11 for order 1): one fewer is FE_ETOOFEW and
+   exactly that many solve (a row is folded once its successor is known,
+   and the first is not).  The signatures take FE_DISCOVER_MAX_COLUMNS
+   forcings and refuse one more. */
+START_TEST(identification_rows_and_forcings_at_their_edges)
+{
+    fe_dynamics_sens sn;
+    simulate(&(plant){0, 2 * PI * 0.5, 0.1, 2.0, 0.0}, 1.0, 0.01, 40, rows);
+    for (size_t order = 1; order <= 2; order++) {
+        const double need = order == 2 ? 24.0 : 22.0;
+        fe_dynamics_span sp;
+        fe_dynamics_ident id;
+        fe_dynamics_fit fit;
+        size_t i = 0;
+        ck_assert_int_eq(fe_dynamics_span_init(&sp, order), FE_OK);
+        for (size_t k = 0; k < 40; k++) {
+            fe_sample t = rows[k];
+            t.temperature = t.position;             /* order 1 reads the temperature */
+            t.ambient = 0.1 * (double)k;
+            ck_assert_int_eq(fe_dynamics_span_add(&sp, &t), FE_OK);
+        }
+        ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_OK);
+        while (id.n < need - 1.0) {
+            fe_sample t = rows[i];
+            t.temperature = t.position;
+            t.ambient = 0.1 * (double)i++;
+            ck_assert_int_eq(fe_dynamics_ident_add(&id, &t), FE_OK);
+        }
+        ck_assert(id.n == need - 1.0);
+        ck_assert_int_eq(fe_dynamics_ident_solve(&id, &fit), FE_ETOOFEW);
+        {
+            fe_sample t = rows[i];
+            t.temperature = t.position;
+            t.ambient = 0.1 * (double)i;
+            ck_assert_int_eq(fe_dynamics_ident_add(&id, &t), FE_OK);
+        }
+        ck_assert(id.n == need);
+        ck_assert_int_eq(fe_dynamics_ident_solve(&id, &fit), FE_OK);
+        ck_assert(fit.n == need);
+        ck_assert_uint_gt(fit.nused, 0);
+    }
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, FE_DISCOVER_MAX_COLUMNS + 1), FE_ESIZE);
+    ck_assert_int_eq(fe_dynamics_sens_init(&sn, 2, FE_DISCOVER_MAX_COLUMNS), FE_OK);
+    ck_assert_uint_eq(sn.m, FE_DISCOVER_MAX_COLUMNS);
+    {
+        double a[2] = {-1.0, 0.0}, phi[FE_DISCOVER_MAX_COLUMNS], y[FE_DISCOVER_MAX_COLUMNS];
+        for (size_t j = 0; j < FE_DISCOVER_MAX_COLUMNS; j++)
+            phi[j] = (double)j;
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.0, a, phi, y, NULL), FE_OK);
+        ck_assert_int_eq(fe_dynamics_sens_step(&sn, 0.1, a, phi, y, NULL), FE_OK);
+        ck_assert_double_eq(y[0], 0.0);             /* no forcing, no response */
+        ck_assert_double_gt(y[FE_DISCOVER_MAX_COLUMNS - 1], 0.0);
+    }
+}
+END_TEST
+
 Suite *fe_dynamics_suite(void)
 {
     Suite *s = suite_create("dynamics");
@@ -785,6 +842,7 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, the_dynamics_catalog_and_its_words);
     tcase_add_test(t, a_missing_viscous_friction_is_named_with_its_coefficient);
     tcase_add_test(t, documented_refusals_by_order_and_value);
+    tcase_add_test(t, identification_rows_and_forcings_at_their_edges);
     suite_add_tcase(s, t);
     return s;
 }

@@ -253,6 +253,85 @@ START_TEST(what_a_program_reads)
 }
 END_TEST
 
+/* `k` copies of pre, then mid, then k copies of post, into t. */
+static const char *repeat(char *t, size_t len, const char *pre, int k, const char *mid,
+                          const char *post)
+{
+    t[0] = '\0';
+    for (int i = 0; i < k; i++)
+        strncat(t, pre, len - strlen(t) - 1);
+    strncat(t, mid, len - strlen(t) - 1);
+    for (int i = 0; i < k; i++)
+        strncat(t, post, len - strlen(t) - 1);
+    return t;
+}
+
+/* Issue 20: each limit of the compiler at its edge.  FE_EXPR_MAX_DEPTH
+   counts the parser's levels, two a parenthesis or function argument and
+   one a sign: 23 parentheses (48 levels) compile and 24 are refused at
+   the 24th, 46 signs compile and 47 do not; 16 values on the stack
+   compile and evaluate, 17 do not; 128 instructions compile, 129 do not
+   (the 129th is refused where it is emitted). */
+START_TEST(each_limit_of_the_compiler_is_met_at_its_edge)
+{
+    char t[1024];
+    fe_expr e;
+    double out = 0.0;
+    fails_at(repeat(t, sizeof t, "(", 24, "1", ")"), FE_ESIZE, 25, "nested too deeply");
+    ck_assert_int_eq(fe_expr_compile(&e, repeat(t, sizeof t, "(", 23, "7", ")"), names, NV, NULL,
+                                     NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, &out), FE_OK);
+    ck_assert_double_eq(out, 7.0);
+    fails_at(repeat(t, sizeof t, "sin(", 24, "1", ")"), FE_ESIZE, 97, "nested too deeply");
+    ck_assert_int_eq(fe_expr_compile(&e, repeat(t, sizeof t, "abs(", 23, "2", ")"), names, NV,
+                                     NULL, NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, &out), FE_OK);
+    ck_assert_double_eq(out, 2.0);
+    fails_at(repeat(t, sizeof t, "-", 47, "1", ""), FE_ESIZE, 48, "nested too deeply");
+    ck_assert_int_eq(fe_expr_compile(&e, repeat(t, sizeof t, "-", 46, "3", ""), names, NV, NULL,
+                                     NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, &out), FE_OK);
+    ck_assert_double_eq(out, 3.0);                      /* an even number of signs */
+    /* The stack: 1+(1+(...(1))) holds one value per level. */
+    fails_at(repeat(t, sizeof t, "1+(", 16, "1", ")"), FE_ESIZE, 49, "too deep for the machine");
+    ck_assert_int_eq(fe_expr_compile(&e, repeat(t, sizeof t, "1+(", 15, "1", ")"), names, NV,
+                                     NULL, NULL, 0), FE_OK);
+    ck_assert_uint_eq(e.depth, FE_EXPR_MAX_STACK);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, &out), FE_OK);
+    ck_assert_double_eq(out, 16.0);
+    /* The length: -1 is two instructions and each +1 two more. */
+    ck_assert_int_eq(fe_expr_compile(&e, repeat(t, sizeof t, "", 0, "-1", ""), names, NV, NULL,
+                                     NULL, 0), FE_OK);
+    ck_assert_uint_eq(e.ncode, 2);
+    for (int i = 0; i < 63; i++)
+        strcat(t, "+1");
+    ck_assert_int_eq(fe_expr_compile(&e, t, names, NV, NULL, NULL, 0), FE_OK);
+    ck_assert_uint_eq(e.ncode, FE_EXPR_MAX_CODE);
+    ck_assert_int_eq(fe_expr_eval(&e, NULL, &out), FE_OK);
+    ck_assert_double_eq(out, 62.0);
+    memmove(t + 1, t, strlen(t) + 1);                   /* --1+1...: 129 instructions */
+    t[0] = '-';
+    fails_at(t, FE_ESIZE, 128, "too long");            /* the last +, the 129th */
+}
+END_TEST
+
+/* Issue 20: the panel evaluation's row stride at its edge: a program that
+   reads variable 3 needs ldv >= 4; 4 is taken, 3 refused (out untouched). */
+START_TEST(a_row_stride_equal_to_the_variables_read_is_enough)
+{
+    fe_expr e;
+    double rows[2 * 4] = {0, 0, 0, 5, 0, 0, 0, 7}, out[2] = {-1, -1}, work[FE_EXPR_MAX_STACK * 2];
+    ck_assert_int_eq(fe_expr_compile(&e, "2*`T (C)`", names, NV, NULL, NULL, 0), FE_OK);
+    ck_assert_uint_eq(e.nvars, 4);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 3, 2, out, work, NULL), FE_EINVAL);
+    ck_assert_double_eq(out[0], -1.0);
+    ck_assert_double_eq(out[1], -1.0);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 4, 2, out, work, NULL), FE_OK);
+    ck_assert_double_eq(out[0], 10.0);
+    ck_assert_double_eq(out[1], 14.0);
+}
+END_TEST
+
 Suite *fe_expr_suite(void)
 {
     Suite *s = suite_create("expr");
@@ -264,6 +343,8 @@ Suite *fe_expr_suite(void)
     tcase_add_test(t, a_program_not_made_by_the_compiler_is_refused);
     tcase_add_test(t, a_panel_equals_its_rows);
     tcase_add_test(t, what_a_program_reads);
+    tcase_add_test(t, each_limit_of_the_compiler_is_met_at_its_edge);
+    tcase_add_test(t, a_row_stride_equal_to_the_variables_read_is_enough);
     suite_add_tcase(s, t);
     return s;
 }

@@ -278,9 +278,12 @@ START_TEST(product_rejects_bad_layout)
     fe_accumulator mv = fe_meanvar_accumulator(), prod;
     const fe_product_part parts[1] = {{&mv, 4}};
     const fe_product spec = {parts, 1};
-    /* A double at offset 4 does not fit in 8 bytes. */
+    /* A double at offset 4 does not fit in 8 bytes, nor in 11 (the edge,
+       issue 20): it needs 12. */
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 8), FE_EINVAL);
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 11), FE_EINVAL);
     ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 12), FE_OK);
+    ck_assert_uint_eq(prod.obs_size, 12);
     ck_assert_int_eq(fe_product_accumulator(NULL, &spec, 12), FE_EINVAL);
     /* Each argument refused alone: a NULL spec, an observation of no
        bytes, parts missing for a non-zero count. */

@@ -83,7 +83,7 @@ static const struct hostile cases[] = {
     {"too few fields", "t,mx,my,mz\n", "9.99,1,2\n", GOOD_ROWS, 0, 0, 0, 3,
      "IN:102:1: expected 4 fields, found 3"},
     {"very long line", "t,mx,my,mz\n", NULL /* 70000 digits */, GOOD_ROWS, 0, 0, 0, 3,
-     "IN:102:1: line longer than 65535 bytes"},
+     "IN:102:1: line longer than 65534 bytes"},
     {"duplicate column", "t,mx,my,mz,mz\n", "", GOOD_ROWS, 0, 1, 1, 2,
      "IN: columns 4 and 5 are both named 'mz'"},
     {"missing column", "t,ax,ay,az\n", "", GOOD_ROWS, 0, 0, 1, 2, "IN: no column 'm"},

@@ -1473,6 +1473,216 @@ START_TEST(fast_update_refuses_a_singular_z_whose_whitened_row_is_infinite)
 }
 END_TEST
 
+/* Issue 20: FE_KALMAN_MAX_DIM and the buffer length at their edges.  A
+   state of FE_KALMAN_MAX_DIM is laid out over exactly fe_kalman_doubles
+   (its x and P zeroed), one double less is FE_ESIZE, one dimension more
+   sizes to 0 and is FE_ESIZE whatever the length; the same for bmax
+   (a buffer never touched past x and P) and for the information form. */
+START_TEST(the_largest_dimension_is_taken_and_one_more_refused)
+{
+    const size_t M = FE_KALMAN_MAX_DIM;
+    size_t need = fe_kalman_doubles(M, 1), needb = fe_kalman_doubles(1, M);
+    double *mem;
+    fe_kalman k;
+    fe_kalman_info s;
+    ck_assert_uint_gt(need, M * M);
+    ck_assert_uint_gt(needb, M * M);                /* D is bmax x bmax */
+    ck_assert_uint_eq(fe_kalman_doubles(M + 1, 1), 0);
+    ck_assert_uint_eq(fe_kalman_doubles(1, M + 1), 0);
+    ck_assert_uint_gt(fe_kalman_info_doubles(M, 1), M * M);
+    mem = malloc((need > needb ? need : needb) * sizeof *mem);
+    ck_assert_ptr_nonnull(mem);
+    mem[0] = mem[M + M * M - 1] = 7.0;
+    ck_assert_int_eq(fe_kalman_init(&k, M, 1, mem, need - 1), FE_ESIZE);
+    ck_assert_double_eq(mem[0], 7.0);
+    ck_assert_int_eq(fe_kalman_init(&k, M, 1, mem, need), FE_OK);
+    ck_assert_uint_eq(k.n, M);
+    ck_assert_double_eq(mem[0], 0.0);
+    ck_assert_double_eq(mem[M + M * M - 1], 0.0);   /* the last of P */
+    ck_assert_int_eq(fe_kalman_init(&k, M + 1, 1, mem, need), FE_ESIZE);
+    ck_assert_int_eq(fe_kalman_init(&k, 1, M, mem, needb - 1), FE_ESIZE);
+    ck_assert_int_eq(fe_kalman_init(&k, 1, M, mem, needb), FE_OK);
+    ck_assert_uint_eq(k.bmax, M);
+    ck_assert_int_eq(fe_kalman_init(&k, 1, M + 1, mem, needb), FE_ESIZE);
+    ck_assert_int_eq(fe_kalman_info_init(&s, 1, M, mem, fe_kalman_info_doubles(1, M) - 1),
+                     FE_ESIZE);
+    ck_assert_int_eq(fe_kalman_info_init(&s, 1, M, mem, fe_kalman_info_doubles(1, M)), FE_OK);
+    ck_assert_int_eq(fe_kalman_info_init(&s, 1, M + 1, mem, needb), FE_ESIZE);
+    free(mem);
+}
+END_TEST
+
+/* Issue 20: the packet size at bmax is folded and bmax + 1 refused with
+   FE_ESIZE, the filter unchanged to the byte, by every update and
+   tracker step, for a small state (fixed kernels) and one above them. */
+START_TEST(a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step)
+{
+    typedef int upd_fn(fe_kalman *, const fe_kalman_obs *, fe_kalman_report *);
+    typedef int track_fn(fe_kalman *, const fe_kalman_track_obs *, fe_kalman_report *);
+    upd_fn *const upd[3] = {fe_kalman_update, fe_kalman_update_fast, fe_kalman_update_joseph};
+    track_fn *const trk[3] = {fe_kalman_track, fe_kalman_track_fast, fe_kalman_track_joseph};
+    const size_t ns[2] = {2, 9};
+    double A[3 * 9] = {0}, z[3] = {1, 2, 3}, Z[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double Z2[4] = {1, 0, 0, 1};
+    for (int in = 0; in < 2; in++) {
+        size_t n = ns[in];
+        for (size_t i = 0; i < 3; i++)
+            A[i * n + i % n] = 1.0;
+        for (int v = 0; v < 6; v++) {
+            kf f;
+            fe_kalman desc;
+            double *snap;
+            fe_kalman_obs o = {3, A, z, Z};
+            fe_kalman_track_obs to = {{NULL, NULL, NULL, 0, NULL}, o};
+            kf_make(&f, n, 2);
+            snap = malloc((n + n * n) * sizeof *snap);
+            ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 1.0), FE_OK);
+            memcpy(snap, f.mem, (n + n * n) * sizeof *snap);
+            desc = f.k;
+            ck_assert_int_eq(v < 3 ? upd[v](&f.k, &o, NULL) : trk[v - 3](&f.k, &to, NULL),
+                             FE_ESIZE);
+            ASSERT_UNCHANGED(f, snap, desc);
+            o.b = to.obs.b = 2;                     /* at bmax */
+            o.Z = to.obs.Z = Z2;
+            ck_assert_int_eq(v < 3 ? upd[v](&f.k, &o, NULL) : trk[v - 3](&f.k, &to, NULL),
+                             FE_OK);
+            ck_assert_uint_eq(f.k.count, 1);
+            /* x0 = 0, P = I, z_i = x_i + v, v ~ N(0, 1): x_i = z_i / 2. */
+            ck_assert_double_eq_tol(f.k.x[0], 0.5, 1e-15);
+            ck_assert_double_eq_tol(f.k.x[1], 1.0, 1e-15);
+            ck_assert_double_eq_tol(f.k.P[0], 0.5, 1e-15);
+            free(snap);
+            kf_free(&f);
+        }
+        {
+            kinfo s;
+            double *copy;
+            size_t len = fe_kalman_info_doubles(n, 2);
+            fe_kalman_obs o = {3, A, z, Z};
+            kinfo_make(&s, n, 2);
+            copy = malloc(len * sizeof *copy);
+            memcpy(copy, s.mem, len * sizeof *copy);
+            ck_assert_int_eq(fe_kalman_info_update(&s.s, &o), FE_ESIZE);
+            ck_assert_mem_eq(s.mem, copy, (n + n * n) * sizeof *copy);
+            ck_assert_uint_eq(s.s.count, 0);
+            o.b = 2;
+            o.Z = Z2;
+            ck_assert_int_eq(fe_kalman_info_update(&s.s, &o), FE_OK);
+            ck_assert_double_eq(s.s.eta[1], 2.0);
+            free(copy);
+            free(s.mem);
+        }
+        memset(A, 0, sizeof A);
+    }
+}
+END_TEST
+
+/* Issue 20: the priors' variances at their edges: p0 = 0 is a covariance
+   prior and the smallest negative double is FE_ENOTPD with the filter
+   unchanged; the information prior needs p0 > 0, so 0 is refused and the
+   smallest variance whose inverse is a double is taken. */
+START_TEST(prior_variances_are_refused_just_below_their_edges)
+{
+    kf f;
+    kinfo s;
+    fe_kalman desc;
+    double snap[2 + 4];
+    kf_make(&f, 2, 1);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 3.0), FE_OK);
+    memcpy(snap, f.mem, sizeof snap);
+    desc = f.k;
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, -DBL_TRUE_MIN), FE_ENOTPD);
+    ASSERT_UNCHANGED(f, snap, desc);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, NULL, 0.0), FE_OK);
+    ck_assert_double_eq(f.k.P[0], 0.0);
+    ck_assert_double_eq(f.k.P[3], 0.0);
+    kf_free(&f);
+    kinfo_make(&s, 2, 1);
+    ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, NULL, 0.0), FE_ENOTPD);
+    ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, NULL, -DBL_TRUE_MIN), FE_ENOTPD);
+    ck_assert_double_eq(s.s.Lambda[0], 0.0);
+    /* 1/p0 must be a double: the variance below the smallest whose
+       inverse is one, and one whose x0/p0 overflows, are refused with the
+       accumulation unchanged (they were once taken, as infinities). */
+    {
+        double pmin = nextafter(1.0 / DBL_MAX, 1.0), x0[2] = {1.0, 0.0}, big[2] = {0.0, 1e300};
+        while (!isfinite(1.0 / pmin))
+            pmin = nextafter(pmin, 1.0);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, x0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, NULL, nextafter(pmin, 0.0)),
+                         FE_ENONFINITE);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, big, 1e-10), FE_ENONFINITE);
+        ck_assert_double_eq(s.s.Lambda[0], 1.0);
+        ck_assert_double_eq(s.s.eta[0], 1.0);
+        ck_assert_double_eq(s.s.eta[1], 0.0);
+        ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, x0, pmin), FE_OK);
+        ck_assert(isfinite(s.s.Lambda[0]) && s.s.Lambda[0] > 1e307);
+        ck_assert_double_eq(s.s.Lambda[3], s.s.Lambda[0]);
+        ck_assert_double_eq(s.s.eta[0], s.s.Lambda[0]);
+    }
+    ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, NULL, INFINITY), FE_OK);
+    ck_assert_double_eq(s.s.Lambda[0], 0.0);       /* zero information */
+    free(s.mem);
+}
+END_TEST
+
+/* Issue 20: the monitor's parameters, band and reports at their edges:
+   each open bound refused at its value and taken one double inside. */
+START_TEST(monitor_ranges_are_refused_at_their_bounds_and_taken_just_inside)
+{
+    const fe_kalman_monitor_params d = fe_kalman_monitor_default_params();
+    fe_kalman_monitor_params p;
+    fe_kalman_monitor m, before;
+    fe_kalman_report r = {1, 1.0, 0.0, NULL, NULL, NULL};
+    double lo = -1, hi = -1;
+    struct { int field; double bad, good; } cases[] = {
+        {0, 1.0, 0}, {1, 1.0, 0}, {1, 0.0, DBL_TRUE_MIN}, {2, 0.0, DBL_TRUE_MIN},
+    };
+    cases[0].good = nextafter(1.0, 2.0);            /* scale_up > 1 */
+    cases[1].good = nextafter(1.0, 0.0);            /* 0 < scale_down < 1 */
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        double *field[3] = {&p.scale_up, &p.scale_down, &p.threshold};
+        p = d;
+        *field[cases[i].field] = cases[i].bad;
+        ck_assert_msg(fe_kalman_monitor_init(&m, &p) == FE_EINVAL, "case %zu", i);
+        *field[cases[i].field] = cases[i].good;
+        ck_assert_msg(fe_kalman_monitor_init(&m, &p) == FE_OK, "case %zu", i);
+    }
+    p = d;
+    p.lags = FE_KALMAN_MONITOR_LAGS + 1;
+    ck_assert_int_eq(fe_kalman_monitor_init(&m, &p), FE_EINVAL);
+    p.lags = 0;
+    ck_assert_int_eq(fe_kalman_monitor_init(&m, &p), FE_OK);
+    p.lags = FE_KALMAN_MONITOR_LAGS;
+    ck_assert_int_eq(fe_kalman_monitor_init(&m, &p), FE_OK);
+    /* A report: NIS 0 is folded, the smallest negative one is not. */
+    ck_assert_int_eq(fe_kalman_monitor_add(&m, &r), FE_OK);
+    before = m;
+    r.nis = -DBL_TRUE_MIN;
+    ck_assert_int_eq(fe_kalman_monitor_add(&m, &r), FE_EINVAL);
+    ck_assert_mem_eq(&m, &before, sizeof m);
+    r.nis = 0.0;
+    ck_assert_int_eq(fe_kalman_monitor_add(&m, &r), FE_OK);
+    ck_assert_uint_eq(m.steps, 2);
+    /* The band: prob in (0, 1). */
+    ck_assert_int_eq(fe_kalman_monitor_nis_band(&m, 0.0, &lo, &hi), FE_EINVAL);
+    ck_assert_int_eq(fe_kalman_monitor_nis_band(&m, 1.0, &lo, &hi), FE_EINVAL);
+    ck_assert_double_eq(lo, -1.0);
+    ck_assert_int_eq(fe_kalman_monitor_nis_band(&m, DBL_TRUE_MIN, &lo, &hi), FE_OK);
+    ck_assert(isfinite(lo) && isfinite(hi) && lo <= hi);
+    FE_ASSERT_REL(lo, hi, 1e-12);                   /* the median, both sides */
+    /* The largest double below 1 is refused: (1 + prob)/2 rounds to 1
+       (it was taken, with hi NaN); the next one down is taken. */
+    lo = hi = -1.0;
+    ck_assert_int_eq(fe_kalman_monitor_nis_band(&m, nextafter(1.0, 0.0), &lo, &hi), FE_EINVAL);
+    ck_assert_double_eq(hi, -1.0);
+    ck_assert_int_eq(fe_kalman_monitor_nis_band(&m, nextafter(nextafter(1.0, 0.0), 0.0), &lo,
+                                                &hi), FE_OK);
+    ck_assert(isfinite(lo) && isfinite(hi) && 0.0 <= lo && lo < hi);
+    ck_assert_double_gt(hi, 30.0);                  /* chi2_2 / 2 beyond 1 - 2^-53 */
+}
+END_TEST
+
 Suite *fe_kalman_suite(void)
 {
     Suite *s = suite_create("kalman");
@@ -1502,6 +1712,10 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, wrong_dynamics_show_in_autocorrelation);
     tcase_add_test(t, monitor_scans_and_refuses);
     tcase_add_test(t, chi_square_quantiles);
+    tcase_add_test(t, the_largest_dimension_is_taken_and_one_more_refused);
+    tcase_add_test(t, a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step);
+    tcase_add_test(t, prior_variances_are_refused_just_below_their_edges);
+    tcase_add_test(t, monitor_ranges_are_refused_at_their_bounds_and_taken_just_inside);
     suite_add_tcase(s, t);
     return s;
 }

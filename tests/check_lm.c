@@ -1161,6 +1161,107 @@ START_TEST(emit_and_sessions_refusals_at_their_edges)
 }
 END_TEST
 
+/* f = x - 3, one residual, one global. */
+static int minus_three(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double j[1] = {1.0};
+    (void)ctx;
+    return fe_lm_emit(s, x[0] - 3.0, 1.0, j, FE_SCHUR_NONE, NULL);
+}
+
+/* Issue 20: the parameters at their edges (lm.h): max_iter 0 makes no
+   iteration (FE_ENOCONV, x as given) and -1 is refused; lambda_min equal
+   to lambda0 is taken and the next double above refused; each tolerance
+   0 is taken and -DBL_TRUE_MIN refused; lambda0 the smallest positive
+   double is taken and 0 refused. */
+START_TEST(parameters_at_their_edges)
+{
+    fe_lm_problem p = {1, 0, 0, minus_three, NULL};
+    fe_lm_params par;
+    fe_lm_result r;
+    double x[1], *w = lm_work(&p, FE_LM_DENSE);
+    double *const tol[4] = {&par.xtol, &par.gtol, &par.ftol, &par.rtol};
+    par = fe_lm_default_params();
+    par.max_iter = -1;
+    x[0] = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+    par.max_iter = 0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_ENOCONV);
+    ck_assert_int_eq(r.stop, FE_LM_MAXITER);
+    ck_assert_int_eq(r.iterations, 0);
+    ck_assert_double_eq(x[0], 0.0);
+    ck_assert_double_eq(r.cost, 4.5);
+    par.max_iter = 1;                               /* one step: 3 (1 - 1e-3 / 1.001...) */
+    ck_assert_int_ne(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+    ck_assert_int_eq(r.iterations, 1);
+    ck_assert_double_eq_tol(x[0], 3.0, 1e-2);
+    par = fe_lm_default_params();
+    par.lambda_min = nextafter(par.lambda0, 1.0);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+    par.lambda_min = par.lambda0;
+    x[0] = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_double_eq_tol(x[0], 3.0, 1e-12);
+    for (int k = 0; k < 4; k++) {
+        par = fe_lm_default_params();
+        *tol[k] = -DBL_TRUE_MIN;
+        ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+        *tol[k] = 0.0;
+        x[0] = 0.0;
+        ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+        ck_assert_double_eq_tol(x[0], 3.0, 1e-9);
+    }
+    par = fe_lm_default_params();
+    par.lambda_min = 0.0;
+    par.lambda0 = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_EINVAL);
+    par.lambda0 = DBL_TRUE_MIN;
+    x[0] = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_double_eq_tol(x[0], 3.0, 1e-12);
+    free(w);
+}
+END_TEST
+
+/* Issue 20: the session count at its edges from inside: one session and
+   FE_SESSIONS_MAX sessions (their readings on spheres of radius 1 about
+   offsets of their own, through one S = I) are fitted; 0 and one more
+   are refused (emit_and_sessions_refusals_at_their_edges). */
+START_TEST(one_and_the_most_sessions_are_fitted)
+{
+    enum { R = 20 };
+    static double m[FE_SESSIONS_MAX][3 * R];
+    fe_sessions c;
+    fe_rng g = fe_rng_seed(64);
+    memset(&c, 0, sizeof c);
+    for (size_t s = 0; s < FE_SESSIONS_MAX; s++) {
+        for (size_t i = 0; i < R; i++) {
+            double u[3];
+            fe_rng_unit_vector(&g, u);
+            for (int j = 0; j < 3; j++)
+                m[s][3 * i + j] = (double)(s % 4) + (double)j * (double)s / 16.0 + u[j];
+        }
+        c.m[s] = m[s];
+        c.n[s] = R;
+    }
+    for (size_t count = 1; count <= FE_SESSIONS_MAX; count += FE_SESSIONS_MAX - 1) {
+        double *x = malloc(fe_sessions_params(&(fe_sessions){count, {0}, {0}, 0}) * sizeof *x);
+        fe_lm_result res;
+        double S[3][3];
+        c.count = count;
+        ck_assert_int_eq(magcal_fit(&c, x, &res), FE_OK);
+        fe_sessions_matrix(x, S);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                ck_assert_double_eq_tol(fabs(S[i][j]), i == j ? 1.0 : 0.0, 1e-6);
+        for (size_t s = 0; s < count; s++)
+            ck_assert_double_eq_tol(x[6 + 3 * s + 2], (double)(s % 4) + 2.0 * (double)s / 16.0,
+                                    1e-6);
+        free(x);
+    }
+}
+END_TEST
+
 Suite *fe_lm_suite(void)
 {
     Suite *s = suite_create("lm");
@@ -1183,6 +1284,8 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     tcase_add_test(t, emit_and_sessions_refusals_at_their_edges);
+    tcase_add_test(t, parameters_at_their_edges);
+    tcase_add_test(t, one_and_the_most_sessions_are_fitted);
     suite_add_tcase(s, t);
     return s;
 }

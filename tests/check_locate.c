@@ -1110,6 +1110,63 @@ START_TEST(a_region_of_two_rows_is_tested_of_one_is_not)
 }
 END_TEST
 
+/* Issue 20: the innovation fold's shape and reports, and both locates'
+   levels, at their edges: FE_DISCOVER_MAX_BLOCKS blocks, 2 reports a
+   block and the last report as row0 are taken; a NIS of 0 is folded and
+   -DBL_TRUE_MIN refused unchanged; alpha one double inside (0, 1) and
+   worth 1 and DBL_TRUE_MIN are taken, worth one double above 1 refused. */
+START_TEST(shapes_reports_and_levels_at_their_edges)
+{
+    fe_innovations inn, before;
+    fe_residual_map m;
+    fe_located out[8];
+    fe_sample s = {0};
+    double w = 1.0;
+    const double lo[3] = {0, -1, 0}, hi[3] = {1, 1, 1};
+    fe_kalman_report r = {1, 0.0, 0, NULL, &w, NULL};
+    size_t n = 99;
+    ck_assert_int_eq(fe_innovations_init(&inn, FE_DISCOVER_MAX_BLOCKS,
+                                         2 * FE_DISCOVER_MAX_BLOCKS - 1, 0), FE_ETOOFEW);
+    ck_assert_int_eq(fe_innovations_init(&inn, FE_DISCOVER_MAX_BLOCKS,
+                                         2 * FE_DISCOVER_MAX_BLOCKS, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&inn, 2, 4, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 20, 0), FE_OK);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 20, 20), FE_ESIZE);
+    ck_assert_int_eq(fe_innovations_init(&inn, 10, 20, 19), FE_OK);   /* the last report */
+    ck_assert_int_eq(fe_innovations_add(&inn, 0.0, &r), FE_OK);      /* NIS 0 */
+    ck_assert_uint_eq(inn.n, 1);
+    ck_assert_int_eq(fe_innovations_add(&inn, 1.0, &r), FE_ESIZE);   /* past the total */
+    ck_assert_int_eq(fe_innovations_init(&inn, 2, 40, 0), FE_OK);
+    for (int i = 0; i < 40; i++) {
+        r.nis = i == 5 ? 40.0 : 1.0;
+        ck_assert_int_eq(fe_innovations_add(&inn, (double)i, &r), FE_OK);
+        if (i == 0) {
+            before = inn;
+            r.nis = -DBL_TRUE_MIN;
+            ck_assert_int_eq(fe_innovations_add(&inn, 0.5, &r), FE_EINVAL);
+            ck_assert_mem_eq(&inn, &before, sizeof inn);
+        }
+    }
+    ck_assert_int_eq(fe_innovations_locate(&inn, DBL_TRUE_MIN, out, 8, &n), FE_OK);
+    ck_assert_uint_eq(n, 0);                        /* nothing at so strict a level */
+    ck_assert_int_eq(fe_innovations_locate(&inn, nextafter(1.0, 0.0), out, 8, &n), FE_OK);
+    ck_assert_uint_ge(n, 1);                        /* the block with NIS 40 */
+    ck_assert_int_eq(fe_residual_map_init(&m, 2, 4, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+    for (int i = 0; i < 4; i++) {
+        s.t = i;
+        s.velocity = i % 2 ? 0.5 : -0.5;
+        ck_assert_int_eq(fe_residual_map_add(&m, &s, i % 2 ? 1.0 : -1.0, 0.0), FE_OK);
+    }
+    ck_assert_int_eq(fe_residual_map_locate(&m, nextafter(1.0, 2.0), 0.05, out, 8, &n),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, 0.05, out, 8, &n), FE_OK);
+    ck_assert_int_eq(fe_residual_map_locate(&m, DBL_TRUE_MIN, 0.05, out, 8, &n), FE_OK);
+    ck_assert_uint_eq(n, 0);                        /* rows worth nothing locate nothing */
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, DBL_TRUE_MIN, out, 8, &n), FE_OK);
+    ck_assert_int_eq(fe_residual_map_locate(&m, 1.0, nextafter(1.0, 0.0), out, 8, &n), FE_OK);
+}
+END_TEST
+
 Suite *fe_locate_suite(void)
 {
     Suite *s = suite_create("locate");
@@ -1134,6 +1191,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, verdict_and_row_worth);
     tcase_add_test(t, located_regions_in_json_and_words);
     tcase_add_test(t, a_region_of_two_rows_is_tested_of_one_is_not);
+    tcase_add_test(t, shapes_reports_and_levels_at_their_edges);
     suite_add_tcase(s, t);
     return s;
 }

@@ -667,6 +667,98 @@ START_TEST(merge_overflow_at_its_edge)
 }
 END_TEST
 
+/* Issue 20: the step's weight, the column indices, the covariance's row
+   count and the rank test at their edges.  A weight of 0 is a row that
+   counts in n and adds nothing; -DBL_TRUE_MIN is refused, unchanged.
+   Column p - 1 is a column and p is not, in every list; q = p columns
+   solve, p + 1 do not.  The covariance needs n > q: n = q is FE_ETOOFEW,
+   n = q + 1 gives rss / (n - q) A^{-1}. */
+START_TEST(weights_indices_and_counts_at_their_edges)
+{
+    enum { Q = 3, DQ = Q + 1 };
+    double g[DQ * DQ], gb[DQ * DQ], x[Q + 1], rss, cov[Q * Q], work[64], score[1];
+    const double j[Q] = {1, 2, 3}, val[1] = {2.0};
+    const size_t last[1] = {Q - 1}, past[1] = {Q}, all[Q + 1] = {0, 1, 2, 3};
+    fe_lsq a, before;
+    ck_assert_int_eq(fe_lsq_init(&a, Q, g), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 1.0), FE_OK);
+    before = a;
+    memcpy(gb, g, sizeof g);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, -DBL_TRUE_MIN), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, -DBL_TRUE_MIN), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, past, val, 1, 1.0, 1.0), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(g, gb, sizeof g);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 0.0), FE_OK);
+    ck_assert_uint_eq(a.n, 2);
+    ck_assert_double_eq(a.wsum, 1.0);
+    ck_assert_mem_eq(g, gb, sizeof g);              /* nothing added */
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 1.0), FE_OK);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q - 1), 9.0 + 4.0);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q), 3.0 + 2.0);
+    ck_assert_int_eq(fe_lsq_solve(&a, past, 1, x, &rss, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_solve(&a, all, Q + 1, x, &rss, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_solve(&a, NULL, Q + 1, x, &rss, NULL, work), FE_EINVAL);
+    /* Rows (1 2 3 | 1) and (0 0 2 | 1) alone (n = 2): column 2 fits with
+       x = 5/13, rss = 2 - 25/13 = 1/13, variance rss / (2 - 1) / 13;
+       columns 0 and 2 (q = n = 2) fit exactly, without a covariance
+       until a third row comes. */
+    ck_assert_int_eq(fe_lsq_reset(&a), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_lsq_solve(&a, last, 1, x, &rss, cov, work), FE_OK);
+    ck_assert_double_eq_tol(x[0], 5.0 / 13.0, 1e-15);
+    ck_assert_double_eq_tol(rss, 1.0 / 13.0, 1e-15);
+    ck_assert_double_eq_tol(cov[0], 1.0 / 169.0, 1e-16);
+    {
+        const size_t two[2] = {0, 2};
+        double c2[4] = {-1, -1, -1, -1};
+        ck_assert_int_eq(fe_lsq_solve(&a, two, 2, x, &rss, c2, work), FE_ETOOFEW);
+        ck_assert_double_eq(c2[0], -1.0);
+        ck_assert_int_eq(fe_lsq_solve(&a, two, 2, x, &rss, NULL, work), FE_OK);
+        ck_assert_double_eq_tol(rss, 0.0, 1e-14);
+        ck_assert_int_eq(fe_lsq_add(&a, j, 0.0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_lsq_solve(&a, two, 2, x, &rss, c2, work), FE_OK);
+        ck_assert(isfinite(c2[0]) && c2[0] > 0.0);
+    }
+    ck_assert_int_eq(fe_lsq_scores(&a, past, 1, last, 1, score, NULL, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, last, 1, past, 1, score, NULL, NULL, work), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_scores(&a, NULL, 0, last, 1, score, NULL, NULL, work), FE_OK);
+    ck_assert_double_gt(score[0], 0.0);
+}
+END_TEST
+
+/* Issue 20: FE_LSQ_RANK_TOL at its edge.  Rows (1 1 | 1) and (0 d | 1):
+   column 1's part unexplained by column 0 is d^2 / (1 + d^2) of its norm,
+   so d^2 = 1.5e-12 passes the rank test and d^2 = 0.5e-12 does not, in
+   the solve, as a base of the scores, and as a candidate (which then
+   scores 0, and 1 = c^2 / s with c = d, s = d^2 above the edge). */
+START_TEST(rank_test_at_its_edge)
+{
+    for (int c = 0; c < 2; c++) {
+        double d2 = c == 0 ? 1.5e-12 : 0.5e-12, d = sqrt(d2), g[9], x[2], rss, work[64];
+        double score[1] = {-1};
+        const double r0[2] = {1.0, 1.0}, r1[2] = {0.0, d};
+        const size_t zero[1] = {0}, one[1] = {1}, both[2] = {0, 1};
+        fe_lsq a;
+        ck_assert_int_eq(fe_lsq_init(&a, 2, g), FE_OK);
+        ck_assert_int_eq(fe_lsq_add(&a, r0, 1.0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_lsq_add(&a, r1, 1.0, 1.0), FE_OK);
+        ck_assert_int_eq(fe_lsq_solve(&a, NULL, 2, x, &rss, NULL, work),
+                         c == 0 ? FE_OK : FE_ESINGULAR);
+        ck_assert_int_eq(fe_lsq_scores(&a, both, 2, NULL, 0, NULL, NULL, &rss, work),
+                         c == 0 ? FE_OK : FE_ESINGULAR);
+        ck_assert_int_eq(fe_lsq_scores(&a, zero, 1, one, 1, score, NULL, NULL, work), FE_OK);
+        if (c == 0) {
+            ck_assert_double_eq_tol(x[1], 1.0 / d, 1e-3 / d);
+            ck_assert_double_eq_tol(score[0], 1.0, 1e-3);
+        } else {
+            ck_assert_double_eq(score[0], 0.0);
+        }
+    }
+}
+END_TEST
+
 Suite *fe_lsq_suite(void)
 {
     Suite *s = suite_create("lsq");
@@ -688,6 +780,8 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, sparse_rows_equal_dense_rows);
     tcase_add_test(t, blocked_rows_stop_exactly_at_the_bad_row);
     tcase_add_test(t, merge_overflow_at_its_edge);
+    tcase_add_test(t, weights_indices_and_counts_at_their_edges);
+    tcase_add_test(t, rank_test_at_its_edge);
     suite_add_tcase(s, t);
     return s;
 }

@@ -720,6 +720,44 @@ START_TEST(collinear_parameters_are_singular)
 }
 END_TEST
 
+/* Issue 20: the columns of a model accumulation at their edge: p
+   parameters and a catalog of FE_DISCOVER_MAX_COLUMNS - p terms are
+   taken, one term more is refused (fe_model_acc_doubles 0, init
+   FE_EINVAL), for p = 1 and p = FE_MODEL_MAX_PARAMS. */
+START_TEST(parameters_and_terms_fill_the_columns_exactly)
+{
+    static char names[FE_DISCOVER_MAX_GROUPS][24];
+    const size_t ps[2] = {1, FE_MODEL_MAX_PARAMS};
+    double th[FE_MODEL_MAX_PARAMS] = {1.0};
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_expr e;
+    ck_assert_int_eq(fe_expr_compile(&e, "t", fe_catalog_var_names(NULL), FE_CATALOG_VARS, NULL,
+                                     NULL, 0), FE_OK);
+    for (int k = 0; k < 2; k++) {
+        size_t p = ps[k], terms = FE_DISCOVER_MAX_COLUMNS - p, n;
+        fe_catalog c;
+        fe_model m = {p, th, NULL, rig_predict, NULL, 0, NULL, NULL};
+        fe_model_acc *a = malloc(sizeof *a);
+        double *st;
+        ck_assert_int_eq(fe_catalog_init(&c, 0, &scale), FE_OK);
+        for (size_t i = 0; c.count < terms; i++) {
+            snprintf(names[i], sizeof names[i], "u%zu", i);
+            ck_assert_int_eq(fe_catalog_add_expr(&c, names[i], NULL, &e), FE_OK);
+        }
+        ck_assert_uint_eq(fe_model_acc_doubles(p, terms + 1, 4), 0);
+        n = fe_model_acc_doubles(p, terms, 4);
+        ck_assert_uint_gt(n, 0);
+        st = malloc(n * sizeof *st);
+        ck_assert_int_eq(fe_model_acc_init(a, &m, &c, 4, 100, st, n), FE_OK);
+        ck_assert_uint_eq(a->ngroups, FE_DISCOVER_MAX_COLUMNS);
+        ck_assert_int_eq(fe_catalog_add_expr(&c, "one_more", NULL, &e), FE_OK);
+        ck_assert_int_eq(fe_model_acc_init(a, &m, &c, 4, 100, st, n), FE_EINVAL);
+        free(st);
+        free(a);
+    }
+}
+END_TEST
+
 Suite *fe_model_suite(void)
 {
     Suite *s = suite_create("model");
@@ -735,6 +773,7 @@ Suite *fe_model_suite(void)
     tcase_add_test(t, concealed_effects_are_found_through_the_model);
     tcase_add_test(t, a_right_model_discovers_nothing);
     tcase_add_test(t, collinear_parameters_are_singular);
+    tcase_add_test(t, parameters_and_terms_fill_the_columns_exactly);
     suite_add_tcase(s, t);
     return s;
 }

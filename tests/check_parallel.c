@@ -1420,6 +1420,64 @@ START_TEST(a_source_error_is_a_refusal)
 }
 END_TEST
 
+/* Issue 20: FE_PARALLEL_MAX_THREADS threads, sources and workers are
+   taken (one more is refused, bad_arguments_fold_nothing) and fold as
+   fe_fold does; a ring of 1 slot and of FE_PARALLEL_MAX_SLOTS too (0 and
+   one more refused, pipeline_bad_arguments_read_nothing). */
+START_TEST(the_most_threads_sources_workers_and_slots_fold)
+{
+    enum { T = FE_PARALLEL_MAX_THREADS, N = 3 * T + 5 };
+    static double x[N];
+    static fe_meanvar parts[T];
+    static void *pp[T];
+    static fe_source srcs[T], *sp[T];
+    static fe_array_source as[T];
+    static fe_parallel_slot ring[FE_PARALLEL_MAX_SLOTS];
+    static slot accs[FE_PARALLEL_MAX_SLOTS];
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_meanvar a, want = FE_MEANVAR_EMPTY;
+    fe_source src;
+    fe_array_source st;
+    size_t done = 0;
+    for (size_t i = 0; i < N; i++)
+        x[i] = (double)(i * i % 17);
+    ck_assert_int_eq(fe_fold(&f, &want, x, N, NULL), FE_OK);
+    for (int t = 0; t < T; t++) {
+        pp[t] = &parts[t];
+        ck_assert_int_eq(fe_init(&f, &parts[t]), FE_OK);
+    }
+    a = (fe_meanvar)FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_parallel_fold(&f, &a, x, N, T, pp, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    ck_assert_uint_eq(a.n, N);
+    FE_ASSERT_REL(a.mean, want.mean, 1e-14);
+    FE_ASSERT_REL(a.m2, want.m2, 1e-12);
+    for (int t = 0; t < T; t++) {               /* source t: a chunk of x */
+        size_t b, e;
+        ck_assert_int_eq(fe_parallel_chunk(N, T, (unsigned)t, &b, &e), FE_OK);
+        ck_assert_int_eq(fe_source_from_array(&srcs[t], &as[t], x + b, e - b, sizeof x[0]), FE_OK);
+        sp[t] = &srcs[t];
+        if (t > 0)
+            ck_assert_int_eq(fe_init(&f, &parts[t - 1]), FE_OK);
+    }
+    a = (fe_meanvar)FE_MEANVAR_EMPTY;
+    ck_assert_int_eq(fe_parallel_fold_sources(&f, &a, sp, T, pp, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    FE_ASSERT_REL(a.m2, want.m2, 1e-12);
+    for (unsigned nslots = 1; nslots <= FE_PARALLEL_MAX_SLOTS; nslots += FE_PARALLEL_MAX_SLOTS - 1)
+        for (unsigned workers = 0; workers <= T; workers += T) {
+            ring_make(ring, accs, nslots, 2, sizeof(double));
+            ck_assert_int_eq(fe_source_from_array(&src, &st, x, N, sizeof x[0]), FE_OK);
+            a = (fe_meanvar)FE_MEANVAR_EMPTY;
+            ck_assert_int_eq(fe_parallel_fold_source(&f, &a, &src, workers, 2, ring, nslots,
+                                                     &done), FE_OK);
+            ck_assert_uint_eq(done, N);
+            FE_ASSERT_REL(a.m2, want.m2, 1e-12);
+            ring_free(ring, nslots);
+        }
+}
+END_TEST
+
 Suite *fe_parallel_suite(void)
 {
     Suite *s = suite_create("parallel");
@@ -1448,6 +1506,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, pipeline_first_refusal_wins);
     tcase_add_test(t, pipeline_source_error_after_earlier_batches);
     tcase_add_test(t, pipeline_bad_arguments_read_nothing);
+    tcase_add_test(t, the_most_threads_sources_workers_and_slots_fold);
     suite_add_tcase(s, t);
     return s;
 }

@@ -672,6 +672,13 @@ START_TEST(f32_bad_samples_leave_it_unchanged)
         before = full;
         ck_assert_int_eq(fe_quadric_f32_add(&full, one), FE_ESIZE);
         ck_assert_mem_eq(&full, &before, sizeof full);
+        /* One sample short of full is taken (issue 20: the edge from
+           inside), and the count is then full. */
+        full = q;
+        full.n = UINT32_MAX - 1;
+        ck_assert_int_eq(fe_quadric_f32_add(&full, one), FE_OK);
+        ck_assert_uint_eq(full.n, UINT32_MAX);
+        ck_assert_int_eq(fe_quadric_f32_add(&full, one), FE_ESIZE);
         ck_assert_int_eq(fe_quadric_f32_add(NULL, one), FE_EINVAL);
         ck_assert_int_eq(fe_quadric_f32_add(&q, NULL), FE_EINVAL);
         ck_assert_int_eq(fe_quadric_f32_recentre(NULL, one), FE_EINVAL);

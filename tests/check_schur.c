@@ -339,12 +339,51 @@ START_TEST(rank_test_at_its_edge)
 }
 END_TEST
 
+/* Issue 20: the row's weight and block index and the damping at their
+   edges: weight 0 and block nb - 1 are taken, -DBL_TRUE_MIN and block nb
+   refused with the accumulation unchanged; lambda 0 solves and
+   -DBL_TRUE_MIN is refused. */
+START_TEST(weights_blocks_and_damping_at_their_edges)
+{
+    double st[64], copy[64], x[3], work[64], rss;
+    const double jg[1] = {1.0}, jl[1] = {1.0};
+    fe_schur a, before;
+    size_t n;
+    ck_assert_int_eq(fe_schur_init(&a, 1, 1, 2, st), FE_OK);
+    n = fe_schur_storage(1, 1, 2);
+    ck_assert_uint_le(n, 64);
+    ck_assert_int_eq(fe_schur_add(&a, jg, FE_SCHUR_NONE, NULL, 2.0, 1.0), FE_OK);
+    before = a;
+    memcpy(copy, st, n * sizeof *st);
+    ck_assert_int_eq(fe_schur_add(&a, jg, 2, jl, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_add(&a, jg, 1, jl, 1.0, -DBL_TRUE_MIN), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, n * sizeof *st);
+    ck_assert_int_eq(fe_schur_add(&a, jg, 1, jl, 5.0, 0.0), FE_OK);
+    ck_assert_uint_eq(a.global.n, 2);
+    ck_assert_mem_eq(st, copy, n * sizeof *st);     /* weight 0 adds nothing */
+    ck_assert_int_eq(fe_schur_add(&a, jg, 0, jl, 3.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_schur_add(&a, NULL, 0, jl, 1.0, 1.0), FE_EINVAL);
+    {   /* x_g = 2 and x_g + x_0 = 3, block 1 free: fix it with a row. */
+        const double z[1] = {0.0};
+        ck_assert_int_eq(fe_schur_add(&a, z, 1, jl, 4.0, 1.0), FE_OK);
+    }
+    ck_assert_int_eq(fe_schur_solve(&a, -DBL_TRUE_MIN, x, &rss, work), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_solve(&a, 0.0, x, &rss, work), FE_OK);
+    ck_assert_double_eq_tol(x[0], 2.0, 1e-14);
+    ck_assert_double_eq_tol(x[1], 1.0, 1e-14);
+    ck_assert_double_eq_tol(x[2], 4.0, 1e-14);
+    ck_assert_double_eq_tol(rss, 0.0, 1e-13);
+}
+END_TEST
+
 Suite *fe_schur_suite(void)
 {
     Suite *s = suite_create("schur");
     TCase *t = tcase_create("arrow");
     tcase_set_timeout(t, 120);
     tcase_add_test(t, merge_refuses_an_overflow_in_any_local_diagonal);
+    tcase_add_test(t, weights_blocks_and_damping_at_their_edges);
     tcase_add_test(t, elimination_equals_dense_and_qr);
     tcase_add_test(t, damped_elimination_equals_damped_dense);
     tcase_add_test(t, merge_every_split_equals_the_whole);

@@ -1692,6 +1692,178 @@ START_TEST(still_and_histogram_refusals_at_their_edges)
 }
 END_TEST
 
+/* Issue 20: the sample count at its edge for each model: p samples are
+   too few (FE_ETOOFEW, FE_SPHERE_TOO_FEW) and p + 1 are not; noiseless
+   ones on the ellipsoid then fit it (the checks of planarity and extent
+   off: p + 1 random points are seldom spread enough for them).  The naive
+   fit's workspace at n (p + 1) doubles is enough and one less is
+   FE_ESIZE, for the same fit. */
+START_TEST(too_few_samples_and_the_naive_workspace_at_their_edges)
+{
+    const double r[3][3] = {{400, 400, 400}, {400, 380, 420}, {400, 380, 420}};
+    for (int model = FE_FIT_SPHERE; model <= FE_FIT_ELLIPSOID; model++) {
+        const int p = model == FE_FIT_SPHERE ? 4 : model == FE_FIT_AXIAL ? 6 : 9;
+        double x[3 * 10], w[10 * 10];
+        fe_sphere_options o = fe_sphere_default_options();
+        fe_sphere_fit f, g;
+        fe_quadric q = FE_QUADRIC_EMPTY;
+        size_t need = fe_sphere_naive_workspace((size_t)p + 1, (fe_sphere_model)model);
+        o.min_planarity = 0.0;
+        o.min_extent = 0.0;
+        fe_test_ellipsoid_points(x, (size_t)p + 1, C0, r[model], 0.0, 40 + (uint64_t)model);
+        ck_assert_int_eq(fe_quadric_add_many(&q, x, (size_t)p, NULL), FE_OK);
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, &o, &f), FE_ETOOFEW);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
+        ck_assert_uint_eq(f.n, (uint64_t)p);
+        ck_assert_int_eq(fe_sphere_fit_stored(x, (size_t)p, (fe_sphere_model)model, &o, &f),
+                         FE_ETOOFEW);
+        ck_assert_int_eq(fe_quadric_add(&q, x + 3 * p), FE_OK);
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, &o, &f), FE_OK);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_ACCEPTED);
+        for (int j = 0; j < 3; j++)
+            ck_assert_double_eq_tol(f.offset[j], C0[j], 1e-6);
+        ck_assert_uint_eq(need, (size_t)(p + 1) * (size_t)(p + 1));
+        ck_assert_uint_le(need, sizeof w / sizeof w[0]);
+        ck_assert_int_eq(fe_sphere_fit_naive(x, (size_t)p + 1, (fe_sphere_model)model, &o, w,
+                                             need - 1, &g), FE_ESIZE);
+        ck_assert_int_eq(fe_sphere_fit_naive(x, (size_t)p + 1, (fe_sphere_model)model, &o, w,
+                                             need, &g), FE_OK);
+        for (int j = 0; j < 3; j++)
+            ck_assert_double_eq_tol(g.offset[j], f.offset[j], 1e-6);
+    }
+}
+END_TEST
+
+/* Issue 20: the options' thresholds at their edges, each set from what
+   the fit reports: a minimum planarity equal to the samples' is met and
+   the next double above is not (FE_SPHERE_PLANAR); the same for the
+   extent (FE_SPHERE_HEMISPHERE, the least of the reported extents);
+   max_iterations equal to the iterations the fit took converges and one
+   fewer is FE_ENOCONV. */
+START_TEST(option_thresholds_at_their_edges)
+{
+    enum { N = 600 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_sphere_options o = fe_sphere_default_options();
+    fe_sphere_fit f, g;
+    double worst = INFINITY;
+    fe_test_ellipsoid_points(x, N, C0, R0, 2.0, 77);
+    for (size_t i = 0; i < N; i++)             /* the cap above 0.3 R left out */
+        if (x[3 * i + 2] < C0[2] + 0.3 * R0[2])
+            ck_assert_int_eq(fe_quadric_add(&q, x + 3 * i), FE_OK);
+    o.min_extent = 0.0;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &f), FE_OK);
+    ck_assert_double_gt(f.planarity, 0.0);
+    ck_assert_int_ge(f.iterations, 2);
+    for (int j = 0; j < 3; j++)
+        worst = fmin(worst, fmin(f.extent_hi[j], -f.extent_lo[j]));
+    ck_assert_double_gt(worst, 0.0);
+    ck_assert_double_lt(worst, 1.0);                /* one-sided in z */
+    o.min_planarity = f.planarity;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_OK);
+    o.min_planarity = nextafter(f.planarity, 1.0);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_EUNDETERMINED);
+    ck_assert_int_eq(g.refusal, FE_SPHERE_PLANAR);
+    ck_assert_double_eq(g.planarity, f.planarity);
+    o = fe_sphere_default_options();
+    o.min_extent = worst;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_OK);
+    o.min_extent = nextafter(worst, 2.0);
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_EUNDETERMINED);
+    ck_assert_int_eq(g.refusal, FE_SPHERE_HEMISPHERE);
+    o = fe_sphere_default_options();
+    o.min_extent = 0.0;
+    o.max_iterations = f.iterations;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_OK);
+    ck_assert_int_eq(g.iterations, f.iterations);
+    o.max_iterations = f.iterations - 1;
+    ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_AXIAL, &o, &g), FE_ENOCONV);
+    ck_assert_int_eq(g.refusal, FE_SPHERE_NO_CONVERGENCE);
+}
+END_TEST
+
+/* Issue 20: batch-means errors need 8 blocks: 7 samples (7 blocks of
+   one) keep the independent errors (se_blocks 0, se == se_iid), 8 give
+   se_blocks 8. */
+START_TEST(blocked_errors_begin_at_eight_blocks)
+{
+    double x[3 * 8];
+    fe_sphere_options o = fe_sphere_default_options();
+    o.min_planarity = 0.0;
+    o.min_extent = 0.0;
+    fe_test_ellipsoid_points(x, 8, C0, R0, 5.0, 91);
+    for (size_t n = 7; n <= 8; n++) {
+        fe_quadric_blocks qb;
+        fe_sphere_fit f;
+        ck_assert_int_eq(fe_quadric_blocks_init(&qb), FE_OK);
+        ck_assert_int_eq(fe_quadric_blocks_add_many(&qb, x, n, NULL), FE_OK);
+        ck_assert_uint_eq(qb.nblocks, n);
+        ck_assert_int_eq(fe_sphere_fit_blocks(&qb, FE_FIT_SPHERE, &o, &f), FE_OK);
+        ck_assert_int_eq(f.se_blocks, n == 7 ? 0 : 8);
+        if (n == 7)
+            ck_assert_mem_eq(f.se, f.se_iid, sizeof f.se);
+    }
+}
+END_TEST
+
+/* Issue 20: the scale's field and ArduPilot's field at 0 (taken: the
+   fitted one) and -DBL_TRUE_MIN (refused, *out unchanged); the still
+   gate's window at 2 (taken) and 1, its thresholds at 0 and
+   -DBL_TRUE_MIN. */
+START_TEST(fields_windows_and_thresholds_at_their_edges)
+{
+    enum { N = 200 };
+    static double x[3 * N];
+    double ring[7 * 2];
+    int rc;
+    fe_sphere_fit f;
+    fe_sphere_scaled sc, scb;
+    fe_sphere_ardupilot ap, apb;
+    fe_still st;
+    fe_still_options so = fe_still_default_options();
+    fe_test_ellipsoid_points(x, N, C0, R0, 1.0, 5);
+    f = fit_moments(x, N, FE_FIT_ELLIPSOID, &rc);
+    ck_assert_int_eq(rc, FE_OK);
+    memset(&sc, 0x5a, sizeof sc);
+    scb = sc;
+    ck_assert_int_eq(fe_sphere_scale(&f, -DBL_TRUE_MIN, &sc), FE_EINVAL);
+    ck_assert_mem_eq(&sc, &scb, sizeof sc);
+    ck_assert_int_eq(fe_sphere_scale(&f, 0.0, &sc), FE_OK);
+    ck_assert_double_eq(sc.field, f.radius);
+    ck_assert_double_eq(sc.gain, 1.0);
+    memset(&ap, 0x5a, sizeof ap);
+    apb = ap;
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, -DBL_TRUE_MIN, 1.0, &ap), FE_EINVAL);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, 0.0, -DBL_TRUE_MIN, &ap), FE_EINVAL);
+    ck_assert_mem_eq(&ap, &apb, sizeof ap);
+    ck_assert_int_eq(fe_sphere_to_ardupilot(&f, 0.0, 1.0, &ap), FE_OK);
+    ck_assert_double_eq(ap.ofs[0], -f.offset[0]);
+    so.window = 1;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 7), FE_EINVAL);
+    so.window = 2;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 13), FE_ESIZE);
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 14), FE_OK);
+    so.max_rel_sd = -DBL_TRUE_MIN;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 14), FE_EINVAL);
+    so.max_rel_sd = 0.0;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 14), FE_OK);
+    so.max_rate = -DBL_TRUE_MIN;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 14), FE_EINVAL);
+    so.max_rate = 0.0;
+    ck_assert_int_eq(fe_still_init(&st, &so, ring, 14), FE_OK);
+    {   /* A window of 2 decides: two equal samples are still (sd 0 <= 0). */
+        const double g0[3] = {0, 0, 9.8};
+        double out[3];
+        int still = -1, ready = -1;
+        for (int i = 0; i < 3; i++)
+            ck_assert_int_eq(fe_still_push(&st, g0, NULL, out, &still, &ready), FE_OK);
+        ck_assert_int_eq(ready, 1);
+        ck_assert_int_eq(still, 1);
+    }
+}
+END_TEST
+
 Suite *fe_sphere_suite(void)
 {
     Suite *s = suite_create("sphere");
@@ -1732,6 +1904,10 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(r, real_ximu3_one_hemisphere_is_refused);
     tcase_add_test(r, real_recordings_f32_step_agrees);
     tcase_add_test(t, still_and_histogram_refusals_at_their_edges);
+    tcase_add_test(t, too_few_samples_and_the_naive_workspace_at_their_edges);
+    tcase_add_test(t, option_thresholds_at_their_edges);
+    tcase_add_test(t, blocked_errors_begin_at_eight_blocks);
+    tcase_add_test(t, fields_windows_and_thresholds_at_their_edges);
     suite_add_tcase(s, t);
     suite_add_tcase(s, r);
     return s;

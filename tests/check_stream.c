@@ -305,6 +305,32 @@ START_TEST(standard_input_is_a_source)
 }
 END_TEST
 
+/* Issue 20: a descriptor source's buffer at its edge: one record's bytes
+   are enough (every record arrives), one byte less is refused. */
+START_TEST(a_buffer_of_one_record_is_enough)
+{
+    char path[] = "/tmp/foldest-edge-XXXXXX";
+    int fd = mkstemp(path);
+    double x[5] = {1, 2, 3, 4, 5}, buf[1];
+    fe_source src;
+    fe_fd_source st;
+    const void *obs;
+    ck_assert_int_ge(fd, 0);
+    unlink(path);
+    ck_assert_int_eq(write(fd, x, sizeof x), (ssize_t)sizeof x);
+    ck_assert_int_eq(lseek(fd, 0, SEEK_SET), 0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, fd, sizeof(double), buf, sizeof(double) - 1),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_source_from_fd(&src, &st, fd, sizeof(double), buf, sizeof(double)), FE_OK);
+    for (int i = 0; i < 5; i++) {
+        ck_assert_int_eq(fe_source_next(&src, &obs), FE_OK);
+        ck_assert_double_eq(*(const double *)obs, x[i]);
+    }
+    ck_assert_int_eq(fe_source_next(&src, &obs), FE_END);
+    close(fd);
+}
+END_TEST
+
 Suite *fe_stream_suite(void)
 {
     Suite *s = suite_create("stream");
@@ -319,6 +345,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, sources_at_their_edges);
     tcase_add_test(t, fd_source_read_error_is_an_io_error);
     tcase_add_test(t, standard_input_is_a_source);
+    tcase_add_test(t, a_buffer_of_one_record_is_enough);
     suite_add_tcase(s, t);
     return s;
 }

@@ -29,7 +29,8 @@ typedef struct fe_csv_reader {
 } fe_csv_reader;
 
 /* fe_csv_reader_init: read from `fd` (the caller's to close) through
-   `buffer` of `cap` bytes; `cap` - 1 is the longest line accepted.  A
+   `buffer` of `cap` bytes; `cap` - 2 bytes is the longest line accepted
+   (a CR before its LF counted: `cap` - 3 characters of a CRLF line).  A
    UTF-8 byte-order mark at the start of the input is skipped. */
 int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap);
 

@@ -439,11 +439,13 @@ int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
 
 /* fe_discover_fit_noise: the same fit by feasible generalised least
    squares under an AR noise model of order at most max_order (<=
-   FE_DISCOVER_EDGE), re-estimated from the fit's own residual:
+   FE_DISCOVER_EDGE, and below the accumulation's lags: the portmanteau
+   needs one more), re-estimated from the fit's own residual:
    coefficients, their standard errors (stderr_ may be NULL), the summary
    and the noise model (with the portmanteau test of the whitened
-   residual).  A full accumulation only (FE_EINVAL for a screen); other
-   errors as fe_discover_fit_columns. */
+   residual).  A full accumulation with lags only (FE_EINVAL for a screen,
+   no lags or max_order out of range; fe_discover_select lowers it to
+   lags - 1 instead); other errors as fe_discover_fit_columns. */
 int fe_discover_fit_noise(const fe_discover_acc *a, const size_t *cols,
                           size_t ncols, size_t max_order, double *coef,
                           double *stderr_, fe_discover_fit *fit,

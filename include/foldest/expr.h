@@ -13,7 +13,10 @@ extern "C" {
 enum {
     FE_EXPR_MAX_CODE = 128,     /* instructions of one expression */
     FE_EXPR_MAX_STACK = 16,     /* values on the machine's stack */
-    FE_EXPR_MAX_DEPTH = 48      /* nesting of the source */
+    FE_EXPR_MAX_DEPTH = 48      /* levels of the parser's recursion: a
+                                   parenthesis or a function's argument
+                                   takes two, a sign one (23 nested
+                                   parentheses, 46 signs) */
 };
 
 /* A compiled expression: a program for a stack machine.  A flat struct:

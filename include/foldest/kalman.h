@@ -176,7 +176,9 @@ int fe_kalman_info_set_prior(fe_kalman_info *s, const double *x0,
                              const double *P0);
 
 /* fe_kalman_info_set_prior_scaled: P0 = p0 I, p0 > 0; p0 = INFINITY gives
-   zero information. */
+   zero information.  FE_ENOTPD for p0 <= 0; FE_ENONFINITE for a NaN, or
+   when 1/p0 or x0/p0 is not a double (p0 below 1/DBL_MAX, or tiny
+   against x0); on error `s` is unchanged. */
 int fe_kalman_info_set_prior_scaled(fe_kalman_info *s, const double *x0,
                                     double p0);
 
@@ -256,7 +258,8 @@ double fe_kalman_monitor_mean_nis(const fe_kalman_monitor *m);
 
 /* fe_kalman_monitor_nis_band: the interval that holds the mean NIS with
    probability `prob` (0 < prob < 1) if the model is right.
-   FE_ETOOFEW when empty, FE_EINVAL on a bad argument. */
+   FE_ETOOFEW when empty, FE_EINVAL on a bad argument (also for the
+   largest double below 1, whose upper level (1 + prob)/2 rounds to 1). */
 int fe_kalman_monitor_nis_band(const fe_kalman_monitor *m, double prob,
                                double *lo, double *hi);
 

@@ -113,8 +113,10 @@ size_t fe_lm_work(const fe_lm_problem *prob, int method);
    NULL.  `result` (if not NULL) receives the counts and costs.  `work`
    holds fe_lm_work(prob, method) doubles; nothing is allocated.
    Returns FE_OK on convergence (ftol, xtol or gtol), FE_ENOCONV (max_iter,
-   or the damping grew without bound), FE_ESTOPPED, FE_EINVAL (bad sizes,
-   method or params), FE_ETOOFEW (the model emitted no residual), or the
+   or the damping grew without bound), FE_ESTOPPED, FE_EINVAL (bad sizes
+   or method; params with max_iter < 0, lambda0 not finite and positive,
+   a tolerance or lambda_min negative, or lambda_min > lambda0; max_iter
+   0 makes no iteration), FE_ETOOFEW (the model emitted no residual), or the
    model's error at the starting point (e.g. FE_ENONFINITE).  A trial
    point where the model fails is treated as a rejected step. */
 int fe_lm_solve(const fe_lm_problem *prob, int method,

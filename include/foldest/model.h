@@ -71,7 +71,8 @@ size_t fe_model_acc_doubles(size_t p, size_t terms, size_t blocks);
    over caller storage; rows [0, fit_rows) are fitted and the rest held
    out, as fe_discover_acc_init.  The model is copied (its callbacks and
    user pointer are kept); `c` is kept by pointer.  Errors: FE_EINVAL (NULL,
-   no predict, p out of range), FE_ENONFINITE (theta0 or typical not finite,
+   no predict, p out of range, p + c->count above FE_DISCOVER_MAX_COLUMNS),
+   FE_ENONFINITE (theta0 or typical not finite,
    a typical value not positive), and those of fe_discover_acc_init. */
 int fe_model_acc_init(fe_model_acc *a, const fe_model *m, const fe_catalog *c,
                       size_t blocks, uint64_t fit_rows, double *storage,

@@ -80,7 +80,7 @@ static int fe__cli_line_error(const fe_cli_table *t, int rc, char *err,
     switch (rc) {
     case FE_ESIZE:
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
-                          "line longer than %d bytes", FE_CLI_LINE_MAX - 1);
+                          "line longer than %d bytes", FE_CLI_LINE_MAX - 2);
     case FE_EPARSE:
         return fe__cli_at(t, t->reader.line, 1, FE_CLI_INPUT, err, errlen,
                           "NUL byte: this is not a text file");
