@@ -13,6 +13,44 @@
 
 static const double PI = 3.14159265358979323846;
 
+START_TEST(every_basis_function_differentiates_as_its_finite_difference)
+{
+    /* The fitted dynamics' Jacobian (fe_dynamics_fit_jacobian) against
+       central differences of the fitted dynamics themselves
+       (fe_dynamics_fit_eval), one basis function at a time (a unit
+       coefficient), for both orders, at states on either side of the
+       centre: each analytic derivative of the basis is pinned. */
+    const double ps[3] = {-1.3, 0.4, 2.1}, vs[2] = {-0.7, 1.5};
+    for (size_t order = 1; order <= 2; order++)
+        for (size_t k = 0; k < FE_DYNAMICS_BASIS; k++)
+            for (int ip = 0; ip < 3; ip++)
+                for (int iv = 0; iv < 2; iv++) {
+                    fe_dynamics_fit fit;
+                    fe_sample s = {0};
+                    double a[2] = {0}, afd[2] = {0};
+                    memset(&fit, 0, sizeof fit);
+                    fit.order = order;
+                    for (int i = 0; i < FE_DYNAMICS_VARS; i++) {
+                        fit.centre[i] = 0.3;
+                        fit.scale[i] = 1.7;
+                    }
+                    fit.coef[k] = 1.0;
+                    s.t = 1.0;
+                    s.position = s.temperature = ps[ip];
+                    s.velocity = vs[iv];
+                    s.input = 0.5;
+                    s.ambient = 0.2;
+                    ck_assert_int_eq(fe_dynamics_fit_jacobian(&s, a, &fit), FE_OK);
+                    ck_assert_int_eq(fe_dynamics_jacobian_fd(fe_dynamics_fit_eval, &fit, order,
+                                                             &s, afd), FE_OK);
+                    for (size_t i = 0; i < order; i++)
+                        ck_assert_msg(fabs(a[i] - afd[i]) <= 1e-6 * (1.0 + fabs(afd[i])),
+                                      "order %zu basis %zu state %d,%d: d/dx%zu %.12g, "
+                                      "by differences %.12g", order, k, ip, iv, i, a[i], afd[i]);
+                }
+}
+END_TEST
+
 START_TEST(a_free_mass_signature_is_exact)
 {
     /* s'' = 1 from rest: s = tau^2 / 2, s' = tau, on an uneven clock. */
@@ -827,6 +865,7 @@ Suite *fe_dynamics_suite(void)
 {
     Suite *s = suite_create("dynamics");
     TCase *t = tcase_create("dynamics");
+    tcase_add_test(t, every_basis_function_differentiates_as_its_finite_difference);
     tcase_add_test(t, a_free_mass_signature_is_exact);
     tcase_add_test(t, an_oscillator_signature_follows_its_closed_form);
     tcase_add_test(t, a_first_order_lag_sampled_coarsely_does_not_ring);

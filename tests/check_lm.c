@@ -136,6 +136,64 @@ START_TEST(wide_linear_model_dense_and_schur)
 }
 END_TEST
 
+/* Wide rows with blocks: 60 globals and 8 locals of one of 2 blocks on
+   every row, 68 nonzeros where the dense sink folds 64 sparsely; the
+   sparse fold must look at the globals and the locals together.  Dense
+   and Schur give the normal-equation solution of all 76 columns. */
+enum { WBN = 240, WBG = 60, WBL = 8, WBB = 2, WBP = WBG + WBB * WBL };
+struct wide_blocks { double J[WBN][WBG + WBL], y[WBN]; };
+
+static int wide_blocks_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const struct wide_blocks *L = ctx;
+    for (int i = 0; i < WBN; i++) {
+        size_t b = (size_t)(i % WBB);
+        double f = -L->y[i];
+        for (int k = 0; k < WBG; k++)
+            f += L->J[i][k] * x[k];
+        for (int k = 0; k < WBL; k++)
+            f += L->J[i][WBG + k] * x[WBG + b * WBL + (size_t)k];
+        fe_lm_emit(s, f, 1.0, L->J[i], b, L->J[i] + WBG);
+    }
+    return FE_OK;
+}
+
+START_TEST(wide_rows_with_blocks_dense_and_schur)
+{
+    static struct wide_blocks L;
+    static double gram[(WBP + 1) * (WBP + 1)], sw[(WBP + 1) * (WBP + 1)], row[WBP];
+    double want[WBP], rss, worst = 0.0, scale = 0.0;
+    fe_rng g = fe_rng_seed(6);
+    fe_lsq a;
+    fe_lm_problem p = {WBG, WBL, WBB, wide_blocks_model, &L};
+
+    fe_lsq_init(&a, WBP, gram);
+    for (int i = 0; i < WBN; i++) {
+        size_t b = (size_t)(i % WBB);
+        memset(row, 0, sizeof row);
+        for (int k = 0; k < WBG + WBL; k++)
+            L.J[i][k] = fe_rng_normal(&g);
+        L.y[i] = L.J[i][3] - 0.5 * L.J[i][WBG + 2] + 0.1 * fe_rng_normal(&g);
+        memcpy(row, L.J[i], WBG * sizeof *row);
+        memcpy(row + WBG + b * WBL, L.J[i] + WBG, WBL * sizeof *row);
+        fe_lsq_add(&a, row, L.y[i], 1.0);
+    }
+    ck_assert_int_eq(fe_lsq_solve(&a, NULL, WBP, want, &rss, NULL, sw), FE_OK);
+    for (int k = 0; k < WBP; k++)
+        scale = fmax(scale, fabs(want[k]));
+    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
+        double x[WBP] = {0}, *w = lm_work(&p, method);
+        fe_lm_result r;
+        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
+        for (int k = 0; k < WBP; k++)
+            worst = fmax(worst, fabs(x[k] - want[k]));
+        FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
+        free(w);
+    }
+    ck_assert_double_le(worst, 1e-10 * scale);
+}
+END_TEST
+
 /* ------------------------------------------------ 2-D bundle adjustment */
 
 enum { NC = 10, NLM = 40, BAP = 2 * NC + 2 * NLM };
@@ -1270,6 +1328,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, rosenbrock_dense_and_schur);
     tcase_add_test(t, linear_model_matches_normal_equations);
     tcase_add_test(t, wide_linear_model_dense_and_schur);
+    tcase_add_test(t, wide_rows_with_blocks_dense_and_schur);
     tcase_add_test(t, bundle_adjustment_dense_and_schur_agree);
     tcase_add_test(t, bundle_adjustment_noisy_ends_at_the_optimum);
     tcase_add_test(t, report_table_and_stop);
