@@ -800,6 +800,32 @@ START_TEST(residual_map_locates_a_window_and_a_region)
 }
 END_TEST
 
+START_TEST(the_largest_statistic_after_the_terms_looks_at_the_regions)
+{
+    /* 40 rows in 4 blocks, the velocity alternating +-0.5 and the
+       residual after the terms its sign: every block has mean 0 and mean
+       square 1, so their statistics are 0, and the regions v > 0 and
+       v < 0 hold 20 rows of mean +-1, t = +-sqrt(20 w) (the speed bands
+       hold every row and are not tested).  The largest statistic is the
+       regions'. */
+    fe_residual_map m;
+    const double lo[3] = {0, -1, 0}, hi[3] = {0, 1, 0};
+    ck_assert_int_eq(fe_residual_map_init(&m, 4, 40, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+    ck_assert_uint_ge(m.nregions, 2);
+    for (int i = 0; i < 40; i++) {
+        fe_sample s = {0};
+        double e = i % 2 ? 1.0 : -1.0;
+        s.t = i;
+        s.velocity = 0.5 * e;
+        ck_assert_int_eq(fe_residual_map_add(&m, &s, e, e), FE_OK);
+    }
+    for (int k = 0; k < 3; k++) {
+        double w = k == 0 ? 1.0 : k == 1 ? 0.5 : 0.05;
+        ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), sqrt(20.0 * w), 1e-12);
+    }
+}
+END_TEST
+
 START_TEST(residual_map_statistics_by_hand)
 {
     /* Two blocks of 10 rows with known sums: the statistics of the
@@ -1173,6 +1199,7 @@ Suite *fe_locate_suite(void)
     TCase *t = tcase_create("locate");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, block_statistics_match_a_direct_computation);
+    tcase_add_test(t, the_largest_statistic_after_the_terms_looks_at_the_regions);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
