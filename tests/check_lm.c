@@ -87,6 +87,29 @@ START_TEST(linear_model_matches_normal_equations)
 }
 END_TEST
 
+/* Both methods solve p from zero to the normal-equation solution want (n
+   parameters, residual sum of squares rss): every parameter within 1e-10
+   of the largest, the cost rss / 2. */
+static void dense_and_schur_solve_as(const fe_lm_problem *p, const double *want, size_t n,
+                                     double rss)
+{
+    double worst = 0.0, scale = 0.0;
+    for (size_t k = 0; k < n; k++)
+        scale = fmax(scale, fabs(want[k]));
+    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
+        double *x = calloc(n, sizeof *x), *w = lm_work(p, method);
+        fe_lm_result r;
+        ck_assert_ptr_nonnull(x);
+        ck_assert_int_eq(fe_lm_solve(p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
+        for (size_t k = 0; k < n; k++)
+            worst = fmax(worst, fabs(x[k] - want[k]));
+        FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
+        free(x);
+        free(w);
+    }
+    ck_assert_double_le(worst, 1e-10 * scale);
+}
+
 /* Wide rows (more nonzeros than the dense sink folds sparsely): the dense
    and Schur paths still give the normal-equation solution. */
 enum { WN = 200, WP = 80 };
@@ -108,7 +131,7 @@ START_TEST(wide_linear_model_dense_and_schur)
 {
     static struct wide L;
     static double gram[(WP + 1) * (WP + 1)], sw[(WP + 1) * (WP + 1)];
-    double want[WP], rss, worst = 0.0, scale = 0.0;
+    double want[WP], rss;
     fe_rng g = fe_rng_seed(4);
     fe_lsq a;
     fe_lm_problem p = {WP, 0, 0, wide_model, &L};
@@ -121,18 +144,7 @@ START_TEST(wide_linear_model_dense_and_schur)
         fe_lsq_add(&a, L.J[i], L.y[i], 1.0);
     }
     ck_assert_int_eq(fe_lsq_solve(&a, NULL, WP, want, &rss, NULL, sw), FE_OK);
-    for (int k = 0; k < WP; k++)
-        scale = fmax(scale, fabs(want[k]));
-    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
-        double x[WP] = {0}, *w = lm_work(&p, method);
-        fe_lm_result r;
-        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
-        for (int k = 0; k < WP; k++)
-            worst = fmax(worst, fabs(x[k] - want[k]));
-        FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
-        free(w);
-    }
-    ck_assert_double_le(worst, 1e-10 * scale);
+    dense_and_schur_solve_as(&p, want, WP, rss);
 }
 END_TEST
 
@@ -162,7 +174,7 @@ START_TEST(wide_rows_with_blocks_dense_and_schur)
 {
     static struct wide_blocks L;
     static double gram[(WBP + 1) * (WBP + 1)], sw[(WBP + 1) * (WBP + 1)], row[WBP];
-    double want[WBP], rss, worst = 0.0, scale = 0.0;
+    double want[WBP], rss;
     fe_rng g = fe_rng_seed(6);
     fe_lsq a;
     fe_lm_problem p = {WBG, WBL, WBB, wide_blocks_model, &L};
@@ -179,18 +191,7 @@ START_TEST(wide_rows_with_blocks_dense_and_schur)
         fe_lsq_add(&a, row, L.y[i], 1.0);
     }
     ck_assert_int_eq(fe_lsq_solve(&a, NULL, WBP, want, &rss, NULL, sw), FE_OK);
-    for (int k = 0; k < WBP; k++)
-        scale = fmax(scale, fabs(want[k]));
-    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
-        double x[WBP] = {0}, *w = lm_work(&p, method);
-        fe_lm_result r;
-        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, w, NULL, NULL, &r), FE_OK);
-        for (int k = 0; k < WBP; k++)
-            worst = fmax(worst, fabs(x[k] - want[k]));
-        FE_ASSERT_REL(2.0 * r.cost, rss, 1e-9);
-        free(w);
-    }
-    ck_assert_double_le(worst, 1e-10 * scale);
+    dense_and_schur_solve_as(&p, want, WBP, rss);
 }
 END_TEST
 

@@ -31,6 +31,10 @@ import os
 import re
 import sys
 
+import ledger
+
+LEDGER = "tests/audit/codes_explained.txt"
+
 CODE = re.compile(r"\bFE_E[A-Z]+\b")
 IDENT = re.compile(r"[A-Za-z_]\w*")
 
@@ -228,34 +232,15 @@ def main():
             for c in sorted(set(CODE.findall(comment))):
                 pairs.append((os.path.basename(h), fn, c))
     found = coverage(publics)
-    explained = {}
-    with open("tests/audit/codes_explained.txt", encoding="utf-8") as f:
-        for lineno, line in enumerate(f, 1):
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            parts = line.split(None, 2)
-            if len(parts) < 3:
-                print("codes_explained.txt:%d: want `function CODE reason`" % lineno)
-                return 1
-            explained[(parts[0], parts[1])] = (lineno, parts[2])
-    gaps, stale, n_tested, n_explained = [], [], 0, 0
-    documented = {(fn, c) for _, fn, c in pairs}
-    for h, fn, c in pairs:
-        if (fn, c) in found:
-            n_tested += 1
-            if (fn, c) in explained:
-                stale.append("codes_explained.txt:%d: %s %s is tested now (%s)"
-                             % (explained[(fn, c)][0], fn, c, found[(fn, c)]))
-            elif verbose:
-                print("tested    %-34s %-16s %s" % (fn, c, found[(fn, c)]))
-        elif (fn, c) in explained:
-            n_explained += 1
-            if verbose:
-                print("explained %-34s %-16s %s" % (fn, c, explained[(fn, c)][1]))
-        else:
-            gaps.append("%s: %s %s: no test statement calls the one and names the other"
-                        % (h, fn, c))
+    explained = ledger.load_explained(LEDGER, "function CODE reason")
+    if explained is None:
+        return 1
+    where = {(fn, c): h for h, fn, c in pairs}
+    documented = set(where)
+    n_tested, n_explained, gaps, stale = ledger.tally(
+        [(fn, c) for _, fn, c in pairs], found, explained, LEDGER, ("tested", 34),
+        lambda p: "%s: %s %s: no test statement calls the one and names the other"
+                  % (where[p], p[0], p[1]), verbose)
     for (fn, c), (lineno, _) in sorted(explained.items()):
         if (fn, c) not in documented:
             stale.append("codes_explained.txt:%d: %s %s is not documented in any header"

@@ -49,6 +49,10 @@ import itertools
 import re
 import sys
 
+import ledger
+
+LEDGER = "tests/audit/options_explained.txt"
+
 CLI = "\0CLI"           # the value of FE_TEST_CLI in an expanded format
 CONV = re.compile(r"%(?:%|(\d+\$)?[-+ #0']*(\*|\d+)?(?:\.(?:\*|\d+))?"
                   r"(?:hh|h|ll|l|L|z|j|t)?([diouxXeEfFgGaAcspn]))")
@@ -628,33 +632,13 @@ def main():
     options, short, problems = parser_options()
     COMMANDS.update(options)
     found = coverage(options, short) if options else {}
-    explained = {}
-    with open("tests/audit/options_explained.txt", encoding="utf-8") as f:
-        for lineno, line in enumerate(f, 1):
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            parts = line.split(None, 2)
-            if len(parts) < 3:
-                print("options_explained.txt:%d: want `command --option reason`" % lineno)
-                return 1
-            explained[(parts[0], parts[1])] = (lineno, parts[2])
+    explained = ledger.load_explained(LEDGER, "command --option reason")
+    if explained is None:
+        return 1
     pairs = sorted((c, o) for c in options for o in options[c])
-    gaps, stale, n_used, n_explained = [], [], 0, 0
-    for c, o in pairs:
-        if (c, o) in found:
-            n_used += 1
-            if (c, o) in explained:
-                stale.append("options_explained.txt:%d: %s %s is used now (%s)"
-                             % (explained[(c, o)][0], c, o, found[(c, o)]))
-            elif verbose:
-                print("used      %-10s %-16s %s" % (c, o, found[(c, o)]))
-        elif (c, o) in explained:
-            n_explained += 1
-            if verbose:
-                print("explained %-10s %-16s %s" % (c, o, explained[(c, o)][1]))
-        else:
-            gaps.append("foldest %s %s: no test runs the command with the option" % (c, o))
+    n_used, n_explained, gaps, stale = ledger.tally(
+        pairs, found, explained, LEDGER, ("used", 10),
+        lambda p: "foldest %s %s: no test runs the command with the option" % p, verbose)
     for (c, o), (lineno, _) in sorted(explained.items()):
         if o not in options.get(c, {}):
             stale.append("options_explained.txt:%d: %s %s is not an option of the command"
