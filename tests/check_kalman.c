@@ -1581,6 +1581,41 @@ END_TEST
    prior and the smallest negative double is FE_ENOTPD with the filter
    unchanged; the information prior needs p0 > 0, so 0 is refused and the
    smallest variance whose inverse is a double is taken. */
+START_TEST(a_merge_that_overflows_in_any_one_sum_is_refused)
+{
+    /* Two information filters of 2 states, each holding 1e308 in one
+       entry of Lambda or eta: the merge's sum, 2e308, overflows in that
+       entry alone.  Each position in turn is refused with FE_ENONFINITE
+       and the first filter left as it was; with 1e307 in the first
+       (1.1e308) the same merge is taken. */
+    for (size_t pos = 0; pos < 6; pos++)
+        for (int fits = 0; fits < 2; fits++) {
+            kinfo a, b;
+            double snap_L[4], snap_e[2];
+            double *ea, *eb;
+            kinfo_make(&a, 2, 1);
+            kinfo_make(&b, 2, 1);
+            ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, NULL, 1.0), FE_OK);
+            ea = pos < 4 ? &a.s.Lambda[pos] : &a.s.eta[pos - 4];
+            eb = pos < 4 ? &b.s.Lambda[pos] : &b.s.eta[pos - 4];
+            *ea = fits ? 1e307 : 1e308;
+            *eb = 1e308;
+            memcpy(snap_L, a.s.Lambda, sizeof snap_L);
+            memcpy(snap_e, a.s.eta, sizeof snap_e);
+            if (fits) {
+                ck_assert_int_eq(fe_kalman_info_merge(&a.s, &b.s), FE_OK);
+                ck_assert(isfinite(*ea));
+            } else {
+                ck_assert_int_eq(fe_kalman_info_merge(&a.s, &b.s), FE_ENONFINITE);
+                ck_assert_mem_eq(a.s.Lambda, snap_L, sizeof snap_L);
+                ck_assert_mem_eq(a.s.eta, snap_e, sizeof snap_e);
+            }
+            free(a.mem);
+            free(b.mem);
+        }
+}
+END_TEST
+
 START_TEST(prior_variances_are_refused_just_below_their_edges)
 {
     kf f;
@@ -1715,6 +1750,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, the_largest_dimension_is_taken_and_one_more_refused);
     tcase_add_test(t, a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step);
     tcase_add_test(t, prior_variances_are_refused_just_below_their_edges);
+    tcase_add_test(t, a_merge_that_overflows_in_any_one_sum_is_refused);
     tcase_add_test(t, monitor_ranges_are_refused_at_their_bounds_and_taken_just_inside);
     suite_add_tcase(s, t);
     return s;
