@@ -218,8 +218,13 @@ START_TEST(schur_and_lm_arguments)
         ck_assert_uint_eq(fe_lm_work(&p, 7), 0);
         ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, work, NULL, NULL, NULL), FE_EINVAL);
         ck_assert_int_eq(fe_lm_solve(NULL, FE_LM_DENSE, NULL, x, work, NULL, NULL, NULL), FE_EINVAL);
+        /* A problem without a model is refused whatever the parameters
+           (max_iter = 0 is taken with a model: parameters_at_their_edges
+           in check_lm). */
         bad.max_iter = 0;
         p.ng = 1;
+        ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &bad, x, work, NULL, NULL, NULL), FE_EINVAL);
+        bad = fe_lm_default_params();
         ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &bad, x, work, NULL, NULL, NULL), FE_EINVAL);
         ck_assert_int_eq(fe_lm_emit(NULL, 1, 1, jg, FE_SCHUR_NONE, NULL), FE_EINVAL);
     }
