@@ -86,11 +86,16 @@ int fe_cli_synth(int argc, char **argv)
             real = v;
         else if (strcmp(o, "--sim") == 0)
             sim = v;
-        else if (strcmp(o, "--seed") == 0)
-            rc = fe_cli_parse_long(o, v, &seed, err, sizeof err);
-        else if (strcmp(o, "--rows") == 0)
-            rc = fe_cli_parse_long(o, v, &rows, err, sizeof err);
-        else if (strcmp(o, "--order") == 0) {
+        else if (strcmp(o, "--seed") == 0 || strcmp(o, "--rows") == 0) {
+            long *to = strcmp(o, "--seed") == 0 ? &seed : &rows;
+            rc = fe_cli_parse_long(o, v, to, err, sizeof err);
+            if (rc == FE_CLI_OK && (*to < 0 || (to == &rows && *to > 0 && *to < 100))) {
+                snprintf(err, sizeof err, "%s: %s is not %s", o, v,
+                         to == &rows ? "100 or more (fe_synth_init's least), or 0 for the default"
+                                     : "0 or more");
+                rc = FE_CLI_USAGE;
+            }
+        } else if (strcmp(o, "--order") == 0) {
             rc = fe_cli_parse_long(o, v, &order, err, sizeof err);
             if (rc == FE_CLI_OK && (order < 0 || order > 2)) {
                 snprintf(err, sizeof err, "--order: %s is not 0, 1 or 2", v);
@@ -111,7 +116,9 @@ int fe_cli_synth(int argc, char **argv)
             return rc;
         }
     }
-    if (effect == NULL || real == NULL || sim == NULL || seed < 0 || rows < 0) {
+    if (effect == NULL || real == NULL || sim == NULL) {
+        fprintf(stderr, "foldest synth: %s is required\n\n",
+                effect == NULL ? "--effect" : real == NULL ? "--real" : "--sim");
         fputs(fe__synth_help, stderr);
         return FE_CLI_USAGE;
     }
