@@ -3,6 +3,7 @@
    fields (delimiters, quotes, white space) and numbers. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <float.h>
 #include <locale.h>
 #include <unistd.h>
 
@@ -377,6 +378,20 @@ static int set_german_numbers(char *dir)
     return 1;
 }
 
+START_TEST(a_double_is_written_in_the_fewest_of_15_16_and_17_digits)
+{
+    /* The smallest subnormal reads back from 15 digits (16 would print
+       ...465e-324), a third needs 16, 0.1 + 0.2 needs 17. */
+    char b[FE_CSV_DOUBLE_TEXT];
+    ck_assert_int_eq(fe_csv_format_double(DBL_TRUE_MIN, b, sizeof b), FE_OK);
+    ck_assert_str_eq(b, "4.94065645841247e-324");
+    ck_assert_int_eq(fe_csv_format_double(1.0 / 3.0, b, sizeof b), FE_OK);
+    ck_assert_str_eq(b, "0.3333333333333333");
+    ck_assert_int_eq(fe_csv_format_double(0.1 + 0.2, b, sizeof b), FE_OK);
+    ck_assert_str_eq(b, "0.30000000000000004");
+}
+END_TEST
+
 START_TEST(numbers_read_and_written_alike_in_any_locale)
 {
     /* A program that links the library may set a locale whose decimal
@@ -541,6 +556,7 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, strtod_extensions_are_not_numbers);
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
     tcase_add_test(t, number_parsers_refuse_each_missing_argument);
+    tcase_add_test(t, a_double_is_written_in_the_fewest_of_15_16_and_17_digits);
     tcase_add_test(t, numbers_read_and_written_alike_in_any_locale);
     tcase_add_test(t, a_line_two_bytes_shorter_than_its_buffer_is_the_longest_read);
     tcase_add_test(t, a_decimal_comma_field_of_255_bytes_is_read_and_256_refused);
