@@ -415,6 +415,38 @@ static void fe__discover_usage(FILE *out)
           out);
 }
 
+/* The options both modes take with the same ranges: o is --holdout,
+   --alpha or --blocks (FE__DISCOVER_SHARED).  FE_CLI_OK with the value
+   set, or FE_CLI_USAGE with err. */
+#define FE__DISCOVER_SHARED(o) \
+    (strcmp(o, "--holdout") == 0 || strcmp(o, "--alpha") == 0 || strcmp(o, "--blocks") == 0)
+
+static int fe__discover_shared_option(const char *o, const char *v, double *holdout,
+                                      double *alpha, long *blocks, char *err, size_t errlen)
+{
+    int rc;
+    if (strcmp(o, "--holdout") == 0) {
+        rc = fe_cli_parse_double(o, v, holdout, err, errlen);
+        if (rc == FE_CLI_OK && !(*holdout >= 0.0 && *holdout < 0.9)) {
+            snprintf(err, errlen, "--holdout: %s is not in [0, 0.9)", v);
+            rc = FE_CLI_USAGE;
+        }
+    } else if (strcmp(o, "--alpha") == 0) {
+        rc = fe_cli_parse_double(o, v, alpha, err, errlen);
+        if (rc == FE_CLI_OK && !(*alpha > 0.0 && *alpha < 0.5)) {
+            snprintf(err, errlen, "--alpha: %s is not in (0, 0.5)", v);
+            rc = FE_CLI_USAGE;
+        }
+    } else {
+        rc = fe_cli_parse_long(o, v, blocks, err, errlen);
+        if (rc == FE_CLI_OK && (*blocks < 4 || *blocks > FE_DISCOVER_MAX_BLOCKS)) {
+            snprintf(err, errlen, "--blocks: %s is not in [4, %d]", v, FE_DISCOVER_MAX_BLOCKS);
+            rc = FE_CLI_USAGE;
+        }
+    }
+    return rc;
+}
+
 static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
                               char *err, size_t errlen)
 {
@@ -477,18 +509,8 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
             a->exclude = v;
         } else if (strcmp(o, "--report") == 0) {
             a->report = v;
-        } else if (strcmp(o, "--holdout") == 0) {
-            rc = fe_cli_parse_double(o, v, &a->holdout, err, errlen);
-            if (rc == FE_CLI_OK && !(a->holdout >= 0.0 && a->holdout < 0.9)) {
-                snprintf(err, errlen, "--holdout: %s is not in [0, 0.9)", v);
-                rc = FE_CLI_USAGE;
-            }
-        } else if (strcmp(o, "--alpha") == 0) {
-            rc = fe_cli_parse_double(o, v, &a->alpha, err, errlen);
-            if (rc == FE_CLI_OK && !(a->alpha > 0.0 && a->alpha < 0.5)) {
-                snprintf(err, errlen, "--alpha: %s is not in (0, 0.5)", v);
-                rc = FE_CLI_USAGE;
-            }
+        } else if (FE__DISCOVER_SHARED(o)) {
+            rc = fe__discover_shared_option(o, v, &a->holdout, &a->alpha, &a->blocks, err, errlen);
         } else if (strcmp(o, "--noise") == 0) {
             if (strcmp(v, "ar") == 0)
                 a->noise = FE_DISCOVER_NOISE_AR;
@@ -508,12 +530,6 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
             rc = fe_cli_parse_long(o, v, &a->lags, err, errlen);
             if (rc == FE_CLI_OK && (a->lags < 0 || a->lags > FE_DISCOVER_LAGS)) {
                 snprintf(err, errlen, "--lags: %s is not in [0, %d]", v, FE_DISCOVER_LAGS);
-                rc = FE_CLI_USAGE;
-            }
-        } else if (strcmp(o, "--blocks") == 0) {
-            rc = fe_cli_parse_long(o, v, &a->blocks, err, errlen);
-            if (rc == FE_CLI_OK && (a->blocks < 4 || a->blocks > FE_DISCOVER_MAX_BLOCKS)) {
-                snprintf(err, errlen, "--blocks: %s is not in [4, %d]", v, FE_DISCOVER_MAX_BLOCKS);
                 rc = FE_CLI_USAGE;
             }
         } else if (strcmp(o, "--threads") == 0) {
@@ -3015,25 +3031,8 @@ static int fe__discover_sphere_main(int argc, char **argv)
                 argv[i][eq - v] = '\0';
                 a.temperature = v;
             }
-        } else if (strcmp(o, "--holdout") == 0) {
-            rc = fe_cli_parse_double(o, v, &a.holdout, err, sizeof err);
-            if (rc == FE_CLI_OK && !(a.holdout >= 0.0 && a.holdout < 0.9)) {
-                snprintf(err, sizeof err, "--holdout: %s is not in [0, 0.9)", v);
-                rc = FE_CLI_USAGE;
-            }
-        } else if (strcmp(o, "--alpha") == 0) {
-            rc = fe_cli_parse_double(o, v, &a.alpha, err, sizeof err);
-            if (rc == FE_CLI_OK && !(a.alpha > 0.0 && a.alpha < 0.5)) {
-                snprintf(err, sizeof err, "--alpha: %s is not in (0, 0.5)", v);
-                rc = FE_CLI_USAGE;
-            }
-        } else if (strcmp(o, "--blocks") == 0) {
-            rc = fe_cli_parse_long(o, v, &a.blocks, err, sizeof err);
-            if (rc == FE_CLI_OK && (a.blocks < 4 || a.blocks > FE_DISCOVER_MAX_BLOCKS)) {
-                snprintf(err, sizeof err, "--blocks: %s is not in [4, %d]", v,
-                         FE_DISCOVER_MAX_BLOCKS);
-                rc = FE_CLI_USAGE;
-            }
+        } else if (FE__DISCOVER_SHARED(o)) {
+            rc = fe__discover_shared_option(o, v, &a.holdout, &a.alpha, &a.blocks, err, sizeof err);
         } else {
             snprintf(err, sizeof err, "unknown option '%s' with --sphere", o);
             rc = FE_CLI_USAGE;
