@@ -2361,6 +2361,37 @@ START_TEST(documented_refusals_at_their_edges)
 }
 END_TEST
 
+/* A row that starts a recording is checked before the break is made:
+   1e154 squares to 1e308, so a second such row in the same block would
+   take the sum of squares of column 0 past DBL_MAX (2e308).  It is
+   refused and the accumulation is unchanged to the byte (no break made);
+   the same row at a tenth of the size (1e306 more) is folded after a
+   break.  Only the pair (0, 0) overflows: r and the other column are 0. */
+START_TEST(a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break)
+{
+    enum { M = 2, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *copy = malloc(nst * sizeof *st);
+    double phi[M] = {1e154, 0.0};
+    fe_discover_acc a, before;
+    fe_discover_row row = {0, phi, 0.0, 0};
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    before = a;
+    memcpy(copy, st, nst * sizeof *st);
+    row.index = 1;
+    row.starts_recording = 1;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    phi[0] = 1e153;
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    ck_assert_uint_eq(a.n, 2);
+    free(st);
+    free(copy);
+}
+END_TEST
+
 /* fe_discover_select's FE_ENONFINITE, "sums too large to whiten": a
    residual of AR(1) noise (phi = 0.9) whose sum of squares is finite
    (1.5e308 < DBL_MAX) but whose prewhitened Gram matrix, (1 + phi^2) times
@@ -2561,6 +2592,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
     tcase_add_test(t, documented_refusals_at_their_edges);
+    tcase_add_test(t, a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break);
     tcase_add_test(t, sums_too_large_to_whiten_are_refused);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);

@@ -683,6 +683,50 @@ START_TEST(the_dynamics_catalog_and_its_words)
 }
 END_TEST
 
+/* Each term of the dynamics catalog has its own sentence, with the
+   coefficient's sign as the sentence states it (a friction, a spring and
+   a loss are reported as positive constants of -coef); a name outside the
+   catalog gets the generic sentence; order 0 is the static catalog's. */
+START_TEST(every_dynamics_term_is_explained_in_its_own_words)
+{
+    static const struct {
+        const char *name;
+        size_t order;
+        double coef;
+        const char *want;
+    } cases[] = {
+        {"offset", 2, 0.5, "the measurement reads 0.5 +/- 0.01 (channel units) high"},
+        {"bias", 2, 0.5, "a constant force per mass: d2x/dt2 gains 0.5 +/- 0.01"},
+        {"bias", 1, 0.5, "a constant heat rate per capacity: dT/dt gains 0.5 +/- 0.01"},
+        {"drift", 2, 0.5, "d2x/dt2 gains c (t - t1) with c = 0.5 +/- 0.01 per time unit"},
+        {"viscous_friction", 2, -0.5, "viscous damping: d2x/dt2 gains -c v with c = 0.5"},
+        {"quadratic_drag", 2, -0.5, "quadratic drag: d2x/dt2 gains -k v|v| with k = 0.5"},
+        {"coulomb_friction", 2, -0.5, "dry friction: d2x/dt2 gains -mu sign(v) with mu = 0.5"},
+        {"linear_stiffness", 2, -0.5, "missing spring: d2x/dt2 gains -kappa x with kappa = 0.5"},
+        {"cubic_stiffness", 2, -0.5, "kappa3 = 0.5 +/- 0.01 (hardening)"},
+        {"cubic_stiffness", 2, 0.5, "kappa3 = -0.5 +/- 0.01 (softening)"},
+        {"newton_cooling", 1, -0.5, "convective loss: dT/dt gains -h (T - T_ambient) with h = 0.5"},
+        {"radiative_cooling", 1, -0.5, "radiative loss: dT/dt gains -e (T^4 - T_ambient^4) with e = 0.5"},
+        {"thermal_sensitivity", 1, 0.5, "dT/dt gains c (T - T1) with c = 0.5 +/- 0.01 (1/time)"},
+        {"input_gain", 2, 0.5, "actuator gain error: d2x/dt2 gains 0.5 +/- 0.01 per input unit"},
+        {"my_term", 2, 0.5, "d2x/dt2 gains 0.5 +/- 0.01 times the term"},
+        {NULL, 1, 0.5, "dT/dt gains 0.5 +/- 0.01 times the term"},
+    };
+    char words[256];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        ck_assert_int_eq(fe_dynamics_explain(cases[i].name, cases[i].order, cases[i].coef, 0.01,
+                                             words, sizeof words), FE_OK);
+        ck_assert_msg(strstr(words, cases[i].want) != NULL, "%s: %s", cases[i].name, words);
+    }
+    ck_assert_int_eq(fe_dynamics_explain("offset", 0, 0.5, 0.01, words, sizeof words), FE_OK);
+    ck_assert_msg(strstr(words, "d2x/dt2") == NULL && strstr(words, "dT/dt") == NULL, "%s",
+                  words);
+    ck_assert_int_eq(fe_dynamics_explain("offset", 3, 0.5, 0.01, words, sizeof words), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_explain("offset", 2, 0.5, 0.01, NULL, sizeof words), FE_EINVAL);
+    ck_assert_int_eq(fe_dynamics_explain("offset", 2, 0.5, 0.01, words, 0), FE_EINVAL);
+}
+END_TEST
+
 /* The recipe: identify the simulation, carry every term through it, fold
    the signatures with the offset, select.  The real cart has a viscous
    friction the simulation lacks; trajectories part by a few noise sds. */
@@ -879,6 +923,7 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, refusals_at_their_edges);
     tcase_add_test(t, an_identification_split_at_a_break_merges_to_the_whole);
     tcase_add_test(t, the_dynamics_catalog_and_its_words);
+    tcase_add_test(t, every_dynamics_term_is_explained_in_its_own_words);
     tcase_add_test(t, a_missing_viscous_friction_is_named_with_its_coefficient);
     tcase_add_test(t, documented_refusals_by_order_and_value);
     tcase_add_test(t, identification_rows_and_forcings_at_their_edges);

@@ -841,6 +841,21 @@ START_TEST(undamped_rank_test_is_relative_to_the_diagonal)
         FE_ASSERT_REL(x[0], x0, 1e-6);
         FE_ASSERT_REL(row.step, hypot(x0, x1), 1e-6);
     }
+    /* At the tolerance's edge: pivot^2 / A22 = 1.01e-12 is solved and
+       0.99e-12 is refused (the pivot is computed to about 1e-4 of itself,
+       so the two cannot trade places by rounding). */
+    x[0] = x[1] = 0.0;
+    c.d = sqrt(1.01e-12 / (1.0 - 1.01e-12));
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_int_eq(row.accepted, 1);
+    FE_ASSERT_REL(x[1], -1.0 / (2.0 * c.d * 1e3), 1e-3);
+    x[0] = x[1] = 0.0;
+    c.d = sqrt(0.99e-12 / (1.0 - 0.99e-12));
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, stop_at_once, &row, &r),
+                     FE_ESTOPPED);
+    ck_assert_double_eq(row.step, 0.0);
+    ck_assert_int_eq(row.accepted, 0);
     free(w);
 }
 END_TEST

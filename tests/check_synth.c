@@ -41,7 +41,8 @@ START_TEST(spec_refusals_at_their_edges)
     ck_assert_int_eq(fe_synth_init(&g, NULL), FE_EINVAL);
     /* The rig of each order: order 2 is the cart, with no temperature for
        a thermal effect; order 1 the stand, with no velocity for a
-       friction; order 0 takes either; no order above 2. */
+       friction; order 0 takes either; no order above 2.  Both have an
+       input (the cart's force, the stand's heater) for input_gain. */
     {
         static const struct { const char *effect; size_t order; int rc; } rig[] = {
             {"newton_cooling", 2, FE_EINVAL}, {"newton_cooling", 1, FE_OK},
@@ -49,6 +50,7 @@ START_TEST(spec_refusals_at_their_edges)
             {"none_thermal", 2, FE_EINVAL}, {"none_thermal", 1, FE_OK},
             {"viscous_friction", 2, FE_OK}, {"viscous_friction", 1, FE_EINVAL},
             {"viscous_friction", 0, FE_OK}, {"viscous_friction", 3, FE_EINVAL},
+            {"input_gain", 1, FE_OK}, {"input_gain", 2, FE_OK},
         };
         for (size_t i = 0; i < sizeof rig / sizeof rig[0]; i++) {
             s = fe_synth_default_spec(rig[i].effect, 3);
