@@ -1071,9 +1071,13 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
 {
     size_t nst = fe_discover_acc_doubles(NM, NK), dim = NM + 1;
     double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2),
-           *s3 = malloc(nst * sizeof *s3), *s4 = malloc(nst * sizeof *s4);
+           *s3 = malloc(nst * sizeof *s3), *s4 = malloc(nst * sizeof *s4),
+           *s6 = malloc(nst * sizeof *s6);
     static double cols[NM][NN];
-    fe_discover_acc rows, panels, columns, part;
+    /* Columns in pieces of 1 to 13 rows: under 8 a piece goes row by row
+       through the lagged products, from 8 by panels. */
+    static const size_t piece[] = {1, 2, 5, 7, 8, 13, 3};
+    fe_discover_acc rows, panels, columns, part, pieces;
     const size_t cuts[3] = {0, 700, 1103};       /* parts, the second ends past the break */
     noise_rows();
     for (size_t t = 0; t < NN; t++)
@@ -1095,6 +1099,17 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
     fe_discover_break(&columns);
     ck_assert_int_eq(fe_discover_add_columns(&columns, cols[0] + NBREAK, NN, nr + NBREAK,
                                              NN - NBREAK, NULL), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&pieces, NM, NK, NFIT, 0, s6, nst), FE_OK);
+    for (size_t t = 0, p = 0; t < NN; p++) {
+        size_t q = piece[p % (sizeof piece / sizeof *piece)], stop = t < NBREAK ? NBREAK : NN;
+        if (q > stop - t)
+            q = stop - t;
+        ck_assert_int_eq(fe_discover_add_columns(&pieces, cols[0] + t, NN, nr + t, q, NULL),
+                         FE_OK);
+        t += q;
+        if (t == NBREAK)
+            fe_discover_break(&pieces);
+    }
     /* Three parts merged, the break inside the second (3 rows before its end). */
     {
         fe_discover_acc merged;
@@ -1121,8 +1136,8 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
                         want[c] += nphi[t][c];
                     want[NM] += nr[t];
                 }
-            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
-            for (int q = 0; q < 4; q++) {
+            const fe_discover_acc *acc[5] = {&rows, &panels, &columns, &merged, &pieces};
+            for (int q = 0; q < 5; q++) {
                 for (size_t c = 0; c <= NM; c++)
                     FE_ASSERT_REL(acc[q]->fsum[k * dim + c] + 1.0, (double)want[c] + 1.0, 1e-11);
             }
@@ -1136,8 +1151,8 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
                         want[c] += nphi[t][c];
                     want[NM] += nr[t];
                 }
-            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
-            for (int q = 0; q < 4; q++)
+            const fe_discover_acc *acc[5] = {&rows, &panels, &columns, &merged, &pieces};
+            for (int q = 0; q < 5; q++)
                 for (size_t c = 0; c <= NM; c++)
                     FE_ASSERT_REL(acc[q]->bsum[k * dim + c] + 1.0, (double)want[c] + 1.0, 1e-11);
         }
@@ -1147,14 +1162,14 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
         {
             enum { E = FE_DISCOVER_EDGE, NE = FE_DISCOVER_EDGE * (NM + 1) };
             double xs[NE], xe[NE];
-            const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
+            const fe_discover_acc *acc[5] = {&rows, &panels, &columns, &merged, &pieces};
             for (size_t u = 0; u < E; u++)
                 for (size_t c = 0; c <= NM; c++) {
                     size_t ts = NBREAK + u, te = NBREAK - 1 - u;
                     xs[u * dim + c] = c < NM ? nphi[ts][c] : nr[ts];
                     xe[u * dim + c] = c < NM ? nphi[te][c] : nr[te];
                 }
-            for (int q = 0; q < 4; q++)
+            for (int q = 0; q < 5; q++)
                 for (size_t i = 0; i < NE; i++)
                     for (size_t j = 0; j < NE; j++) {
                         ck_assert_double_eq_tol(acc[q]->edge_start[i * NE + j], xs[i] * xs[j],
@@ -1167,8 +1182,8 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
             for (size_t i = 0; i < dim; i++)
                 for (size_t j = 0; j < dim; j++) {
                     double want = brute_lag(l, i, j);
-                    const fe_discover_acc *acc[4] = {&rows, &panels, &columns, &merged};
-                    for (int q = 0; q < 4; q++)
+                    const fe_discover_acc *acc[5] = {&rows, &panels, &columns, &merged, &pieces};
+                    for (int q = 0; q < 5; q++)
                         FE_ASSERT_REL(acc[q]->zlag[(l - 1) * dim * dim + i * dim + j] + 1.0,
                                       want + 1.0, 1e-11);
                 }
@@ -1178,6 +1193,7 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
     free(s2);
     free(s3);
     free(s4);
+    free(s6);
 }
 END_TEST
 
