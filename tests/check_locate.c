@@ -833,6 +833,45 @@ START_TEST(the_largest_statistic_after_the_terms_looks_at_the_regions)
         double w = k == 0 ? 1.0 : k == 1 ? 0.5 : 0.05;
         ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), sqrt(20.0 * w), 1e-12);
     }
+    /* The four speed bands split 0 .. vmax (here 1) in quarters. */
+    {
+        int band = 0;
+        for (size_t g = 0; g < m.nregions; g++)
+            if (m.region[g] == FE_REGION_SPEED) {
+                ck_assert_double_eq(m.region_lo[g], band / 4.0);
+                ck_assert_double_eq(m.region_hi[g], (band + 1) / 4.0);
+                band++;
+            }
+        ck_assert_int_eq(band, 4);
+    }
+}
+END_TEST
+
+/* A cell is tested from 2 rows: rows 0 .. 37 at v = +0.5 with residuals
+   -1, +1, ... (mean 0) and rows 38, 39 at v = -0.5 with residual +1.
+   All 40 rows: mean 0.05, mean square 1, so every z is 0; the region
+   v < 0 (2 rows, mean 1) has t = 0.95 sqrt(2 w), larger than block 3's
+   (0.2 - 0.05) sqrt(10 w) and the region v > 0's 0.05 sqrt(38 w).  With
+   only row 39 at v = -0.5 the region of one row is not tested, v > 0
+   (39 rows, more than all but 2) neither, and the blocks' means are 0:
+   the largest statistic is 0. */
+START_TEST(cells_of_two_rows_are_tested_and_of_one_not)
+{
+    const double lo[3] = {0, -1, 0}, hi[3] = {0, 1, 0}, w = 0.5;
+    for (int two = 1; two >= 0; two--) {
+        fe_residual_map m;
+        ck_assert_int_eq(fe_residual_map_init(&m, 4, 40, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+        for (int i = 0; i < 40; i++) {
+            fe_sample s = {0};
+            int apart = i >= (two ? 38 : 39);
+            double e = apart ? 1.0 : i % 2 ? 1.0 : -1.0;
+            s.t = i;
+            s.velocity = apart ? -0.5 : 0.5;
+            ck_assert_int_eq(fe_residual_map_add(&m, &s, e, e), FE_OK);
+        }
+        ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w),
+                                two ? 0.95 * sqrt(2.0 * w) : 0.0, 1e-12);
+    }
 }
 END_TEST
 
@@ -1210,6 +1249,7 @@ Suite *fe_locate_suite(void)
     tcase_set_timeout(t, 300);
     tcase_add_test(t, block_statistics_match_a_direct_computation);
     tcase_add_test(t, the_largest_statistic_after_the_terms_looks_at_the_regions);
+    tcase_add_test(t, cells_of_two_rows_are_tested_and_of_one_not);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);

@@ -646,6 +646,44 @@ START_TEST(blocked_rows_stop_exactly_at_the_bad_row)
 }
 END_TEST
 
+/* fe_lsq_add_rows' refusals at their edges: one row needs no stride
+   (ldj 0 and p - 1 are taken for m = 1), two rows need ldj >= p (p - 1
+   refused, p taken); null arguments are refused with nothing folded, and
+   a null J is fine when p = 0; a negative weight is refused as by
+   fe_lsq_add, after the rows before it. */
+START_TEST(add_rows_arguments_at_their_edges)
+{
+    enum { Q = 3 };
+    double g[(Q + 1) * (Q + 1)], g0[1], J[2 * Q] = {1, 2, 3, 4, 5, 6}, r[2] = {1, 2},
+           w[2] = {1, -1};
+    fe_lsq a, e;
+    size_t done = 9;
+    ck_assert_int_eq(fe_lsq_init(&a, Q, g), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, 0, r, NULL, 1, &done), FE_OK);
+    ck_assert_uint_eq(done, 1);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, Q - 1, r, NULL, 1, &done), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, Q - 1, r, NULL, 2, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, Q, r, NULL, 2, &done), FE_OK);
+    ck_assert_uint_eq(done, 2);
+    ck_assert_uint_eq(a.n, 4);
+    /* (1, 2, 3) three times and (4, 5, 6) once: G_00 = 3 + 16. */
+    ck_assert_double_eq(g[0], 19.0);
+    ck_assert_int_eq(fe_lsq_add_rows(NULL, J, Q, r, NULL, 2, &done), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, NULL, Q, r, NULL, 2, &done), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, Q, NULL, NULL, 2, &done), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, NULL, Q, NULL, NULL, 0, &done), FE_OK);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_uint_eq(a.n, 4);
+    ck_assert_int_eq(fe_lsq_init(&e, 0, g0), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_rows(&e, NULL, 0, r, NULL, 2, &done), FE_OK);
+    ck_assert_double_eq(g0[0], 5.0);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, Q, r, w, 2, &done), FE_EINVAL);
+    ck_assert_uint_eq(done, 1);
+    ck_assert_uint_eq(a.n, 5);
+}
+END_TEST
+
 /* A merge whose diagonal sum would pass DBL_MAX / 4 (the room the
    library keeps for the solve) is refused with `a` unchanged; one that
    reaches it exactly is taken. */
@@ -779,6 +817,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, exact_fit_has_zero_rss);
     tcase_add_test(t, sparse_rows_equal_dense_rows);
     tcase_add_test(t, blocked_rows_stop_exactly_at_the_bad_row);
+    tcase_add_test(t, add_rows_arguments_at_their_edges);
     tcase_add_test(t, merge_overflow_at_its_edge);
     tcase_add_test(t, weights_indices_and_counts_at_their_edges);
     tcase_add_test(t, rank_test_at_its_edge);

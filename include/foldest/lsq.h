@@ -59,7 +59,10 @@ int fe_lsq_add(fe_lsq *a, const double *j, double r, double w);
    weight w[i] (w NULL: all weights 1).  Stops at the first row refused;
    `*done` (if not NULL) receives how many were folded.  Unweighted rows
    go through BLAS in blocks (equal to fe_lsq_add row by row up to
-   rounding, several times faster for p >= 16). */
+   rounding, several times faster for p >= 16).  Errors: those of
+   fe_lsq_add for the row refused (the rows before it stay folded);
+   FE_EINVAL, nothing folded, for a null a, a null r (or J, with p > 0)
+   when m > 0, or ldj < p when m > 1 (one row needs no stride). */
 int fe_lsq_add_rows(fe_lsq *a, const double *J, size_t ldj, const double *r,
                     const double *w, size_t m, size_t *done);
 
