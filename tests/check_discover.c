@@ -716,6 +716,12 @@ START_TEST(screen_refuses_what_it_cannot_answer)
     ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_EINVAL);
     ck_assert_int_eq(fe_discover_fit_columns(&a, cols, 2, coef, NULL, &fit, w, nw), FE_EINVAL);
     ck_assert_int_eq(fe_discover_fit_columns(&a, base, 2, coef, NULL, &fit, w, nw), FE_OK);
+    /* Null arguments, each alone; cols and coef may be null for no column. */
+    ck_assert_int_eq(fe_discover_fit_columns(NULL, base, 2, coef, NULL, &fit, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, base, 2, coef, NULL, NULL, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, NULL, 2, coef, NULL, &fit, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, base, 2, NULL, NULL, &fit, w, nw), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_fit_columns(&a, NULL, 0, NULL, NULL, &fit, w, nw), FE_OK);
     ck_assert_int_eq(fe_discover_acc_init(&b, WM, PK, PFIT, 0, s2, nst), FE_OK);
     ck_assert_int_eq(fe_discover_merge(&b, &a), FE_EMISMATCH);
     ck_assert_int_eq(fe_discover_copy(&b, &a), FE_EMISMATCH);

@@ -431,7 +431,9 @@ int fe_discover_select(const fe_discover_acc *a,
    the accumulation: coefficients, batch-means standard errors and the
    summary.  Used for the baseline and the final model, and by callers
    who want a model of their own choosing.  From a screen, only columns
-   among its base columns (FE_EINVAL otherwise). */
+   among its base columns (FE_EINVAL otherwise).  FE_EINVAL too for a null
+   a or fit, or a null cols or coef with ncols > 0 (both may be null for
+   no column: the fit of r alone). */
 int fe_discover_fit_columns(const fe_discover_acc *a, const size_t *cols,
                             size_t ncols, double *coef, double *stderr_,
                             fe_discover_fit *fit, double *work,
