@@ -620,6 +620,18 @@ START_TEST(edges_of_the_sizes_models_and_sums)
         ck_assert_int_eq(fe_kalman_predict(&f.k, &bad), FE_ENONFINITE);
         ck_assert_double_eq(f.k.x[0], 2.0);
         ck_assert_double_eq(f.k.P[3], 2.0);
+        /* A control matrix with m = 0 inputs is no control either: u is
+           not needed (null), and the prediction is the same. */
+        {
+            fe_kalman_model none = {Phi, Gamma, NULL, 0, NULL};
+            kf g;
+            kf_make(&g, 2, 1);
+            ck_assert_int_eq(fe_kalman_set_prior(&g.k, x0, P0), FE_OK);
+            ck_assert_int_eq(fe_kalman_predict(&g.k, &none), FE_OK);
+            ck_assert_double_eq_tol(g.k.x[0], 4.0, 1e-15);
+            ck_assert_double_eq_tol(g.k.P[0], 1.5, 1e-15);
+            kf_free(&g);
+        }
         ck_assert_int_eq(fe_kalman_predict(&f.k, &nog), FE_OK);
         /* x = (2 + 0.5*4, 4); P = [[1 + 0.25*2, 0.5*2], [1, 2]]. */
         ck_assert_double_eq_tol(f.k.x[0], 4.0, 1e-15);
@@ -713,6 +725,14 @@ START_TEST(edges_of_the_sizes_models_and_sums)
         for (int i = 0; i < 4; i++)
             ck_assert_double_eq(a.s.Lambda[i], 0.0);
         ck_assert(a.s.eta[0] == 0.0 && a.s.eta[1] == 0.0);
+        /* x0 / p0 overflowing in either entry alone (1e300 / 1e-10) is
+           refused, and the prior is the one before (p0 = infinity). */
+        for (int k = 0; k < 2; k++) {
+            bad[0] = k == 0 ? 1e300 : 1.0;
+            bad[1] = k == 1 ? -1e300 : -4.0;
+            ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&a.s, bad, 1e-10), FE_ENONFINITE);
+            ck_assert(a.s.Lambda[0] == 0.0 && a.s.eta[0] == 0.0 && a.s.eta[1] == 0.0);
+        }
         free(a.mem);
     }
 }
