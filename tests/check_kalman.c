@@ -1451,6 +1451,43 @@ START_TEST(monitor_scans_and_refuses)
 }
 END_TEST
 
+/* The two CUSUMs step by step against their formula (Page's recursion on
+   the log-likelihood ratio of the NIS, chi-square on b degrees of
+   freedom, scaled by lambda against 1): S <- max(0, S + llr), llr =
+   -(b/2) ln lambda + (NIS/2)(1 - 1/lambda), lambda 3 up and 0.3 down,
+   for reports of 1 to 3 dimensions and NIS from 0 to 12, under a
+   threshold no sum reaches. */
+START_TEST(cusums_follow_their_recursion)
+{
+    fe_kalman_monitor_params p = fe_kalman_monitor_default_params();
+    fe_kalman_monitor m;
+    double up = 0.0, down = 0.0, top_up = 0.0, top_down = 0.0;
+    p.scale_up = 3.0;
+    p.scale_down = 0.3;
+    p.threshold = 1e9;
+    ck_assert_int_eq(fe_kalman_monitor_init(&m, &p), FE_OK);
+    for (int k = 0; k < 60; k++) {
+        size_t b = 1 + (size_t)(k % 3);
+        double nis = (double)((k * 7) % 13);
+        fe_kalman_report r = {b, nis, 0.0, NULL, NULL, NULL};
+        double lu = -0.5 * (double)b * log(3.0) + 0.5 * nis * (1.0 - 1.0 / 3.0);
+        double ld = -0.5 * (double)b * log(0.3) + 0.5 * nis * (1.0 - 1.0 / 0.3);
+        ck_assert_int_eq(fe_kalman_monitor_add(&m, &r), FE_OK);
+        up = fmax(0.0, up + lu);
+        down = fmax(0.0, down + ld);
+        top_up = fmax(top_up, up);
+        top_down = fmax(top_down, down);
+        ck_assert_msg(fabs(m.cusum_up - up) <= 1e-12 * (1.0 + up), "step %d: up %.17g, want "
+                      "%.17g", k, m.cusum_up, up);
+        ck_assert_msg(fabs(m.cusum_down - down) <= 1e-12 * (1.0 + down), "step %d: down %.17g, "
+                      "want %.17g", k, m.cusum_down, down);
+    }
+    ck_assert_double_gt(top_up, 1.0);            /* both sums moved */
+    ck_assert_double_gt(top_down, 1.0);
+    ck_assert_uint_eq(m.alarms, 0);
+}
+END_TEST
+
 START_TEST(chi_square_quantiles)
 {
     /* Tabulated values, six significant digits. */
@@ -1766,6 +1803,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, monitor_sees_a_pessimistic_model);
     tcase_add_test(t, wrong_dynamics_show_in_autocorrelation);
     tcase_add_test(t, monitor_scans_and_refuses);
+    tcase_add_test(t, cusums_follow_their_recursion);
     tcase_add_test(t, chi_square_quantiles);
     tcase_add_test(t, the_largest_dimension_is_taken_and_one_more_refused);
     tcase_add_test(t, a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step);
