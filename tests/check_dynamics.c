@@ -349,6 +349,95 @@ static int input_force(const fe_sample *s, double *g, void *user)
     return 0;
 }
 
+/* Every field of a sample the deviation's callbacks see between rows is
+   linear in time, as the header promises: rows at t = 0, 1, 3 whose
+   fields are field_k(t) = k + (k + 1) t / 10 (k = 1 for real, 2 for sim,
+   ...); position and velocity are left out, as the deviation moves them
+   in half of the calls. */
+struct linear_check { int calls, bad; };
+
+static double linear_field(int k, double t)
+{
+    return k + (k + 1) * t / 10.0;
+}
+
+static int fields_are_linear(const fe_sample *s, double *out, void *user)
+{
+    struct linear_check *c = user;
+    const double got[6] = {s->real, s->sim, s->dsim, s->temperature, s->ambient, s->input};
+    static const int k[6] = {1, 2, 3, 6, 7, 8};
+    c->calls++;
+    for (int i = 0; i < 6; i++)
+        if (fabs(got[i] - linear_field(k[i], s->t)) > 1e-13 * (1.0 + fabs(got[i])))
+            c->bad++;
+    *out = -s->position;
+    return 0;
+}
+
+START_TEST(every_field_is_linear_in_time_between_rows)
+{
+    static const double ts[3] = {0.0, 1.0, 3.0};
+    struct linear_check c = {0, 0};
+    fe_dynamics_deviation dv;
+    double a[2] = {-1.0, 0.0}, d[2];
+    ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 2), FE_OK);
+    for (int i = 0; i < 3; i++) {
+        fe_sample s;
+        s.t = ts[i];
+        s.real = linear_field(1, s.t);
+        s.sim = linear_field(2, s.t);
+        s.dsim = linear_field(3, s.t);
+        s.position = linear_field(4, s.t);
+        s.velocity = linear_field(5, s.t);
+        s.temperature = linear_field(6, s.t);
+        s.ambient = linear_field(7, s.t);
+        s.input = linear_field(8, s.t);
+        ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a, fields_are_linear, &c,
+                                                     fields_are_linear, &c, d), FE_OK);
+    }
+    ck_assert_int_gt(c.calls, 2 * 12);          /* 12 calls a substep, 2 row steps */
+    ck_assert_int_eq(c.bad, 0);
+}
+END_TEST
+
+static int stiff_damping(const fe_sample *s, double *d, void *user)
+{
+    (void)user;
+    *d = -0.01 * s->position - 50.0 * s->velocity;
+    return 0;
+}
+
+/* The substeps of a row step follow the faster end's Jacobian: a step
+   from a row that declares a slow rate (a = (-0.01, 0)) to one that
+   declares the true fast one (-0.01, -50) is cut as finely as when both
+   ends declare it (h lambda <= 0.2: 126 substeps of the half-unit step),
+   and so gives the same deviation to the bit; either order of the two. */
+START_TEST(substeps_follow_the_faster_end_of_a_step)
+{
+    const double slow[2] = {-0.01, 0.0}, fast[2] = {-0.01, -50.0};
+    double c = 1.0, want[2], got[2];
+    for (int first_slow = 0; first_slow < 2; first_slow++) {
+        fe_dynamics_deviation dv;
+        for (int run = 0; run < 2; run++) {
+            ck_assert_int_eq(fe_dynamics_deviation_init(&dv, 2), FE_OK);
+            for (int i = 0; i < 2; i++) {
+                fe_sample s;
+                const double *a = run == 0 || (i == 0) != first_slow ? fast : slow;
+                memset(&s, 0, sizeof s);
+                s.t = 0.5 * i;
+                ck_assert_int_eq(fe_dynamics_deviation_step(&dv, &s, a, stiff_damping, NULL,
+                                                            constant_force, &c,
+                                                            run == 0 ? want : got), FE_OK);
+            }
+        }
+        ck_assert_double_eq(got[0], want[0]);
+        ck_assert_double_eq(got[1], want[1]);
+        /* and the rate has settled near c / 50 */
+        ck_assert_double_eq_tol(want[1], c / 50.0, 1e-4);
+    }
+}
+END_TEST
+
 START_TEST(a_deviation_follows_its_closed_form)
 {
     fe_dynamics_deviation dv;
@@ -918,6 +1007,8 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, a_heated_body_is_identified);
     tcase_add_test(t, a_radiating_body_jacobian_follows_its_temperature);
     tcase_add_test(t, a_deviation_follows_its_closed_form);
+    tcase_add_test(t, substeps_follow_the_faster_end_of_a_step);
+    tcase_add_test(t, every_field_is_linear_in_time_between_rows);
     tcase_add_test(t, spans_and_finite_differences_at_zero);
     tcase_add_test(t, refusals_leave_the_state_unchanged);
     tcase_add_test(t, refusals_at_their_edges);
