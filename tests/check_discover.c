@@ -129,6 +129,54 @@ START_TEST(fit_matches_brute_force)
 }
 END_TEST
 
+/* Every test statistic is free of the residual's unit: the same case with
+   r in units 10^4 times larger (r times 1e-4, so that the candidates'
+   products with it are mostly under 1) ranks every candidate of every
+   step with the same statistic, sign included, to 1e-9. */
+START_TEST(statistics_do_not_depend_on_the_residuals_unit)
+{
+    synth_case sc;
+    fe_discover_acc small;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r1 = malloc(sizeof *r1), *r2 = malloc(sizeof *r2);
+    double *st, phi[FE_DISCOVER_MAX_COLUMNS];
+    size_t nst;
+    fe_sample s;
+    int rc = FE_OK;
+    fold_case(&sc, "viscous_friction", 5, 4000, 20, 0.25);
+    nst = fe_discover_acc_doubles(sc.c.count, 20);
+    st = malloc(nst * sizeof *st);
+    ck_assert_int_eq(fe_discover_acc_init(&small, sc.c.count, 20, sc.a.fit_rows, 0, st, nst),
+                     FE_OK);
+    fe_synth_rewind(&sc.g);
+    while (fe_synth_next(&sc.g, &s) == FE_OK) {
+        rc |= fe_catalog_eval(&sc.c, &s, phi);
+        rc |= fe_discover_add(&small, phi, 1e-4 * (s.real - s.sim));
+    }
+    ck_assert_int_eq(rc, FE_OK);
+    select_case(&sc, &o, r1);
+    o.base = sc.base;
+    o.nbase = sc.nbase;
+    ck_assert_int_eq(fe_discover_select(&small, sc.groups, sc.c.count, &o, r2, sc.work, sc.nwork),
+                     FE_OK);
+    ck_assert_uint_gt(r1->nranked[0], 3);
+    for (size_t k = 0; k <= FE_DISCOVER_MAX_STEPS; k++) {
+        ck_assert_uint_eq(r2->nranked[k], r1->nranked[k]);
+        for (size_t i = 0; i < r1->nranked[k]; i++) {
+            const fe_discover_rank *a = &r1->ranking[k][i], *b = &r2->ranking[k][i];
+            ck_assert_uint_eq(b->group, a->group);
+            ck_assert_msg(fabs(b->statistic - a->statistic) <= 1e-9 * (1.0 + fabs(a->statistic)),
+                          "step %zu, group %zu: %.17g in small units, %.17g", k, a->group,
+                          b->statistic, a->statistic);
+        }
+    }
+    free(st);
+    free(r1);
+    free(r2);
+    free_case(&sc);
+}
+END_TEST
+
 START_TEST(each_coefficient_has_its_own_interval)
 {
     /* Each coefficient's 95% interval uses its own degrees of freedom
@@ -2585,6 +2633,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, fit_matches_brute_force);
     tcase_add_test(t, score_is_the_drop_in_rss);
     tcase_add_test(t, each_coefficient_has_its_own_interval);
+    tcase_add_test(t, statistics_do_not_depend_on_the_residuals_unit);
     tcase_add_test(t, heldout_z_is_the_held_out_loss_over_its_spread);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
