@@ -12,6 +12,17 @@
 
 #include "foldest/csv.h"
 #include "foldest/error.h"
+#include "csv_private.h"
+
+/* The split's fast path: SSE2, which every x86-64 processor has, with a
+   compiler that offers its intrinsics and __builtin_ctzll; FE_CSV_PORTABLE
+   builds without it. */
+#if defined(__SSE2__) && defined(__GNUC__) && !defined(FE_CSV_PORTABLE)
+#include <emmintrin.h>
+#define FE__CSV_SSE2 1
+#else
+#define FE__CSV_SSE2 0
+#endif
 /* CSV Includes ends here */
 /* [[file:../literate/csv.org::Read one line][Read one line]] */
 int fe_csv_reader_init(fe_csv_reader *r, int fd, char *buffer, size_t cap)
@@ -145,17 +156,66 @@ static int fe__csv_blank(char c)
     return c == ' ' || c == '\t';
 }
 
-int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
-                 size_t max, size_t *count, size_t *bad_column)
+/* Find the delimiters sixty-four bytes a step (csv.org) */
+#if FE__CSV_SSE2
+/* Bit i set when q[i] is the delimiter (d: it in every byte), for the 16
+   bytes at q. */
+static uint64_t fe__csv_bits16(const char *q, __m128i d)
+{
+    __m128i x = _mm_loadu_si128((const __m128i *)(const void *)q);
+    return (uint64_t)(unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(x, d));
+}
+
+/* The same for the 64 bytes at q, or for the bytes from q to the line's
+   end if fewer (bits past the end clear); `tail` holds the bits of the
+   line's last 16 bytes, when it has 16. */
+static uint64_t fe__csv_bits64(const char *q, const char *line, const char *end, char delimiter,
+                               __m128i d, uint64_t tail)
+{
+    size_t n = (size_t)(end - q), i = 0;
+    uint64_t m = 0;
+    if (n >= 64)
+        return fe__csv_bits16(q, d) | fe__csv_bits16(q + 16, d) << 16
+               | fe__csv_bits16(q + 32, d) << 32 | fe__csv_bits16(q + 48, d) << 48;
+    for (; i + 16 <= n; i += 16)
+        m |= fe__csv_bits16(q + i, d) << i;
+    if (i < n && end - line >= 16) {
+        m |= tail >> (16 - (n - i)) << i;       /* the last n - i of the 16 */
+    } else {
+        for (; i < n; i++)
+            m |= (uint64_t)(q[i] == delimiter) << i;
+    }
+    return m;
+}
+#endif
+
+/* The split; `simd` asks for the fast path over plain fields where it is
+   compiled (the tests ask for both). */
+static int fe__csv_split(char *line, char delimiter, fe_csv_field *fields,
+                         size_t max, size_t *count, size_t *bad_column, int simd)
 {
     char *p = line, *end;
     size_t k = 0;
     int ws = delimiter == FE_CSV_WHITESPACE;
+#if FE__CSV_SSE2
+    __m128i d = _mm_set1_epi8(delimiter);
+    uint64_t tail = 0, m = 0;
+    char *base = line;
+#endif
 
     if (line == NULL || count == NULL || (fields == NULL && max > 0))
         return FE_EINVAL;
     *count = 0;
     end = line + strlen(line);
+#if FE__CSV_SSE2
+    simd = simd && !ws;
+    if (simd) {                 /* before any byte of the line is written */
+        tail = end - line >= 16 ? fe__csv_bits16(end - 16, d) : 0;
+        m = fe__csv_bits64(line, line, end, delimiter, d, tail);
+    }
+#else
+    (void)simd;
+#endif
     if (ws) {
         while (fe__csv_blank(*p))
             p++;
@@ -164,6 +224,43 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
     }
     for (;;) {
         char *out, *field_start;
+#if FE__CSV_SSE2
+        if (simd) {
+            /* Split the plain fields at the bits of the delimiter mask (csv.org) */
+            size_t off = (size_t)(p - base);
+            if (off < 64) {
+                m = m >> off << off;
+            } else {
+                base = p;
+                m = fe__csv_bits64(base, line, end, delimiter, d, tail);
+            }
+            while (!fe__csv_blank(*p) && *p != '"') {
+                char *q;
+                while (m == 0 && end - base > 64) {
+                    base += 64;
+                    m = fe__csv_bits64(base, line, end, delimiter, d, tail);
+                }
+                q = m != 0 ? base + __builtin_ctzll(m) : end;
+                if (q > p && fe__csv_blank(q[-1]))
+                    break;                          /* a blank to trim: not plain */
+                if (k == max) {
+                    *count = max + 1;
+                    return FE_ESIZE;
+                }
+                fields[k].text = p;
+                fields[k].column = (size_t)(p - line) + 1;
+                k++;
+                if (q == end) {
+                    *count = k;
+                    return FE_OK;
+                }
+                *q = '\0';
+                p = q + 1;
+                m &= m - 1;
+            }
+            *count = k;
+        }
+#endif
         while (!ws && fe__csv_blank(*p))
             p++;
         field_start = p;
@@ -195,8 +292,8 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
             }
         } else {
             if (!ws) {                  /* memchr: many bytes a step */
-                char *d = memchr(p, delimiter, (size_t)(end - p));
-                p = d != NULL ? d : end;
+                char *dl = memchr(p, delimiter, (size_t)(end - p));
+                p = dl != NULL ? dl : end;
             } else {
                 while (*p != '\0' && !fe__csv_blank(*p))
                     p++;
@@ -228,6 +325,18 @@ int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
         }
     }
 }
+
+int fe_csv_split(char *line, char delimiter, fe_csv_field *fields,
+                 size_t max, size_t *count, size_t *bad_column)
+{
+    return fe__csv_split(line, delimiter, fields, max, count, bad_column, 1);
+}
+
+int fe__csv_split_portable(char *line, char delimiter, fe_csv_field *fields,
+                           size_t max, size_t *count, size_t *bad_column)
+{
+    return fe__csv_split(line, delimiter, fields, max, count, bad_column, 0);
+}
 /* Split a line into fields ends here */
 /* [[file:../literate/csv.org::Parse a field as a number][Parse a field as a number]] */
 /* 10^0 .. 10^22: every one a double exactly. */
@@ -235,35 +344,52 @@ static const double fe__csv_pow10[23] = {
     1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+/* w * 10^n plus the n digits at s, two a step; s past them.  s[1] is read
+   only when s[0] is a digit, so never a byte past the NUL. */
+static const char *fe__csv_digits(const char *s, uint64_t *w)
+{
+    uint64_t v = *w;
+    for (;;) {
+        unsigned d0 = (unsigned)(unsigned char)s[0] - '0', d1;
+        if (d0 > 9)
+            break;
+        d1 = (unsigned)(unsigned char)s[1] - '0';
+        if (d1 > 9) {
+            v = 10 * v + d0;
+            s++;
+            break;
+        }
+        v = 100 * v + (10 * d0 + d1);
+        s += 2;
+    }
+    *w = v;
+    return s;
+}
+
 /* A whole field that is a plain decimal with w <= 2^53 and |q| <= 22 (see
    the text): *value, and 1.  Otherwise 0, and strtod decides.  At most 19
    digits in all keep w below 10^19 < 2^64, so the digits are read
    without a test for overflow; w <= 2^53 is asked once, at the end. */
 static int fe__csv_fast_number(const char *s, double *value)
 {
+    static const double sign[2] = {1.0, -1.0};
     uint64_t w = 0;
-    int q = 0, neg = 0;
-    const char *first;
+    int q = 0, neg = *s == '-';
+    const char *first, *point;
     double v;
-    if (*s == '+' || *s == '-')
-        neg = *s++ == '-';
+    s += neg | (*s == '+');                     /* no branch on the sign */
     first = s;
-    while ((unsigned)(*s - '0') < 10u)
-        w = 10 * w + (uint64_t)(*s++ - '0');
-    if (*s == '.') {
-        const char *point = ++s;
-        while ((unsigned)(*s - '0') < 10u)
-            w = 10 * w + (uint64_t)(*s++ - '0');
-        q = -(int)(s - point);
-        if (s - first > 20)                     /* 19 digits and the point */
-            return 0;
-    } else if (s - first > 19) {
-        return 0;
+    s = point = fe__csv_digits(s, &w);
+    if (*point == '.') {
+        s = fe__csv_digits(point + 1, &w);
+        q = -(int)(s - point - 1);
     }
-    if (s == first || (s == first + 1 && *first == '.'))
-        return 0;                               /* no digit */
-    if (*s == 'e' || *s == 'E') {
+    if ((size_t)(s - first) - (*point == '.') - 1 > 18)
+        return 0;                               /* no digit, or over 19 */
+    if (*s != '\0') {
         int e = 0, eneg = 0;
+        if (*s != 'e' && *s != 'E')
+            return 0;
         s++;
         if (*s == '+' || *s == '-')
             eneg = *s++ == '-';
@@ -272,18 +398,21 @@ static int fe__csv_fast_number(const char *s, double *value)
         for (; (unsigned)(*s - '0') < 10u; s++)
             if (e < 10000)
                 e = 10 * e + (*s - '0');
+        if (*s != '\0')
+            return 0;
         q += eneg ? -e : e;
     }
-    if (*s != '\0' || w > (UINT64_C(1) << 53))
+    if (w > (UINT64_C(1) << 53))
         return 0;
     if (w == 0) {
-        *value = neg ? -0.0 : 0.0;
+        *value = sign[neg] * 0.0;
         return 1;
     }
     if (q < -22 || q > 22)
         return 0;
-    v = q < 0 ? (double)w / fe__csv_pow10[-q] : (double)w * fe__csv_pow10[q];
-    *value = neg ? -v : v;
+    v = (double)(int64_t)w;                     /* w <= 2^53: exact */
+    v = q < 0 ? v / fe__csv_pow10[-q] : v * fe__csv_pow10[q];
+    *value = sign[neg] * v;
     return 1;
 }
 
@@ -390,19 +519,13 @@ int fe_csv_format_double(double v, char *buf, size_t len)
     return FE_OK;
 }
 
-int fe_csv_number(const fe_csv_field *field, double *value)
+/* fe_csv_number past the fast path: the grammar, the words, strtod. */
+static int fe__csv_number_slow(const char *s, double *value)
 {
     char *end, copy[FE_CSV_NUMBER_MAX];
     double v;
-    const char *s;
-
-    if (field == NULL || field->text == NULL || value == NULL)
-        return FE_EINVAL;
-    s = field->text;
     if (*s == '\0')
         return FE_EPARSE;
-    if (fe__csv_fast_number(s, value))
-        return FE_OK;
     if (!fe__csv_plain(s, '.'))
         return fe__csv_nonfinite_word(s) ? FE_ENONFINITE : FE_EPARSE;
     if (fe__csv_c_locale(s, copy, sizeof copy, &s) != FE_OK)
@@ -417,6 +540,15 @@ int fe_csv_number(const fe_csv_field *field, double *value)
         return FE_ENONFINITE;   /* overflow; an underflow to 0 or a denormal is kept */
     *value = v;
     return FE_OK;
+}
+
+int fe_csv_number(const fe_csv_field *field, double *value)
+{
+    if (field == NULL || field->text == NULL || value == NULL)
+        return FE_EINVAL;
+    if (fe__csv_fast_number(field->text, value))
+        return FE_OK;
+    return fe__csv_number_slow(field->text, value);
 }
 
 int fe_csv_number_comma(const fe_csv_field *field, double *value)

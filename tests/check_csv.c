@@ -9,6 +9,7 @@
 
 #include "foldest.h"
 #include "testutil.h"
+#include "../src/csv_private.h"
 
 /* A reader over `text` through a pipe, with a buffer of `cap` bytes. */
 typedef struct { int fd; char buf[64]; fe_csv_reader r; } pipe_reader;
@@ -540,6 +541,265 @@ START_TEST(a_decimal_comma_field_of_255_bytes_is_read_and_256_refused)
 }
 END_TEST
 
+/* The split as the chapter states it, one byte at a time and nothing
+   else: the oracle for fe_csv_split (its SSE2 fast path over plain fields,
+   where compiled) and fe__csv_split_portable (the general loop alone). */
+static int ref_blank(char c)
+{
+    return c == ' ' || c == '\t';
+}
+
+static int ref_split(char *line, char delim, fe_csv_field *f, size_t max, size_t *count,
+                     size_t *bad)
+{
+    int ws = delim == FE_CSV_WHITESPACE;
+    char *p = line;
+    size_t k = 0;
+    *count = 0;
+    if (ws) {
+        while (ref_blank(*p))
+            p++;
+        if (*p == '\0')
+            return FE_OK;
+    }
+    for (;;) {
+        char *start, *out, c;
+        while (!ws && ref_blank(*p))
+            p++;
+        start = out = p;
+        if (*p == '"') {
+            for (p++;;) {
+                if (*p == '\0') {
+                    *bad = (size_t)(start - line) + 1;
+                    return FE_EPARSE;
+                }
+                if (p[0] == '"' && p[1] == '"') {
+                    *out++ = '"';
+                    p += 2;
+                } else if (*p == '"') {
+                    p++;
+                    break;
+                } else {
+                    *out++ = *p++;
+                }
+            }
+            while (ref_blank(*p))
+                p++;
+            if (!ws && *p != '\0' && *p != delim) {
+                *bad = (size_t)(p - line) + 1;
+                return FE_EPARSE;
+            }
+        } else {
+            while (*p != '\0' && (ws ? !ref_blank(*p) : *p != delim))
+                p++;
+            out = p;
+            while (out > start && ref_blank(out[-1]))
+                out--;
+        }
+        if (k == max) {
+            *count = max + 1;
+            return FE_ESIZE;
+        }
+        f[k].text = start;
+        f[k].column = (size_t)(start - line) + 1;
+        *count = ++k;
+        while (ws && ref_blank(*p))
+            p++;
+        c = *p;
+        *out = '\0';
+        if (c == '\0')
+            return FE_OK;
+        if (!ws)
+            p++;
+    }
+}
+
+typedef int split_fn(char *, char, fe_csv_field *, size_t, size_t *, size_t *);
+
+/* `text` (n bytes) split by `split` and by the oracle, each on its own
+   copy placed `off` bytes into a buffer of exactly off + n + 1 bytes (so
+   that AddressSanitizer sees a read past the NUL) whose first bytes are
+   delimiters: the same status, count, bad column, fields, columns, and
+   the same bytes left in the line. */
+static void split_alike(split_fn *split, const char *name, const char *text, size_t n,
+                        char delim, size_t max, size_t off)
+{
+    enum { MAXF = 200 };
+    fe_csv_field got[MAXF], want[MAXF];
+    size_t ngot = 99, nwant = 99, badgot = 0, badwant = 0;
+    char *a = malloc(off + n + 1), *b = malloc(off + n + 1);
+    int rgot, rwant;
+    if (a == NULL || b == NULL)
+        ck_abort_msg("out of memory");
+    memset(a, delim == FE_CSV_WHITESPACE ? ' ' : delim, off);
+    memset(b, delim == FE_CSV_WHITESPACE ? ' ' : delim, off);
+    memcpy(a + off, text, n);
+    memcpy(b + off, text, n);
+    a[off + n] = b[off + n] = '\0';
+    rgot = split(a + off, delim, got, max, &ngot, &badgot);
+    rwant = ref_split(b + off, delim, want, max, &nwant, &badwant);
+    /* Check's assertions cost a write each: test first, assert on a failure. */
+    if (rgot != rwant || ngot != nwant || badgot != badwant)
+        ck_abort_msg("%s '%.*s' delimiter '%c' max %zu at offset %zu: status %d count %zu "
+                     "bad %zu, oracle %d %zu %zu", name, (int)n, text, delim, max, off, rgot, ngot,
+                     badgot, rwant, nwant, badwant);
+    for (size_t i = 0; i < nwant && i < max; i++) {
+        if (got[i].text - a != want[i].text - b || got[i].column != want[i].column
+            || strcmp(got[i].text, want[i].text) != 0)
+            ck_abort_msg("%s '%.*s' delimiter '%c' at offset %zu: field %zu '%s' at %zu, "
+                         "oracle '%s' at %zu", name, (int)n, text, delim, off, i, got[i].text,
+                         got[i].column, want[i].text, want[i].column);
+    }
+    if (memcmp(a, b, off + n + 1) != 0)
+        ck_abort_msg("%s '%.*s': other bytes written", name, (int)n, text);
+    free(a);
+    free(b);
+}
+
+static void split_alike_both(const char *text, size_t n, char delim, size_t max, size_t off)
+{
+    split_alike(fe_csv_split, "fe_csv_split", text, n, delim, max, off);
+    split_alike(fe__csv_split_portable, "fe__csv_split_portable", text, n, delim, max, off);
+}
+
+/* Every length up to 80 (across 16, 32 and 64 bytes), plain fields of
+   several widths, one quote, blank or delimiter put at every position,
+   each line at the offsets 0 to 15 of a 16-byte window in turn.  Under
+   valgrind (FE_TEST_QUICK) three widths of the eight. */
+START_TEST(split_fast_path_matches_the_oracle_at_every_offset)
+{
+    static const size_t period[] = {2, 9, 17, 1, 3, 8, 16, 1000};
+    static const char special[] = {'"', ' ', '\t', ',', 'x'};
+    size_t widths = fe_test_quick() ? 3 : sizeof period / sizeof *period;
+    char text[96];
+    size_t lines = 0;
+    for (size_t n = 0; n <= 80; n++)
+        for (size_t w = 0; w < widths; w++)
+            for (size_t j = 0; j <= n; j++)
+                for (size_t c = 0; c < sizeof special; c++) {
+                    for (size_t i = 0; i < n; i++)
+                        text[i] = i % period[w] == period[w] - 1 ? ',' : (char)('0' + i % 10);
+                    if (j < n)
+                        text[j] = special[c];
+                    else if (c > 0)
+                        continue;               /* j == n: the line as it is, once */
+                    split_alike_both(text, n, ',', 100, (n + j + c) % 16);
+                    lines++;
+                }
+    ck_assert_uint_gt(lines, 30000);
+}
+END_TEST
+
+/* Random lines over small alphabets (dense in quotes and blanks, plain
+   numbers, long runs without a delimiter), every delimiter, the white
+   space mode, a field limit that is often reached, any offset. */
+START_TEST(split_fast_path_matches_the_oracle_on_random_lines)
+{
+    static const char *const alphabet[] = {"1.-,;\t \"a", "0123456789.,-", "0123456789.-,",
+                                           "abcdefghij\"\"  ,", "0123456789;,\t", "\"\",,  \t"};
+    static const char delims[] = {',', ';', '\t', FE_CSV_WHITESPACE};
+    fe_rng g = fe_rng_seed(16);
+    int cases = fe_test_quick() ? 5000 : 200000;
+    char text[200];
+    for (int t = 0; t < cases; t++) {
+        const char *al = alphabet[fe_rng_next(&g) % 6];
+        size_t nal = strlen(al), n = fe_rng_next(&g) % 150, max;
+        char delim = delims[fe_rng_next(&g) % 4];
+        int sparse = fe_rng_next(&g) % 4 == 0;
+        for (size_t i = 0; i < n; i++) {
+            char c = al[fe_rng_next(&g) % nal];
+            if (sparse && (c == ',' || c == ';' || c == '\t') && fe_rng_next(&g) % 16 != 0)
+                c = '7';                        /* long fields: chunks with no delimiter */
+            text[i] = c;
+        }
+        max = fe_rng_next(&g) % 3 == 0 ? fe_rng_next(&g) % 12 : 160;
+        split_alike_both(text, n, delim, max, fe_rng_next(&g) % 16);
+    }
+}
+END_TEST
+
+/* A plain decimal as the chapter defines it: [+-] digits [. digits]
+   [(e|E) [+-] digits], with a digit before the exponent. */
+static int ref_plain(const char *s)
+{
+    int digits = 0;
+    if (*s == '+' || *s == '-')
+        s++;
+    for (; *s >= '0' && *s <= '9'; s++)
+        digits++;
+    if (*s == '.')
+        for (s++; *s >= '0' && *s <= '9'; s++)
+            digits++;
+    if (digits == 0)
+        return 0;
+    if (*s == 'e' || *s == 'E') {
+        s++;
+        if (*s == '+' || *s == '-')
+            s++;
+        if (!(*s >= '0' && *s <= '9'))
+            return 0;
+        while (*s >= '0' && *s <= '9')
+            s++;
+    }
+    return *s == '\0';
+}
+
+/* Text over "0123456789.eE+-" and a stray byte or two, most of it shaped
+   like a decimal (sign, 0 to 22 digits, a point, 0 to 22 digits, an
+   exponent): fe_csv_number says what the grammar and strtod say, to the
+   bit, and leaves the value alone when it refuses. */
+START_TEST(numbers_match_the_grammar_and_strtod_on_random_text)
+{
+    static const char alphabet[] = "0123456789.eE+-";
+    fe_rng g = fe_rng_seed(17);
+    int cases = fe_test_quick() ? 10000 : 300000;
+    char text[80];
+    for (int t = 0; t < cases; t++) {
+        size_t n = 0;
+        fe_csv_field f = {text, 1};
+        double v = -7.0, want = -7.0;
+        int rc, rwant;
+        if (fe_rng_next(&g) % 4 == 0) {
+            size_t len = fe_rng_next(&g) % 24;
+            for (; n < len; n++)
+                text[n] = alphabet[fe_rng_next(&g) % (sizeof alphabet - 1)];
+        } else {
+            size_t a = fe_rng_next(&g) % 23, b = fe_rng_next(&g) % 23;
+            if (fe_rng_next(&g) % 2)
+                text[n++] = "+-"[fe_rng_next(&g) % 2];
+            for (size_t i = 0; i < a; i++)
+                text[n++] = (char)('0' + fe_rng_next(&g) % 10);
+            if (fe_rng_next(&g) % 4 != 0)
+                text[n++] = '.';
+            for (size_t i = 0; i < b; i++)
+                text[n++] = (char)('0' + fe_rng_next(&g) % 10);
+            if (fe_rng_next(&g) % 4 == 0) {
+                text[n++] = "eE"[fe_rng_next(&g) % 2];
+                if (fe_rng_next(&g) % 2)
+                    text[n++] = "+-"[fe_rng_next(&g) % 2];
+                for (size_t i = fe_rng_next(&g) % 4; i > 0; i--)
+                    text[n++] = (char)('0' + fe_rng_next(&g) % 10);
+            }
+            if (fe_rng_next(&g) % 16 == 0)
+                text[n++] = "x. e1"[fe_rng_next(&g) % 5];
+        }
+        text[n] = '\0';
+        rc = fe_csv_number(&f, &v);
+        if (!ref_plain(text)) {
+            rwant = FE_EPARSE;
+        } else {
+            errno = 0;
+            want = strtod(text, NULL);
+            rwant = !isfinite(want) || (errno == ERANGE && fabs(want) > 1.0) ? FE_ENONFINITE : FE_OK;
+            if (rwant != FE_OK)
+                want = -7.0;
+        }
+        if (rc != rwant || memcmp(&v, &want, sizeof v) != 0)
+            ck_abort_msg("'%s': %d %.17g, want %d %.17g", text, rc, v, rwant, want);
+    }
+}
+END_TEST
+
 Suite *fe_csv_suite(void)
 {
     Suite *s = suite_create("csv");
@@ -560,6 +820,9 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, numbers_read_and_written_alike_in_any_locale);
     tcase_add_test(t, a_line_two_bytes_shorter_than_its_buffer_is_the_longest_read);
     tcase_add_test(t, a_decimal_comma_field_of_255_bytes_is_read_and_256_refused);
+    tcase_add_test(t, split_fast_path_matches_the_oracle_at_every_offset);
+    tcase_add_test(t, split_fast_path_matches_the_oracle_on_random_lines);
+    tcase_add_test(t, numbers_match_the_grammar_and_strtod_on_random_text);
     suite_add_tcase(s, t);
     return s;
 }
