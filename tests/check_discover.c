@@ -2462,6 +2462,35 @@ START_TEST(a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break)
 }
 END_TEST
 
+/* A recording the simulation matches exactly (r = 0 on every row): the
+   noise model's fit gives coefficients 0 and a portmanteau of 0 with
+   p-value 1, not the 0/0 of a lag's autocorrelation over a zero sum of
+   squares. */
+START_TEST(a_residual_that_is_exactly_zero_is_white)
+{
+    enum { M = 2, K = 8, N = 400 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), coef[M], se[M];
+    size_t cols[M] = {0, 1};
+    fe_discover_acc a;
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t i = 0; i < N; i++) {
+        double phi[M] = {1.0, sin(0.1 * (double)i)};
+        ck_assert_int_eq(fe_discover_add(&a, phi, 0.0), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, M, 2, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_double_eq(coef[0], 0.0);
+    ck_assert_double_eq(coef[1], 0.0);
+    ck_assert_uint_gt(nz.lags_tested, 0);
+    ck_assert_double_eq(nz.portmanteau, 0.0);
+    ck_assert_double_eq(nz.portmanteau_p, 1.0);
+    free(st);
+    free(w);
+}
+END_TEST
+
 /* fe_discover_select's FE_ENONFINITE, "sums too large to whiten": a
    residual of AR(1) noise (phi = 0.9) whose sum of squares is finite
    (1.5e308 < DBL_MAX) but whose prewhitened Gram matrix, (1 + phi^2) times
@@ -2665,6 +2694,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, documented_refusals_at_their_edges);
     tcase_add_test(t, a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break);
     tcase_add_test(t, sums_too_large_to_whiten_are_refused);
+    tcase_add_test(t, a_residual_that_is_exactly_zero_is_white);
     tcase_set_timeout(acc, 900);
     tcase_add_test(acc, concealed_effects_are_found_and_nulls_are_not);
     suite_add_tcase(s, t);
