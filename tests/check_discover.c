@@ -2328,7 +2328,7 @@ START_TEST(the_widest_accumulation_folds_and_fits)
     /* FE_DISCOVER_MAX_COLUMNS columns, lagged products kept (the default),
        folded row by row: the fit of the first and the last column equals
        the two-by-two normal equations over the rows, and one more column
-       is refused. */
+       is refused; folded by panels, and into a screen, the same fit. */
     enum { M = FE_DISCOVER_MAX_COLUMNS, K = 4, N = 400 };
     size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
     double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
@@ -2362,6 +2362,28 @@ START_TEST(the_widest_accumulation_folds_and_fits)
     det = s00 * s11 - s01 * s01;
     FE_ASSERT_REL(coef[0], (double)((s11 * y0 - s01 * y1) / det), 1e-10);
     FE_ASSERT_REL(coef[1], (double)((s00 * y1 - s01 * y0) / det), 1e-10);
+    /* The same rows by panels (fe_discover_add_rows) at this width. */
+    {
+        double *st2 = malloc(nst * sizeof *st2), coef2[2];
+        fe_discover_acc b;
+        size_t done = 0;
+        ck_assert_ptr_nonnull(st2);
+        ck_assert_int_eq(fe_discover_acc_init(&b, M, K, N, 0, st2, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_add_rows(&b, phi[0], M, r, N, &done), FE_OK);
+        ck_assert_uint_eq(done, N);
+        ck_assert_int_eq(fe_discover_fit_columns(&b, cols, 2, coef2, NULL, &fit, w, nw), FE_OK);
+        FE_ASSERT_REL(coef2[0], coef[0], 1e-10);
+        FE_ASSERT_REL(coef2[1], coef[1], 1e-10);
+        /* and into a screen of that width (its column path, a pointer per
+           column and r), whose base column 0 fits as in the whole. */
+        ck_assert_int_eq(fe_discover_screen_init(&b, M, 1, K, N, 0, st2, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_add_rows(&b, phi[0], M, r, N, &done), FE_OK);
+        ck_assert_uint_eq(done, N);
+        ck_assert_int_eq(fe_discover_fit_columns(&a, cols, 1, coef, NULL, &fit, w, nw), FE_OK);
+        ck_assert_int_eq(fe_discover_fit_columns(&b, cols, 1, coef2, NULL, &fit, w, nw), FE_OK);
+        FE_ASSERT_REL(coef2[0], coef[0], 1e-12);
+        free(st2);
+    }
     free(st);
     free(w);
 }

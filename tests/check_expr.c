@@ -329,6 +329,11 @@ START_TEST(a_row_stride_equal_to_the_variables_read_is_enough)
     ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 4, 2, out, work, NULL), FE_OK);
     ck_assert_double_eq(out[0], 10.0);
     ck_assert_double_eq(out[1], 14.0);
+    /* Each null argument alone, with everything else right. */
+    ck_assert_int_eq(fe_expr_eval_rows(NULL, rows, 4, 2, out, work, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, NULL, 4, 2, out, work, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 4, 2, NULL, work, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_expr_eval_rows(&e, rows, 4, 2, out, NULL, NULL), FE_EINVAL);
 }
 END_TEST
 

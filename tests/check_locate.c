@@ -203,6 +203,35 @@ START_TEST(blocks_without_pairs_have_no_autocorrelation_test)
 }
 END_TEST
 
+/* The lag-one test of a block is the mean product over the mean square:
+   four blocks of 10 scalar reports of +-1, alternating, each block cut by
+   breaks at its start and middle, so that it holds 8 pairs (each -1) and
+   10 squares (each 1): rho = (-8 / 8) / (10 / 10) = -1, z = rho sqrt(8).
+   The window found carries that statistic. */
+START_TEST(the_lag_one_statistic_is_a_mean_product_over_a_mean_square)
+{
+    fe_innovations inn;
+    fe_located loc[4];
+    size_t n = 0;
+    double w = 1.0;
+    ck_assert_int_eq(fe_innovations_init(&inn, 4, 40, 0), FE_OK);
+    for (int i = 0; i < 40; i++) {
+        fe_kalman_report r = {1, 1.0, 0, NULL, &w, NULL};
+        if (i % 5 == 0)
+            fe_innovations_break(&inn);
+        w = i % 2 ? 1.0 : -1.0;
+        ck_assert_int_eq(fe_innovations_add(&inn, i, &r), FE_OK);
+    }
+    for (int b = 0; b < 4; b++) {
+        ck_assert_double_eq(inn.block[b].acf_terms, 8);
+        ck_assert_double_eq(inn.block[b].sq_terms, 10);
+    }
+    ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, loc, 4, &n), FE_OK);
+    ck_assert_uint_ge(n, 1);
+    ck_assert_double_eq_tol(loc[0].t, -sqrt(8.0), 1e-12);
+}
+END_TEST
+
 START_TEST(merge_of_consecutive_parts_equals_whole)
 {
     /* Reports of one, two, four and six dimensions (whitened vectors
@@ -1251,6 +1280,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, the_largest_statistic_after_the_terms_looks_at_the_regions);
     tcase_add_test(t, cells_of_two_rows_are_tested_and_of_one_not);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
+    tcase_add_test(t, the_lag_one_statistic_is_a_mean_product_over_a_mean_square);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
     tcase_add_test(t, a_lag_one_sum_that_overflows_is_refused);

@@ -141,6 +141,37 @@ START_TEST(bad_arguments_give_nan)
     ck_assert(isnan(fe_student_t_quantile(0, 3)));
     ck_assert_double_eq(fe_student_t_two_sided(INFINITY, 3), 0.0);
     ck_assert_double_eq(fe_f_upper(-1, 2, 3), 1.0);
+    /* I_x(a, b): each argument alone at the edge of its domain (a, b > 0,
+       0 <= x <= 1), just outside it NaN, on it or just inside a value. */
+    {
+        const double tiny = 1e-300, below0 = -DBL_TRUE_MIN, above1 = nextafter(1.0, 2.0);
+        ck_assert(isnan(fe_beta_inc(0.0, 2.0, 0.5)));
+        ck_assert(isnan(fe_beta_inc(2.0, 0.0, 0.5)));
+        ck_assert(isnan(fe_beta_inc(2.0, 2.0, below0)));
+        ck_assert(isnan(fe_beta_inc(2.0, 2.0, above1)));
+        ck_assert(isnan(fe_beta_inc(NAN, 2.0, 0.5)));
+        ck_assert(isnan(fe_beta_inc(2.0, NAN, 0.5)));
+        ck_assert(isnan(fe_beta_inc(2.0, 2.0, NAN)));
+        ck_assert_double_eq(fe_beta_inc(2.0, 2.0, 0.0), 0.0);
+        ck_assert_double_eq(fe_beta_inc(2.0, 2.0, 1.0), 1.0);
+        /* I_x(2, 2) = x^2 (3 - 2 x) */
+        ck_assert_double_eq_tol(fe_beta_inc(2.0, 2.0, 0.25), 0.0625 * 2.5, 1e-15);
+        ck_assert(!isnan(fe_beta_inc(tiny, 2.0, 0.5)) && !isnan(fe_beta_inc(2.0, tiny, 0.5)));
+    }
+    /* P(F > f): d1, d2 > 0 (fractional, under 1, too), f not NaN; with d1 = 2 it is
+       (1 + 2 f / d2)^(-d2 / 2) exactly, and for d1 = 1/2 it is the beta
+       tail I_{d2 / (d2 + d1 f)}(d2 / 2, d1 / 2). */
+    ck_assert(isnan(fe_f_upper(1.0, 0.0, 3.0)));
+    ck_assert(isnan(fe_f_upper(1.0, 3.0, 0.0)));
+    ck_assert(isnan(fe_f_upper(NAN, 3.0, 3.0)));
+    ck_assert_double_eq_tol(fe_f_upper(1.5, 2.0, 6.0), pow(1.0 + 2.0 * 1.5 / 6.0, -3.0), 1e-14);
+    ck_assert_double_eq_tol(fe_f_upper(1.5, 0.5, 6.0),
+                            fe_beta_inc(3.0, 0.25, 6.0 / (6.0 + 0.5 * 1.5)), 1e-14);
+    ck_assert(fe_f_upper(1.5, 0.5, 6.0) > 0.0 && fe_f_upper(1.5, 0.5, 6.0) < 1.0);
+    ck_assert_double_eq_tol(fe_f_upper(1.5, 2.0, 0.5),
+                            fe_beta_inc(0.25, 1.0, 0.5 / (0.5 + 2.0 * 1.5)), 1e-14);
+    /* I_y(d2/2, 1) = y^(d2/2) for d1 = 2 */
+    ck_assert_double_eq_tol(fe_f_upper(1.5, 2.0, 0.5), pow(0.5 / 3.5, 0.25), 1e-14);
 }
 END_TEST
 
