@@ -177,6 +177,40 @@ START_TEST(statistics_do_not_depend_on_the_residuals_unit)
 }
 END_TEST
 
+/* The family-wise level of a step: a candidate enters when its p-value is
+   under alpha over the number of candidates in play (the ranked ones that
+   are not redundant).  With alpha set just above and just below the first
+   step's best p-value times that number, the same term enters, or none. */
+START_TEST(a_step_tests_at_alpha_over_the_candidates_in_play)
+{
+    synth_case sc;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    size_t in_play = 0, first;
+    double p = 2.0;
+    fold_case(&sc, "viscous_friction", 3, 20000, 20, 0.25);
+    select_case(&sc, &o, r);
+    ck_assert_uint_ge(r->steps, 1);
+    first = r->added[0];
+    for (size_t i = 0; i < r->nranked[0]; i++) {
+        in_play += !r->ranking[0][i].redundant;
+        if (r->ranking[0][i].group == first)
+            p = r->ranking[0][i].p_value;
+    }
+    ck_assert_uint_ge(in_play, 3);
+    ck_assert(p > 0.0 && p * in_play < 0.5);
+    o.alpha = p * (double)in_play * (1.0 + 1e-6);
+    select_case(&sc, &o, r);
+    ck_assert_uint_ge(r->steps, 1);
+    ck_assert_uint_eq(r->added[0], first);
+    o.alpha = p * (double)in_play * (1.0 - 1e-6);
+    select_case(&sc, &o, r);
+    ck_assert_uint_eq(r->steps, 0);
+    free(r);
+    free_case(&sc);
+}
+END_TEST
+
 START_TEST(each_coefficient_has_its_own_interval)
 {
     /* Each coefficient's 95% interval uses its own degrees of freedom
@@ -2684,6 +2718,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, fit_matches_brute_force);
     tcase_add_test(t, score_is_the_drop_in_rss);
     tcase_add_test(t, each_coefficient_has_its_own_interval);
+    tcase_add_test(t, a_step_tests_at_alpha_over_the_candidates_in_play);
     tcase_add_test(t, statistics_do_not_depend_on_the_residuals_unit);
     tcase_add_test(t, heldout_z_is_the_held_out_loss_over_its_spread);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
