@@ -415,11 +415,16 @@ static void fe__discover_usage(FILE *out)
           out);
 }
 
-/* The options both modes take with the same ranges: o is --holdout,
-   --alpha or --blocks (FE__DISCOVER_SHARED).  FE_CLI_OK with the value
-   set, or FE_CLI_USAGE with err. */
-#define FE__DISCOVER_SHARED(o) \
-    (strcmp(o, "--holdout") == 0 || strcmp(o, "--alpha") == 0 || strcmp(o, "--blocks") == 0)
+/* Whether o is one of the options both modes take with the same ranges
+   (fe__discover_shared_option parses them). */
+static int fe__discover_is_shared(const char *o)
+{
+    return strcmp(o, "--holdout") == 0 || strcmp(o, "--alpha") == 0
+        || strcmp(o, "--blocks") == 0;
+}
+
+/* One of them (o is --holdout, --alpha or --blocks): FE_CLI_OK with the
+   value set, or FE_CLI_USAGE with err. */
 
 static int fe__discover_shared_option(const char *o, const char *v, double *holdout,
                                       double *alpha, long *blocks, char *err, size_t errlen)
@@ -509,7 +514,7 @@ static int fe__discover_parse(int argc, char **argv, fe__discover_args *a,
             a->exclude = v;
         } else if (strcmp(o, "--report") == 0) {
             a->report = v;
-        } else if (FE__DISCOVER_SHARED(o)) {
+        } else if (fe__discover_is_shared(o)) {
             rc = fe__discover_shared_option(o, v, &a->holdout, &a->alpha, &a->blocks, err, errlen);
         } else if (strcmp(o, "--noise") == 0) {
             if (strcmp(v, "ar") == 0)
@@ -3031,7 +3036,7 @@ static int fe__discover_sphere_main(int argc, char **argv)
                 argv[i][eq - v] = '\0';
                 a.temperature = v;
             }
-        } else if (FE__DISCOVER_SHARED(o)) {
+        } else if (fe__discover_is_shared(o)) {
             rc = fe__discover_shared_option(o, v, &a.holdout, &a.alpha, &a.blocks, err, sizeof err);
         } else {
             snprintf(err, sizeof err, "unknown option '%s' with --sphere", o);
