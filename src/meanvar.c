@@ -6,6 +6,17 @@
 #include "foldest/error.h"
 #include "foldest/meanvar.h"
 
+#include "meanvar_private.h"
+
+#if defined(__SSE2__) && !defined(FE_MEANVAR_PORTABLE)
+#include <emmintrin.h>
+#define FE__MEANVAR_SSE2 1
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define FE__MEANVAR_AVX2 1
+#endif
+#endif
+
 enum { FE__MEANVAR_BLOCK = 512, FE__MEANVAR_LANES = 8 };
 /* Mean and Variance Includes ends here */
 /* [[file:../literate/meanvar.org::Fold one observation][Fold one observation]] */
@@ -54,41 +65,160 @@ int fe_meanvar_merge(fe_meanvar *a, const fe_meanvar *b)
     return FE_OK;
 }
 /* Merge two accumulations ends here */
-/* [[file:../literate/meanvar.org::Summarise one block by corrected two-pass][Summarise one block by corrected two-pass]] */
-static int fe__meanvar_block(const double *x, size_t m, fe_meanvar *out)
+/* [[file:../literate/meanvar.org::Add eight lanes in their fixed order][Add eight lanes in their fixed order]] */
+static double fe__meanvar_lane_total(const double l[FE__MEANVAR_LANES])
 {
-    double s[FE__MEANVAR_LANES] = {0}, q[FE__MEANVAR_LANES] = {0},
-           c[FE__MEANVAR_LANES] = {0};
-    double sum = 0.0, sq = 0.0, corr = 0.0, mean;
-    size_t i = 0, l;
+    return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
+}
+/* Add eight lanes in their fixed order ends here */
+/* [[file:../literate/meanvar.org::Sum a block's lanes by loops][Sum a block's lanes by loops]] */
+static void fe__meanvar_sum_lanes_portable(const double *x, size_t g,
+                                           double s[FE__MEANVAR_LANES])
+{
+    for (size_t l = 0; l < FE__MEANVAR_LANES; l++)
+        s[l] = 0.0;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES)
+        for (size_t l = 0; l < FE__MEANVAR_LANES; l++)
+            s[l] += x[i + l];
+}
+
+static void fe__meanvar_deviate_lanes_portable(const double *x, size_t g, double mean,
+                                               double q[FE__MEANVAR_LANES],
+                                               double c[FE__MEANVAR_LANES])
+{
+    for (size_t l = 0; l < FE__MEANVAR_LANES; l++)
+        q[l] = c[l] = 0.0;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES)
+        for (size_t l = 0; l < FE__MEANVAR_LANES; l++) {
+            double d = x[i + l] - mean;
+            q[l] += d * d;
+            c[l] += d;
+        }
+}
+/* Sum a block's lanes by loops ends here */
+/* [[file:../literate/meanvar.org::Sum a block's lanes in SSE2 registers][Sum a block's lanes in SSE2 registers]] */
+#if FE__MEANVAR_SSE2
+
+static void fe__meanvar_sum_lanes(const double *x, size_t g,
+                                  double s[FE__MEANVAR_LANES])
+{
+    __m128d s01 = _mm_setzero_pd(), s23 = s01, s45 = s01, s67 = s01;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES) {
+        s01 = _mm_add_pd(s01, _mm_loadu_pd(x + i));
+        s23 = _mm_add_pd(s23, _mm_loadu_pd(x + i + 2));
+        s45 = _mm_add_pd(s45, _mm_loadu_pd(x + i + 4));
+        s67 = _mm_add_pd(s67, _mm_loadu_pd(x + i + 6));
+    }
+    _mm_storeu_pd(s, s01);
+    _mm_storeu_pd(s + 2, s23);
+    _mm_storeu_pd(s + 4, s45);
+    _mm_storeu_pd(s + 6, s67);
+}
+
+static void fe__meanvar_deviate_lanes(const double *x, size_t g, double mean,
+                                      double q[FE__MEANVAR_LANES],
+                                      double c[FE__MEANVAR_LANES])
+{
+    const __m128d mu = _mm_set1_pd(mean);
+    __m128d q01 = _mm_setzero_pd(), q23 = q01, q45 = q01, q67 = q01;
+    __m128d c01 = q01, c23 = q01, c45 = q01, c67 = q01;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES) {
+        __m128d d01 = _mm_sub_pd(_mm_loadu_pd(x + i), mu);
+        __m128d d23 = _mm_sub_pd(_mm_loadu_pd(x + i + 2), mu);
+        __m128d d45 = _mm_sub_pd(_mm_loadu_pd(x + i + 4), mu);
+        __m128d d67 = _mm_sub_pd(_mm_loadu_pd(x + i + 6), mu);
+        q01 = _mm_add_pd(q01, _mm_mul_pd(d01, d01));
+        q23 = _mm_add_pd(q23, _mm_mul_pd(d23, d23));
+        q45 = _mm_add_pd(q45, _mm_mul_pd(d45, d45));
+        q67 = _mm_add_pd(q67, _mm_mul_pd(d67, d67));
+        c01 = _mm_add_pd(c01, d01);
+        c23 = _mm_add_pd(c23, d23);
+        c45 = _mm_add_pd(c45, d45);
+        c67 = _mm_add_pd(c67, d67);
+    }
+    _mm_storeu_pd(q, q01);
+    _mm_storeu_pd(q + 2, q23);
+    _mm_storeu_pd(q + 4, q45);
+    _mm_storeu_pd(q + 6, q67);
+    _mm_storeu_pd(c, c01);
+    _mm_storeu_pd(c + 2, c23);
+    _mm_storeu_pd(c + 4, c45);
+    _mm_storeu_pd(c + 6, c67);
+}
+
+#else
+#define fe__meanvar_sum_lanes fe__meanvar_sum_lanes_portable
+#define fe__meanvar_deviate_lanes fe__meanvar_deviate_lanes_portable
+#endif
+/* Sum a block's lanes in SSE2 registers ends here */
+/* [[file:../literate/meanvar.org::Sum a block's lanes in AVX2 registers][Sum a block's lanes in AVX2 registers]] */
+#if FE__MEANVAR_AVX2
+
+__attribute__((target("avx2")))
+static void fe__meanvar_sum_lanes_avx2(const double *x, size_t g,
+                                       double s[FE__MEANVAR_LANES])
+{
+    __m256d s03 = _mm256_setzero_pd(), s47 = s03;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES) {
+        s03 = _mm256_add_pd(s03, _mm256_loadu_pd(x + i));
+        s47 = _mm256_add_pd(s47, _mm256_loadu_pd(x + i + 4));
+    }
+    _mm256_storeu_pd(s, s03);
+    _mm256_storeu_pd(s + 4, s47);
+}
+
+__attribute__((target("avx2")))
+static void fe__meanvar_deviate_lanes_avx2(const double *x, size_t g, double mean,
+                                           double q[FE__MEANVAR_LANES],
+                                           double c[FE__MEANVAR_LANES])
+{
+    const __m256d mu = _mm256_set1_pd(mean);
+    __m256d q03 = _mm256_setzero_pd(), q47 = q03, c03 = q03, c47 = q03;
+    for (size_t i = 0; i < g * FE__MEANVAR_LANES; i += FE__MEANVAR_LANES) {
+        __m256d d03 = _mm256_sub_pd(_mm256_loadu_pd(x + i), mu);
+        __m256d d47 = _mm256_sub_pd(_mm256_loadu_pd(x + i + 4), mu);
+        q03 = _mm256_add_pd(q03, _mm256_mul_pd(d03, d03));
+        q47 = _mm256_add_pd(q47, _mm256_mul_pd(d47, d47));
+        c03 = _mm256_add_pd(c03, d03);
+        c47 = _mm256_add_pd(c47, d47);
+    }
+    _mm256_storeu_pd(q, q03);
+    _mm256_storeu_pd(q + 4, q47);
+    _mm256_storeu_pd(c, c03);
+    _mm256_storeu_pd(c + 4, c47);
+}
+
+#endif
+/* Sum a block's lanes in AVX2 registers ends here */
+/* [[file:../literate/meanvar.org::Summarise one block by corrected two-pass][Summarise one block by corrected two-pass]] */
+typedef void fe__meanvar_sum_fn(const double *, size_t, double *);
+typedef void fe__meanvar_deviate_fn(const double *, size_t, double, double *, double *);
+
+static int fe__meanvar_summarise(const double *x, size_t m, fe_meanvar *out,
+                                 fe__meanvar_sum_fn *sum_lanes,
+                                 fe__meanvar_deviate_fn *deviate_lanes)
+{
+    double s[FE__MEANVAR_LANES], q[FE__MEANVAR_LANES], c[FE__MEANVAR_LANES];
+    double sum, sq, corr, mean;
+    size_t g = m / FE__MEANVAR_LANES, i;
 
     /* First pass: the block's sum, hence its mean. */
-    for (; i + FE__MEANVAR_LANES <= m; i += FE__MEANVAR_LANES)
-        for (l = 0; l < FE__MEANVAR_LANES; l++)
-            s[l] += x[i + l];
-    for (; i < m; i++)
+    sum_lanes(x, g, s);
+    sum = fe__meanvar_lane_total(s);
+    for (i = g * FE__MEANVAR_LANES; i < m; i++)
         sum += x[i];
-    for (l = 0; l < FE__MEANVAR_LANES; l++)
-        sum += s[l];
     if (!isfinite(sum))
         return FE_ENONFINITE;
     mean = sum / (double)m;
 
     /* Second pass: squared deviations and the first-order correction. */
-    for (i = 0; i + FE__MEANVAR_LANES <= m; i += FE__MEANVAR_LANES)
-        for (l = 0; l < FE__MEANVAR_LANES; l++) {
-            double d = x[i + l] - mean;
-            q[l] += d * d;
-            c[l] += d;
-        }
-    for (; i < m; i++) {
+    deviate_lanes(x, g, mean, q, c);
+    sq = fe__meanvar_lane_total(q);
+    corr = fe__meanvar_lane_total(c);
+    for (i = g * FE__MEANVAR_LANES; i < m; i++) {
         double d = x[i] - mean;
         sq += d * d;
         corr += d;
-    }
-    for (l = 0; l < FE__MEANVAR_LANES; l++) {
-        sq += q[l];
-        corr += c[l];
     }
     sq -= corr * corr / (double)m;
     if (!isfinite(sq))
@@ -97,6 +227,23 @@ static int fe__meanvar_block(const double *x, size_t m, fe_meanvar *out)
     out->mean = mean + corr / (double)m;
     out->m2 = sq > 0.0 ? sq : 0.0;
     return FE_OK;
+}
+
+static int fe__meanvar_block(const double *x, size_t m, fe_meanvar *out)
+{
+#if FE__MEANVAR_AVX2
+    if (__builtin_cpu_supports("avx2"))
+        return fe__meanvar_summarise(x, m, out, fe__meanvar_sum_lanes_avx2,
+                                     fe__meanvar_deviate_lanes_avx2);
+#endif
+    return fe__meanvar_summarise(x, m, out, fe__meanvar_sum_lanes,
+                                 fe__meanvar_deviate_lanes);
+}
+
+int fe__meanvar_block_portable(const double *x, size_t m, fe_meanvar *out)
+{
+    return fe__meanvar_summarise(x, m, out, fe__meanvar_sum_lanes_portable,
+                                 fe__meanvar_deviate_lanes_portable);
 }
 /* Summarise one block by corrected two-pass ends here */
 /* [[file:../literate/meanvar.org::Fold an array block by block][Fold an array block by block]] */

@@ -7,6 +7,8 @@
 #include "foldest.h"
 #include "testutil.h"
 
+#include "../src/meanvar_private.h"
+
 static const double ten[10] = {-0.178654, 0.828305, 0.0592247, -0.0121089,
                                -1.48014,  -0.315044, -0.324796, -0.676357,
                                0.16301,   -0.858164};
@@ -203,6 +205,57 @@ START_TEST(streaming_equals_batch)
 }
 END_TEST
 
+/* The block kernels (the AVX2 or SSE2 registers where the processor has
+   them, the loops otherwise) hold the same eight lanes and add them in the
+   same order: a block folded by fe_meanvar_add_many into an empty
+   accumulation has the bits of fe__meanvar_block_portable, the loops alone.
+   The values mix magnitudes by position, so that another order of the
+   squares' lanes rounds differently (the first pass's order is not seen:
+   the correction takes out any error of the provisional mean); both agree
+   with a long-double two-pass sum too.
+   Where the library may fuse multiply-adds (-mfma), the kernels may round
+   a square differently, and only the agreement is asserted. */
+START_TEST(every_kernel_gives_the_loops_bits)
+{
+    static const size_t sizes[] = {1, 2, 7, 8, 9, 15, 16, 17, 63, 64, 65, 255, 511, 512};
+    double x[512];
+    fe_rng r = fe_rng_seed(2611);
+    for (size_t i = 0; i < 512; i++)
+        x[i] = 1e6 * (double)(i % 3) + (1.0 + 1e3 * (double)(i % 8)) * fe_rng_normal(&r);
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        size_t m = sizes[k];
+        fe_meanvar fast = FE_MEANVAR_EMPTY, loops = FE_MEANVAR_EMPTY;
+        long double sum = 0, ss = 0, mean;
+        for (size_t i = 0; i < m; i++)
+            sum += x[i];
+        mean = sum / (long double)m;
+        for (size_t i = 0; i < m; i++)
+            ss += (x[i] - mean) * (x[i] - mean);
+        ck_assert_int_eq(fe_meanvar_add_many(&fast, x, m, NULL), FE_OK);
+        ck_assert_int_eq(fe__meanvar_block_portable(x, m, &loops), FE_OK);
+        ck_assert_uint_eq(fast.n, m);
+        ck_assert_uint_eq(loops.n, m);
+#if !defined(__FMA__)
+        ck_assert_msg(fast.mean == loops.mean && fast.m2 == loops.m2,
+                      "m = %zu: kernel (%.17g, %.17g), loops (%.17g, %.17g)", m,
+                      fast.mean, fast.m2, loops.mean, loops.m2);
+#endif
+        FE_ASSERT_REL(fast.mean, (double)mean, 1e-15);
+        FE_ASSERT_REL(loops.mean, (double)mean, 1e-15);
+        if (m > 1) {
+            FE_ASSERT_REL(fast.m2, (double)ss, 1e-13);
+            FE_ASSERT_REL(loops.m2, (double)ss, 1e-13);
+        }
+    }
+    x[9] = NAN;
+    {
+        fe_meanvar loops = {7, 1.0, 2.0};
+        ck_assert_int_eq(fe__meanvar_block_portable(x, 16, &loops), FE_ENONFINITE);
+        ck_assert(loops.n == 7 && loops.mean == 1.0 && loops.m2 == 2.0);
+    }
+}
+END_TEST
+
 START_TEST(precision_at_large_offset)
 {
     /* 10^7 samples of 1e9 + N(0,1): variance to 1e-6 relative, where the
@@ -300,6 +353,7 @@ Suite *fe_meanvar_suite(void)
     tcase_add_test(t, nonfinite_is_refused_and_nothing_changes);
     tcase_add_test(t, bulk_stops_exactly_at_the_bad_value);
     tcase_add_test(t, streaming_equals_batch);
+    tcase_add_test(t, every_kernel_gives_the_loops_bits);
     tcase_add_test(t, precision_at_large_offset);
     tcase_add_test(t, small_values_far_from_one);
     tcase_add_test(t, merge_overflow_at_its_edge);
