@@ -90,6 +90,14 @@ static const struct cli_case cases[] = {
     {"no bad rows: zero in the JSON", "stats --json", "a\n1\n", 0,
      "\"bad_rows\": {\"total\": 0, "},
     {"--skip-bad-rows after --", "stats -- --skip-bad-rows", "a\n1\n", 2, NULL},
+    /* The fold refuses a square that overflows, at the first such row in
+       file order, even when the column before refuses a later row, and
+       before the reader's complaint about a row after it. */
+    {"the fold refuses the first row in file order", "stats",
+     "a,b\n1,1\n2,1e300\n1e300,3\n", 3, "%s:3: "},
+    {"the fold refuses the first row in file order, first column", "stats",
+     "a,b\n1,1\n1e300,2\n3,1e300\n", 3, "%s:3: "},
+    {"a refusal before a malformed row", "stats", "a\n1\n1e300\nx\n", 3, "%s:3: "},
 };
 
 START_TEST(table_driven)
@@ -102,6 +110,48 @@ START_TEST(table_driven)
     ck_assert_msg(status == c->status, "%s: status %d, want %d; output:\n%s", c->what,
                   status, c->status, out);
     ck_assert_msg(strstr(out, want) != NULL, "%s: output lacks \"%s\":\n%s", c->what, want, out);
+}
+END_TEST
+
+/* The fold takes the rows in runs of 512, column by column: over 1300
+   rows (runs of 512, 512 and 276) the minimum and maximum are right with
+   the extremes in the first row, inside a later run and in the last row,
+   in a column of positive numbers and one of negative ones (neither may
+   start from zero), and the mean and standard deviation are those of a
+   long-double sum over the same numbers. */
+START_TEST(stats_over_runs_of_rows)
+{
+    enum { N = 1300 };
+    static char text[N * 32 + 16];
+    char out[4096], path[64], want[256];
+    size_t len = 0;
+    long double sum[2] = {0, 0}, ss[2] = {0, 0};
+    double x[2][N];
+    len += (size_t)sprintf(text + len, "a,b\n");
+    for (int i = 0; i < N; i++) {
+        x[0][i] = i == 0 ? 5000 : i == 777 ? 1 : 2 + (double)(i % 100);
+        x[1][i] = i == N - 1 ? -5000 : -(double)(i + 1);
+        len += (size_t)sprintf(text + len, "%.17g,%.17g\n", x[0][i], x[1][i]);
+        sum[0] += x[0][i];
+        sum[1] += x[1][i];
+    }
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < N; i++)
+            ss[j] += (x[j][i] - sum[j] / N) * (x[j][i] - sum[j] / N);
+    ck_assert_int_eq(run_on("stats --json", text, len, out, sizeof out, path, sizeof path), 0);
+    for (int j = 0; j < 2; j++) {
+        const char *at = strstr(out, j == 0 ? "\"name\": \"a\"" : "\"name\": \"b\"");
+        double mean, sd, lo, hi;
+        ck_assert_ptr_nonnull(at);
+        ck_assert_int_eq(sscanf(at + 11, ", \"mean\": %lg, \"stddev\": %lg, \"min\": %lg, \"max\": %lg",
+                                &mean, &sd, &lo, &hi), 4);
+        FE_ASSERT_REL(mean, (double)(sum[j] / N), 1e-14);
+        FE_ASSERT_REL(sd, sqrt((double)(ss[j] / (N - 1))), 1e-14);
+        ck_assert_double_eq(lo, j == 0 ? 1 : -5000);
+        ck_assert_double_eq(hi, j == 0 ? 5000 : -1);
+    }
+    snprintf(want, sizeof want, "\"rows\": %d,", N);
+    ck_assert_ptr_nonnull(strstr(out, want));
 }
 END_TEST
 
@@ -628,6 +678,7 @@ Suite *fe_cli_suite(void)
     TCase *t = tcase_create("stats");
     tcase_set_timeout(t, 60);
     tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
+    tcase_add_test(t, stats_over_runs_of_rows);
     tcase_add_test(t, binary_and_long_lines);
     tcase_add_test(t, json_outputs_follow_their_schemas);
     tcase_add_test(t, schema_validator_refuses);

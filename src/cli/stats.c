@@ -19,28 +19,58 @@ static const char fe__stats_help[] =
     "online); the rows are folded in file order, so the result is the same for\n"
     "any N.  Standard input, pipes and gzip files are read by one thread.\n";
 
-/* The fold, one row at a time in file order (fe_cli_table_each). */
+/* The fold, in file order (fe_cli_table_each): the rows wait in a run of
+   FE__STATS_RUN, column by column, with their lines, and each column's run
+   goes to fe_meanvar_add_many, the mean and variance's block kernel. */
+enum { FE__STATS_RUN = 512 };
+
 typedef struct fe__stats_fold {
-    size_t k;
+    size_t k, nrun;             /* columns; rows in the run */
     double *lo, *hi;
     fe_meanvar *mv;
+    double *run;                /* k x FE__STATS_RUN: column j at j * FE__STATS_RUN */
+    size_t run_line[FE__STATS_RUN];
 } fe__stats_fold;
+
+/* Fold the rows waiting in the run.  A value the fold refuses is reported
+   at the first row, in file order, that holds one (a later column may
+   refuse an earlier row): the row the one-value-at-a-time fold stops at. */
+static int fe__stats_fold_run(fe__stats_fold *s, fe_cli_table *t)
+{
+    size_t first = s->nrun;
+    int refused = FE_OK;
+    for (size_t j = 0; j < s->k; j++) {
+        const double *x = s->run + j * FE__STATS_RUN;
+        size_t done;
+        int rc = fe_meanvar_add_many(&s->mv[j], x, s->nrun, &done);
+        if (rc != FE_OK && done < first) {
+            first = done;
+            refused = rc;
+        }
+        for (size_t i = 0; i < done; i++) {
+            if (s->mv[j].n == done - i || x[i] < s->lo[j])  /* the column's first value */
+                s->lo[j] = x[i];
+            if (s->mv[j].n == done - i || x[i] > s->hi[j])
+                s->hi[j] = x[i];
+        }
+    }
+    s->nrun = 0;
+    if (refused == FE_OK)
+        return 0;
+    fe_cli_progress_done(t);
+    fprintf(stderr, "foldest stats: %s:%zu: %s\n", t->name, s->run_line[first],
+            fe_strerror(refused));
+    return FE_CLI_INPUT;
+}
 
 static int fe__stats_row(void *ctx, fe_cli_table *t, const double *row)
 {
     fe__stats_fold *s = ctx;
-    for (size_t j = 0; j < s->k; j++) {
-        int rc;
-        if (s->mv[j].n == 0 || row[j] < s->lo[j])
-            s->lo[j] = row[j];
-        if (s->mv[j].n == 0 || row[j] > s->hi[j])
-            s->hi[j] = row[j];
-        rc = fe_meanvar_add(&s->mv[j], row[j]);
-        if (rc != FE_OK) {
-            fprintf(stderr, "foldest stats: %s:%zu: %s\n", t->name, t->line, fe_strerror(rc));
-            return FE_CLI_INPUT;
-        }
-    }
+    for (size_t j = 0; j < s->k; j++)
+        s->run[j * FE__STATS_RUN + s->nrun] = row[j];
+    s->run_line[s->nrun++] = t->line;
+    if (s->nrun == FE__STATS_RUN && fe__stats_fold_run(s, t) != 0)
+        return FE_CLI_INPUT;
     fe_cli_progress(t);
     return 0;
 }
@@ -56,7 +86,7 @@ int fe_cli_stats(int argc, char **argv)
     int json = 0, rc, threads = fe_cli_threads_default();
     fe_cli_table t;
     size_t k = 0, *cols = NULL;
-    double *row = NULL, *lo = NULL, *hi = NULL;
+    double *row = NULL, *lo = NULL, *hi = NULL, *run = NULL;
     fe_meanvar *mv = NULL;
     fe__stats_fold fold;
 
@@ -129,13 +159,21 @@ int fe_cli_stats(int argc, char **argv)
     lo = calloc(k + 1, sizeof *lo);
     hi = calloc(k + 1, sizeof *hi);
     mv = calloc(k + 1, sizeof *mv);
-    if (row == NULL || lo == NULL || hi == NULL || mv == NULL)
+    run = calloc((k + 1) * FE__STATS_RUN, sizeof *run);
+    if (row == NULL || lo == NULL || hi == NULL || mv == NULL || run == NULL)
         goto out_of_memory;
     fold.k = k;
+    fold.nrun = 0;
     fold.lo = lo;
     fold.hi = hi;
     fold.mv = mv;
+    fold.run = run;
     rc = fe_cli_table_each(&t, cols, k, threads, fe__stats_row, &fold, err, sizeof err);
+    /* The rows still waiting come before the end, or a malformed row. */
+    if ((rc == FE_END || err[0] != '\0') && fe__stats_fold_run(&fold, &t) != 0) {
+        rc = FE_CLI_INPUT;
+        goto done;
+    }
     fe_cli_progress_done(&t);
     if (rc != FE_END) {
         if (err[0] != '\0')
@@ -185,6 +223,7 @@ done:
     free(lo);
     free(hi);
     free(mv);
+    free(run);
     fe_cli_table_close(&t);
     return rc;
 }
