@@ -228,7 +228,8 @@ int main(int argc, char **argv)
     make_stream(&s3, 3, 0, 3);
     make_stream(&s3d, 3, 1, 4);
     printf("Kalman update, n = %d (ns per update: best of %d interleaved runs of %ld updates,"
-           " %ld for the reference)\n", N, rounds, chunk, chunk_ref);
+           " %ld for the reference); machine busy %.0f%% before the run (other processes'"
+           " share of the cores)\n", N, rounds, chunk, chunk_ref, 100 * fe_bench_busy_fraction());
     for (int t = 0; t < 3; t++) {
         const stream *s = streams[t];
         double t_ref, t_fast, t_hand, xr[N], Pr[N * N], xf[N], Pf[N * N], xh[N], Ph[N * N];

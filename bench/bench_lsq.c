@@ -297,6 +297,8 @@ static void bench_ba(double max_dense)
 int main(int argc, char **argv)
 {
     double max_dense = argc > 1 ? strtod(argv[1], NULL) : 60.0;
+    printf("machine busy %.0f%% before the run (other processes' share of the cores)\n",
+           100 * fe_bench_busy_fraction());
     printf("1. normal-equation fold + solve vs batch least squares (best of runs)\n");
     bench_fold(8, 200000);
     bench_fold(32, 100000);
