@@ -1285,6 +1285,54 @@ START_TEST(lagged_products_match_brute_force_in_every_path)
 }
 END_TEST
 
+/* The lagged products with one and with two lags (fe_discover_set_lags),
+   by rows, panels of rows and columns, against brute force: the panel
+   paths are not skipped when P is small (discover:284 of CI's sample
+   24773 skipped them at P = 1). */
+START_TEST(lagged_products_at_one_and_two_lags)
+{
+    size_t nst = fe_discover_acc_doubles(NM, NK), dim = NM + 1;
+    double *st[3];
+    static double cols[NM][NN];
+    noise_rows();
+    for (size_t t = 0; t < NN; t++)
+        for (size_t c = 0; c < NM; c++)
+            cols[c][t] = nphi[t][c];
+    for (int k = 0; k < 3; k++)
+        st[k] = malloc(nst * sizeof *st[k]);
+    for (size_t P = 1; P <= 2; P++) {
+        fe_discover_acc acc[3];
+        for (int k = 0; k < 3; k++) {
+            ck_assert_int_eq(fe_discover_acc_init(&acc[k], NM, NK, NFIT, 0, st[k], nst), FE_OK);
+            ck_assert_int_eq(fe_discover_set_lags(&acc[k], P), FE_OK);
+        }
+        for (size_t t = 0; t < NN; t++) {
+            if (t == NBREAK)
+                fe_discover_break(&acc[0]);
+            ck_assert_int_eq(fe_discover_add(&acc[0], nphi[t], nr[t]), FE_OK);
+        }
+        ck_assert_int_eq(fe_discover_add_rows(&acc[1], nphi[0], NM, nr, NBREAK, NULL), FE_OK);
+        fe_discover_break(&acc[1]);
+        ck_assert_int_eq(fe_discover_add_rows(&acc[1], nphi[NBREAK], NM, nr + NBREAK,
+                                              NN - NBREAK, NULL), FE_OK);
+        ck_assert_int_eq(fe_discover_add_columns(&acc[2], cols[0], NN, nr, NBREAK, NULL), FE_OK);
+        fe_discover_break(&acc[2]);
+        ck_assert_int_eq(fe_discover_add_columns(&acc[2], cols[0] + NBREAK, NN, nr + NBREAK,
+                                                 NN - NBREAK, NULL), FE_OK);
+        for (size_t l = 1; l <= P; l++)
+            for (size_t i = 0; i < dim; i++)
+                for (size_t j = 0; j < dim; j++) {
+                    double want = brute_lag(l, i, j);
+                    for (int k = 0; k < 3; k++)
+                        FE_ASSERT_REL(acc[k].zlag[(l - 1) * dim * dim + i * dim + j] + 1.0,
+                                      want + 1.0, 1e-11);
+                }
+    }
+    for (int k = 0; k < 3; k++)
+        free(st[k]);
+}
+END_TEST
+
 START_TEST(levinson_recovers_a_known_autoregression)
 {
     /* The autocovariances of AR(2), phi = (1.2, -0.5), unit innovations:
@@ -2736,6 +2784,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, screen_refuses_what_it_cannot_answer);
     tcase_add_test(t, columns_stop_at_the_first_refused_row);
     tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
+    tcase_add_test(t, lagged_products_at_one_and_two_lags);
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
     tcase_add_test(t, long_range_model_of_the_fine_blocks);

@@ -51,6 +51,27 @@ START_TEST(expressions_are_their_formulas)
 }
 END_TEST
 
+/* An unquoted name holds letters, digits, '_' and '.': every edge of each
+   range ('a' and 'z', 'A' and 'Z', '0' and '9') inside a name that must be
+   read whole (expr:202 of CI's sample 24773 stopped a name at a '0'). */
+START_TEST(unquoted_names_hold_every_edge_of_their_ranges)
+{
+    static const char *const edge_names[] = {"az", "AZ", "n09", "_x.y", "x0"};
+    const double v[5] = {2.0, 3.0, 5.0, 7.0, 11.0};
+    fe_expr e;
+    size_t col = 99;
+    char msg[256];
+    double out = NAN;
+    ck_assert_int_eq(fe_expr_compile(&e, "az*AZ + n09 - _x.y/x0", edge_names, 5, &col, msg,
+                                     sizeof msg), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_OK);
+    ck_assert_double_eq_tol(out, 2.0 * 3.0 + 5.0 - 7.0 / 11.0, 1e-15);
+    ck_assert_int_eq(fe_expr_compile(&e, "x0", edge_names, 5, &col, msg, sizeof msg), FE_OK);
+    ck_assert_int_eq(fe_expr_eval(&e, v, &out), FE_OK);
+    ck_assert_double_eq(out, 11.0);
+}
+END_TEST
+
 START_TEST(precedence_as_in_mathematics)
 {
     const double v[NV] = {3, 0, 0, 0, 0};
@@ -343,6 +364,7 @@ Suite *fe_expr_suite(void)
     TCase *t = tcase_create("expr");
     tcase_add_test(t, expressions_are_their_formulas);
     tcase_add_test(t, precedence_as_in_mathematics);
+    tcase_add_test(t, unquoted_names_hold_every_edge_of_their_ranges);
     tcase_add_test(t, errors_name_their_column);
     tcase_add_test(t, values_that_are_not_finite_are_refused);
     tcase_add_test(t, a_program_not_made_by_the_compiler_is_refused);
