@@ -1285,6 +1285,21 @@ START_TEST(parameters_at_their_edges)
         ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
         ck_assert_double_eq_tol(x[0], 3.0, 1e-9);
     }
+    /* ftol at the starting cost (4.5) stops before the first step; just
+       below it, the iteration runs (lm:482 of seed 4's sample made the
+       test strict). */
+    par = fe_lm_default_params();
+    par.ftol = 4.5;
+    x[0] = 0.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_int_eq(r.stop, FE_LM_FTOL);
+    ck_assert_int_eq(r.iterations, 0);
+    ck_assert_double_eq(x[0], 0.0);
+    par.ftol = nextafter(4.5, 0.0);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_int_eq(r.iterations, 1);      /* one step, to a cost far below ftol */
+    ck_assert_int_eq(r.stop, FE_LM_FTOL);
+    ck_assert_double_eq_tol(x[0], 3.0, 1e-2);
     par = fe_lm_default_params();
     par.lambda_min = 0.0;
     par.lambda0 = 0.0;

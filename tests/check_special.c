@@ -135,6 +135,18 @@ START_TEST(bad_arguments_give_nan)
     ck_assert(isnan(fe_beta_inc(-1, 1, 0.5)));
     ck_assert(isnan(fe_beta_inc(1, 1, 1.5)));
     ck_assert(isnan(fe_gamma_q(0, 1)));
+    /* x = 0, the edge of the incomplete gamma's domain: P = 0 and Q = 1
+       exactly, for a below, at and above 1 (special:521 of seed 4's
+       sample left x = 0 to the series); just below 0, NaN. */
+    {
+        static const double a[] = {0.25, 1.0, 3.0, 200.0};
+        for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) {
+            ck_assert_double_eq(fe_gamma_p(a[i], 0.0), 0.0);
+            ck_assert_double_eq(fe_gamma_q(a[i], 0.0), 1.0);
+            ck_assert(isnan(fe_gamma_p(a[i], -DBL_TRUE_MIN)));
+            ck_assert(isnan(fe_gamma_q(a[i], -DBL_TRUE_MIN)));
+        }
+    }
     ck_assert(isnan(fe_chi2_upper(1.0, 0.0)));      /* k > 0 is the edge */
     ck_assert(isnan(fe_chi2_upper(1.0, -1.0)));
     ck_assert(isnan(fe_student_t_two_sided(1, 0)));
