@@ -2447,7 +2447,7 @@ static void fe__gls_score(const fe_discover_acc *a, const fe__ws *w, const fe__m
     out->rss_drop = drop > 0.0 ? drop : 0.0;
     nu = cur->n - (double)(s + d + nz->order);
     if (nu < 1.0)
-        nu = 1.0;
+        return;                 /* no degree of freedom left: nothing to test */
     s2 = (rsst - out->rss_drop) / nu;
     if (!(s2 > 0.0))
         return;                 /* an exact fit: nothing to test */
