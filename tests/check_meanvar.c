@@ -13,6 +13,19 @@ static const double ten[10] = {-0.178654, 0.828305, 0.0592247, -0.0121089,
                                -1.48014,  -0.315044, -0.324796, -0.676357,
                                0.16301,   -0.858164};
 
+/* The mean of x[0..n-1] and the sum of squared deviations from it, in
+   long double by two passes: the reference the folds are held to. */
+static void reference_moments(const double *x, size_t n, long double *mean, long double *ss)
+{
+    long double sum = 0;
+    for (size_t i = 0; i < n; i++)
+        sum += x[i];
+    *mean = sum / (long double)n;
+    *ss = 0;
+    for (size_t i = 0; i < n; i++)
+        *ss += (x[i] - *mean) * (x[i] - *mean);
+}
+
 START_TEST(mean_of_three)
 {
     const double z[3] = {55, 89, 144};
@@ -185,15 +198,11 @@ START_TEST(streaming_equals_batch)
     static double x[N];
     fe_rng r = fe_rng_seed(11);
     fe_meanvar fast = FE_MEANVAR_EMPTY, slow = FE_MEANVAR_EMPTY;
-    long double sum = 0, ss = 0, mean;
+    long double ss, mean;
     int rc = FE_OK;
-    for (int i = 0; i < N; i++) {
-        x[i] = 3.0 + 2.0 * fe_rng_normal(&r);
-        sum += x[i];
-    }
-    mean = sum / N;
     for (int i = 0; i < N; i++)
-        ss += (x[i] - mean) * (x[i] - mean);
+        x[i] = 3.0 + 2.0 * fe_rng_normal(&r);
+    reference_moments(x, N, &mean, &ss);
     ck_assert_int_eq(fe_meanvar_add_many(&fast, x, N, NULL), FE_OK);
     for (int i = 0; i < N; i++)
         rc |= fe_meanvar_add(&slow, x[i]);
@@ -225,12 +234,8 @@ START_TEST(every_kernel_gives_the_loops_bits)
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
         size_t m = sizes[k];
         fe_meanvar fast = FE_MEANVAR_EMPTY, loops = FE_MEANVAR_EMPTY;
-        long double sum = 0, ss = 0, mean;
-        for (size_t i = 0; i < m; i++)
-            sum += x[i];
-        mean = sum / (long double)m;
-        for (size_t i = 0; i < m; i++)
-            ss += (x[i] - mean) * (x[i] - mean);
+        long double ss, mean;
+        reference_moments(x, m, &mean, &ss);
         ck_assert_int_eq(fe_meanvar_add_many(&fast, x, m, NULL), FE_OK);
         ck_assert_int_eq(fe__meanvar_block_portable(x, m, &loops), FE_OK);
         ck_assert_uint_eq(fast.n, m);
@@ -309,12 +314,8 @@ START_TEST(small_values_far_from_one)
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
         size_t n = sizes[k];
         fe_meanvar a = FE_MEANVAR_EMPTY;
-        long double sum = 0, ss = 0, mean;
-        for (size_t i = 0; i < n; i++)
-            sum += x[i];
-        mean = sum / (long double)n;
-        for (size_t i = 0; i < n; i++)
-            ss += (x[i] - mean) * (x[i] - mean);
+        long double ss, mean;
+        reference_moments(x, n, &mean, &ss);
         ck_assert_int_eq(fe_meanvar_add_many(&a, x, n, NULL), FE_OK);
         ck_assert_uint_eq(a.n, n);
         FE_ASSERT_REL(a.mean, (double)mean, 1e-12);
