@@ -17,8 +17,10 @@
    Then the same two folds from CSV files of the same records, as a
    recording is read (fe_csv_*): with the 6 significant digits of a sensor
    recording, and with the 17 of an exact round trip.
-   Prints ns per record, the ratios (goal: ranking <= 3x the base fold) in
-   memory and from the files, that the screen ranks as the full
+   Prints ns per record; the ratios of issue 16 (ranking from a file at
+   most 1.25 times the base fold; in memory, the screen's fold within 2
+   times the bound of its multiply-adds at the core's peak, measured here
+   by a loop of independent multiply-adds in registers), that the screen ranks as the full
    accumulation does (both by batch means: a screen keeps no lagged
    products; the exit status is 1 when they differ by more than 1e-6), and
    the accumulation's size, which does not depend on the number of
@@ -366,6 +368,27 @@ static double rel(double x, double y)
     return s > 0 ? d / s : 0.0;
 }
 
+/* The core's peak rate of double multiply-adds, per ns: 128 independent
+   chains of x = fma(x, m, c), vectorised and fused where the bench is
+   compiled for a processor that has them (every chain read after, so that
+   none is dropped), best of rounds. */
+static double peak_multiply_adds(void)
+{
+    enum { CHAINS = 128, STEPS = 2000000 };
+    double x[CHAINS], t, sink = 0.0;
+    for (int k = 0; k < CHAINS; k++)
+        x[k] = 1.0 + 1e-3 * k;
+    FE_BENCH_BEST(t, 3, {
+        for (int i = 0; i < STEPS; i++)
+            for (int k = 0; k < CHAINS; k++)
+                x[k] = fma(x[k], 0.999999, 1e-7);
+        for (int k = 0; k < CHAINS; k++)
+            sink += x[k];
+    });
+    fe_bench_keep(sink);
+    return (double)CHAINS * STEPS / t / 1e9;
+}
+
 int main(int argc, char **argv)
 {
     size_t n = argc > 1 ? (size_t)strtod(argv[1], NULL) : 1000000;
@@ -483,8 +506,17 @@ int main(int argc, char **argv)
            1e3 * t_select);
     printf("  the screen's ranking vs the full accumulation's: same order, %.1e relative at worst\n",
            worst);
-    printf("  ratio ranking / base fold in memory, each by its fastest path: %.2f   (goal <= 3)\n",
+    printf("  ratio ranking / base fold in memory, each by its fastest path: %.2f\n",
            (t_screen + t_select) / t_base);
+    {
+        double peak = peak_multiply_adds();
+        double madds = (double)((BASE + 1) * (BASE + CAND + 1) + 3 * CAND + (BASE + 1) * (BASE + 1));
+        double fold = 1e9 * (t_screen - t_terms_cols) / (double)n, bound = madds / peak;
+        printf("  the screen's fold alone (less the terms' evaluation by columns): %.1f ns a record;"
+               " its %.0f multiply-adds at the core's peak (%.1f a ns, measured): %.1f ns;"
+               " ratio %.2f (goal <= 2: %s)\n", fold, madds, peak, bound, fold / bound,
+               fold <= 2.0 * bound ? "met" : "not met");
+    }
     for (int d = 0; d < 2; d++) {
         if (t_file_base[d] > 0 && t_file_screen[d] > 0) {
             printf("from a CSV file of the same records, %d significant digits (8 columns, read,"
@@ -493,8 +525,9 @@ int main(int argc, char **argv)
                    1e9 * t_file_base[d] / (double)n);
             printf("    screen of the %d candidates                    %8.1f\n", CAND,
                    1e9 * t_file_screen[d] / (double)n);
-            printf("  ratio ranking / base fold from the file: %.2f   (goal <= 3)\n",
-                   (t_file_screen[d] + t_select) / t_file_base[d]);
+            printf("  ratio ranking / base fold from the file: %.2f   (goal <= 1.25: %s)\n",
+                   (t_file_screen[d] + t_select) / t_file_base[d],
+                   t_file_screen[d] + t_select <= 1.25 * t_file_base[d] ? "met" : "not met");
         } else {
             printf("from a CSV file: could not write or read one in $TMPDIR or /tmp (skipped)\n");
         }
