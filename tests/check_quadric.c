@@ -835,6 +835,22 @@ START_TEST(blocks_add_many_is_the_step_repeated)
     ck_assert_int_eq(fe_quadric_blocks_add_many(&many, NULL, 1, NULL), FE_EINVAL);
     ck_assert_int_eq(fe_quadric_blocks_add_many(&many, NULL, 0, &done), FE_OK);
     ck_assert_uint_eq(done, 0);
+    /* The refused sample right after one or two good ones at the start
+       of a run: those are folded and counted (quadric:2069 of CI's
+       sample 23844 gave back the one good sample). */
+    for (size_t k = 1; k <= 2; k++) {
+        double y[9];
+        memcpy(y, x, 3 * k * sizeof *y);
+        y[3 * k] = 1e300;
+        y[3 * k + 1] = y[3 * k + 2] = 0.0;
+        fe_quadric_blocks_init(&many);
+        fe_quadric_blocks_init(&upto);
+        ck_assert_int_eq(fe_quadric_blocks_add_many(&many, y, k + 1, &done), FE_ENONFINITE);
+        ck_assert_uint_eq(done, k);
+        ck_assert_int_eq(fe_quadric_blocks_add_many(&upto, y, k, NULL), FE_OK);
+        ck_assert_mem_eq(&many, &upto, sizeof many);
+        ck_assert_double_eq(many.all.m[0], (double)k);
+    }
 }
 END_TEST
 
