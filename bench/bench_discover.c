@@ -37,6 +37,10 @@
 
 enum { BASE = 3, CAND = 50, K = 20, PANEL = 256, PCOL = 128, NS = 7 };
 
+/* The screen's multiply-adds a row: the base columns' and r's whole rows,
+   the band of each candidate, and the lag product among the whole ones. */
+enum { SCREEN_MADDS = (BASE + 1) * (BASE + CAND + 1) + 3 * CAND + (BASE + 1) * (BASE + 1) };
+
 /* Term values of record i (state: x, v, u, s, t, T, s of the record before):
    3 base terms, then (m > BASE) the 50 candidates.  Integer powers by
    multiplication; tanh is a catalog term (Coulomb friction's smooth sign)
@@ -501,7 +505,7 @@ int main(int argc, char **argv)
            PANEL, 1e9 * t_full_panels / (double)n, (size_t)((BASE + CAND + 1) * (BASE + CAND + 2)));
     printf("    screen, panels of %d columns                   %8.1f   (%zu multiply-adds a row)\n",
            PCOL, 1e9 * t_screen / (double)n,
-           (size_t)((BASE + 1) * (BASE + CAND + 1) + 3 * CAND + (BASE + 1) * (BASE + 1)));
+           (size_t)SCREEN_MADDS);
     printf("  ranking the %d candidates from the screen        %8.3f ms in all\n", CAND,
            1e3 * t_select);
     printf("  the screen's ranking vs the full accumulation's: same order, %.1e relative at worst\n",
@@ -510,7 +514,7 @@ int main(int argc, char **argv)
            (t_screen + t_select) / t_base);
     {
         double peak = peak_multiply_adds();
-        double madds = (double)((BASE + 1) * (BASE + CAND + 1) + 3 * CAND + (BASE + 1) * (BASE + 1));
+        double madds = (double)SCREEN_MADDS;
         double fold = 1e9 * (t_screen - t_terms_cols) / (double)n, bound = madds / peak;
         printf("  the screen's fold alone (less the terms' evaluation by columns): %.1f ns a record;"
                " its %.0f multiply-adds at the core's peak (%.1f a ns, measured): %.1f ns;"

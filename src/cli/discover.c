@@ -425,7 +425,6 @@ static int fe__discover_is_shared(const char *o)
 
 /* One of them (o is --holdout, --alpha or --blocks): FE_CLI_OK with the
    value set, or FE_CLI_USAGE with err. */
-
 static int fe__discover_shared_option(const char *o, const char *v, double *holdout,
                                       double *alpha, long *blocks, char *err, size_t errlen)
 {

@@ -86,7 +86,7 @@ int fe_cli_stats(int argc, char **argv)
     int json = 0, rc, threads = fe_cli_threads_default();
     fe_cli_table t;
     size_t k = 0, *cols = NULL;
-    double *row = NULL, *lo = NULL, *hi = NULL, *run = NULL;
+    double *lo = NULL, *hi = NULL, *run = NULL;
     fe_meanvar *mv = NULL;
     fe__stats_fold fold;
 
@@ -155,12 +155,11 @@ int fe_cli_stats(int argc, char **argv)
         for (k = 0; k < t.ncols; k++)
             cols[k] = k;
     }
-    row = calloc(k + 1, sizeof *row);          /* + 1: never calloc(0) */
-    lo = calloc(k + 1, sizeof *lo);
+    lo = calloc(k + 1, sizeof *lo);            /* + 1: never calloc(0) */
     hi = calloc(k + 1, sizeof *hi);
     mv = calloc(k + 1, sizeof *mv);
     run = calloc((k + 1) * FE__STATS_RUN, sizeof *run);
-    if (row == NULL || lo == NULL || hi == NULL || mv == NULL || run == NULL)
+    if (lo == NULL || hi == NULL || mv == NULL || run == NULL)
         goto out_of_memory;
     fold.k = k;
     fold.nrun = 0;
@@ -219,7 +218,6 @@ out_of_memory:
     rc = FE_CLI_IO;
 done:
     free(cols);
-    free(row);
     free(lo);
     free(hi);
     free(mv);
