@@ -2117,7 +2117,12 @@ static void lr_haar(const double *x, size_t n, size_t B, double *e)
     e[J] = y[0] * y[0];
 }
 
-START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
+/* The check above on the record drawn from `seed` with a slow wave of
+   amplitude `wave` in the data; the slope numerator of the line through
+   the levels (sw sxy - sx sy, positive: the line is used), sw and sx into
+   *slope, *sw_out and *sx_out. */
+static void lr_check(uint64_t seed, double wave, double *slope, double *sw_out,
+                     double *sx_out)
 {
     static double z[LR_N][LR_M + 1], q[LR_M][LR_N], x[LR_N];
     size_t nst = fe_discover_acc_doubles(LR_M, 20), nw = fe_discover_workspace_doubles(LR_M, 20);
@@ -2128,7 +2133,7 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
     fe_discover_options o = fe_discover_default_options();
     fe_discover_result *r = malloc(sizeof *r);
     fe_discover_acc a;
-    fe_rng g = fe_rng_seed(5);
+    fe_rng g = fe_rng_seed(seed);
     double G[LR_M][LR_M] = {{0}}, Gi[LR_M][LR_M], used[9] = {0}, e[9], ly[8], var[8], wt[8];
     double rss = 0.0, nu = LR_N - LR_M, sw = 0, sx = 0, sxx = 0, sy = 0, sxy = 0, det;
     double lnv[9], coef[9][8], walk = 0.0;
@@ -2136,7 +2141,7 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
     ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, LR_N, 0, st, nst), FE_OK);
     for (size_t t = 0; t < LR_N; t++) {
         double u = (double)t / LR_N;
-        walk = 0.12 * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);  /* slow, not modelled */
+        walk = wave * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);  /* slow, not modelled */
         z[t][0] = 1.0;
         z[t][1] = u;
         z[t][2] = sin(9.0 * u);
@@ -2217,16 +2222,22 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
     }
     det = sw * sxx - sx * sx;
     line = usable >= 2 && det > 1e-12 * sw * sxx && sw * sxy - sx * sy > 0.0;
-    ck_assert(line);                                /* the slow wave: a slope */
+    *slope = sw * sxy - sx * sy;
+    *sw_out = sw;
+    *sx_out = sx;
+    if (wave > 0.0)
+        ck_assert(line);                            /* the slow wave: a slope */
     for (size_t t = 1; t <= J + 1; t++) {
         lnv[t - 1] = 0.0;
         for (size_t i = 1; i <= J; i++) {
-            coef[t - 1][i - 1] = wt[i - 1] * ((sxx - t * sx) + (t * sw - sx) * i) / det;
+            coef[t - 1][i - 1] = line ? wt[i - 1] * ((sxx - t * sx) + (t * sw - sx) * i) / det
+                                      : wt[i - 1] / sw;     /* the weighted mean */
             lnv[t - 1] += coef[t - 1][i - 1] * ly[i - 1];
         }
         FE_ASSERT_REL(r->noise.scale_ratio[t - 1], exp(lnv[t - 1]), 1e-9);
     }
-    ck_assert(exp(lnv[J]) > 1.5);                    /* the slow wave shows */
+    if (wave > 0.0)
+        ck_assert(exp(lnv[J]) > 1.5);                /* the slow wave shows */
     /* Each coefficient: its column made orthogonal to the others, the
        shares of its energy in the levels, the factor, its degrees of
        freedom and the standard error. */
@@ -2266,7 +2277,8 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
         FE_ASSERT_REL(r->dof[c], dof, 1e-8);
         FE_ASSERT_REL(r->t_critical[c], fe_student_t_quantile(0.05, dof), 1e-8);
         /* The slow columns lean on the coarse levels; the ripple does not. */
-        ck_assert(c == 3 ? dof == nu && f < 1.01 : dof < 20.0 && f > 2.0);
+        if (wave > 0.0)
+            ck_assert(c == 3 ? dof == nu && f < 1.01 : dof < 20.0 && f > 2.0);
         if (c == 2) {
             /* The wave as a candidate against the other three: its test
                uses the scale fit of the residual with it in the model,
@@ -2289,6 +2301,30 @@ START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
     free(r);
     free(st);
     free(w);
+}
+
+START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
+{
+    double slope, sw, sx;
+    lr_check(5, 0.12, &slope, &sw, &sx);
+}
+END_TEST
+
+/* The line through the levels is taken for any positive slope, however
+   small, and their weighted mean for a slope of zero or less: white noise
+   alone (no wave), record after record, each against the rows, until a
+   slope just above zero (by less than sx, the size of the sums the line
+   is made of) and one just below (by less than sw) have been checked. */
+START_TEST(the_line_through_the_levels_at_a_slope_near_zero)
+{
+    int above = 0, below = 0;
+    for (uint64_t seed = 1; seed <= 200 && !(above && below); seed++) {
+        double slope, sw, sx;
+        lr_check(seed, 0.0, &slope, &sw, &sx);
+        above |= slope > 0.0 && slope < sx;
+        below |= slope <= 0.0 && slope > -sw;
+    }
+    ck_assert(above && below);
 }
 END_TEST
 
@@ -2883,6 +2919,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
+    tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
