@@ -2689,6 +2689,39 @@ START_TEST(a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break)
 }
 END_TEST
 
+/* The lag-one sums guard their own overflow: with the other lags off
+   (fe_discover_set_lags 0) nothing else holds r_t r_(t-1).  c = 0.9e154
+   squares to 0.81e308: two rows a block keep each block's sums finite,
+   while the lag-one sum of r grows by c^2 a pair and would pass DBL_MAX
+   at the third.  A row after a break forms no pair and is folded; the
+   row after it pairs with it and is refused, the accumulation unchanged.
+   A null accumulation or row is refused the same way. */
+START_TEST(the_lag_one_sums_guard_their_own_overflow)
+{
+    enum { M = 1, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *copy = malloc(nst * sizeof *st);
+    double zero[M] = {0.0}, c = 0.9e154;
+    fe_discover_acc a, before;
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 8, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_set_lags(&a, 0), FE_OK);
+    for (int i = 0; i < 3; i++)
+        ck_assert_int_eq(fe_discover_add(&a, zero, c), FE_OK);     /* L_rr = 2 c^2 */
+    fe_discover_break(&a);
+    ck_assert_int_eq(fe_discover_add(&a, zero, c), FE_OK);         /* no pair */
+    before = a;
+    memcpy(copy, st, nst * sizeof *st);
+    ck_assert_int_eq(fe_discover_add(&a, zero, c), FE_ENONFINITE); /* 3 c^2 */
+    ck_assert_int_eq(fe_discover_add(NULL, zero, c), FE_EINVAL);
+    ck_assert_int_eq(fe_discover_add(&a, NULL, c), FE_EINVAL);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    ck_assert_int_eq(fe_discover_add(&a, zero, c / 8.0), FE_OK);   /* 2.125 c^2 */
+    free(st);
+    free(copy);
+}
+END_TEST
+
 /* A recording the simulation matches exactly (r = 0 on every row): the
    noise model's fit gives coefficients 0 and a portmanteau of 0 with
    p-value 1, not the 0/0 of a lag's autocorrelation over a zero sum of
@@ -2920,6 +2953,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
+    tcase_add_test(t, the_lag_one_sums_guard_their_own_overflow);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
