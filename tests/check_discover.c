@@ -612,6 +612,33 @@ static void add_wide_rows(fe_discover_acc *a, size_t from, size_t to)
     ck_assert_int_eq(rc, FE_OK);
 }
 
+/* A wide full accumulation (M = 11 > 8 columns with r: rows gathered
+   into the scratch panel) by columns: a NaN in its last term column or in
+   r stops the fold at its row, the rows before it folded as row by row. */
+START_TEST(a_wide_fold_by_columns_stops_at_a_bad_last_column)
+{
+    size_t nst = fe_discover_acc_doubles(WM, PK), done = 99;
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+    double *bad[2] = {&wcol[WM - 1][150], &pr[150]};
+    wide_rows();
+    for (int b = 0; b < 2; b++) {
+        double keep = *bad[b];
+        fe_discover_acc rows, cols;
+        ck_assert_int_eq(fe_discover_acc_init(&rows, WM, PK, PFIT, 0, s1, nst), FE_OK);
+        ck_assert_int_eq(fe_discover_acc_init(&cols, WM, PK, PFIT, 0, s2, nst), FE_OK);
+        add_wide_rows(&rows, 0, 150);
+        *bad[b] = NAN;
+        ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], PN, pr, 400, &done),
+                         FE_ENONFINITE);
+        ck_assert_uint_eq(done, 150);
+        assert_same_sums(&cols, &rows);
+        *bad[b] = keep;
+    }
+    free(s1);
+    free(s2);
+}
+END_TEST
+
 START_TEST(column_path_equals_row_path)
 {
     /* By columns, narrow (M = 7: the lane kernels) and wide (M = 11: rows
@@ -2954,6 +2981,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
     tcase_add_test(t, the_lag_one_sums_guard_their_own_overflow);
+    tcase_add_test(t, a_wide_fold_by_columns_stops_at_a_bad_last_column);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
