@@ -46,8 +46,23 @@ static int fe__cli_reader_options(int argc, char **argv)
     return out;
 }
 
+/* When the BLAS is OpenBLAS: one thread, and its idle workers stopped
+   (declared weak: with another BLAS they are absent, and nothing is
+   done). */
+extern void openblas_set_num_threads(int) __attribute__((weak));
+extern void blas_thread_shutdown_(void) __attribute__((weak));
+
+static void fe__cli_blas_one_thread(void)
+{
+    if (openblas_set_num_threads != NULL)
+        openblas_set_num_threads(1);
+    if (blas_thread_shutdown_ != NULL)
+        blas_thread_shutdown_();
+}
+
 int main(int argc, char **argv)
 {
+    fe__cli_blas_one_thread();
     fe_cli_signals_install();
     argc = fe__cli_reader_options(argc, argv);
     if (argc < 2 || strcmp(argv[1], "help") == 0 || strcmp(argv[1], "--help") == 0
