@@ -639,6 +639,34 @@ START_TEST(a_wide_fold_by_columns_stops_at_a_bad_last_column)
 }
 END_TEST
 
+/* The widest accumulation, m = FE_DISCOVER_MAX_COLUMNS, by columns and by
+   rows: the same sums (every array sized by the limit holds its columns
+   and r). */
+START_TEST(the_widest_fold_by_columns_equals_the_rows)
+{
+    enum { M = FE_DISCOVER_MAX_COLUMNS, K = 2, N = 40 };
+    size_t nst = fe_discover_acc_doubles(M, K), done = 0;
+    double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+    static double col[M][N], row[N][M], r[N];
+    fe_discover_acc rows, cols;
+    fe_rng g = fe_rng_seed(11);
+    for (size_t t = 0; t < N; t++) {
+        for (size_t c = 0; c < M; c++)
+            col[c][t] = row[t][c] = fe_rng_normal(&g);
+        r[t] = fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(fe_discover_acc_init(&rows, M, K, N, 0, s1, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&cols, M, K, N, 0, s2, nst), FE_OK);
+    for (size_t t = 0; t < N; t++)
+        ck_assert_int_eq(fe_discover_add(&rows, row[t], r[t]), FE_OK);
+    ck_assert_int_eq(fe_discover_add_columns(&cols, col[0], N, r, N, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    assert_same_sums(&cols, &rows);
+    free(s1);
+    free(s2);
+}
+END_TEST
+
 START_TEST(column_path_equals_row_path)
 {
     /* By columns, narrow (M = 7: the lane kernels) and wide (M = 11: rows
@@ -2982,6 +3010,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
     tcase_add_test(t, the_lag_one_sums_guard_their_own_overflow);
     tcase_add_test(t, a_wide_fold_by_columns_stops_at_a_bad_last_column);
+    tcase_add_test(t, the_widest_fold_by_columns_equals_the_rows);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
