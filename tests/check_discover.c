@@ -2383,6 +2383,72 @@ START_TEST(the_line_through_the_levels_at_a_slope_near_zero)
 }
 END_TEST
 
+/* Two effects, x1 and x2, and a copy of x1 (x1 plus 1 % of its own)
+   ranked after an unrelated column u: selection adds x1 (or its copy) and
+   x2; the other of the pair, whatever its place in the ranking, is the
+   first pick's look-alike.  The two probes after them are scored against
+   the final model of two terms, with its own noise model (the noise is
+   AR(1), so a model without x2 would whiten otherwise): the same
+   statistics as the probes ranked as ordinary candidates with that model
+   as the base. */
+START_TEST(look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms)
+{
+    enum { N = 2000, K = 20, M = 7 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_acc a;
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"u", 1, 1}, {"x1", 2, 1}, {"copy", 3, 1},
+                                   {"x2", 4, 1}, {"p1", 5, 1}, {"p2", 6, 1}};
+    size_t base[3] = {0, 0, 0}, other;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r), *q = malloc(sizeof *q);
+    fe_rng g = fe_rng_seed(23);
+    double e = 0.0;
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M];
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&g);
+        phi[2] = fe_rng_normal(&g);
+        phi[3] = phi[2] + 0.01 * fe_rng_normal(&g);
+        phi[4] = fe_rng_normal(&g);
+        phi[5] = sin(0.01 * (double)t);
+        phi[6] = fe_rng_normal(&g);
+        e = 0.6 * e + 0.4 * fe_rng_normal(&g);       /* AR(1) noise */
+        ck_assert_int_eq(fe_discover_add(&a, phi, 0.4 * phi[2] + 0.3 * phi[4] + e), FE_OK);
+    }
+    o.base = base;
+    o.nbase = 1;
+    o.nprobes = 2;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->steps, 2);
+    ck_assert_uint_eq(r->naside, 0);
+    ck_assert(r->added[0] == 2 || r->added[0] == 3);
+    ck_assert_uint_eq(r->added[1], 4);
+    other = r->added[0] == 2 ? 3 : 2;
+    ck_assert_uint_eq(r->ranking[0][0].group, 1);       /* u first, not alike */
+    ck_assert_uint_eq(r->nalike[0], 1);
+    ck_assert_uint_eq(r->alike[0][0], other);
+    ck_assert_uint_eq(r->probes_tested, 2);
+    /* The probes as candidates against the final model. */
+    base[1] = r->added[0];
+    base[2] = r->added[1];
+    o.nbase = 3;
+    o.nprobes = 0;
+    o.max_steps = 0;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+    for (size_t i = 0; i < q->nranked[0]; i++)
+        if (q->ranking[0][i].group == r->probe.group) {
+            FE_ASSERT_REL(r->probe.statistic, q->ranking[0][i].statistic, 1e-12);
+            FE_ASSERT_REL(r->probe.p_value, q->ranking[0][i].p_value, 1e-12);
+        }
+    free(r);
+    free(q);
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
 {
     /* r = x1 + x2 + noise, and a candidate x3 = x1 + x2 + a little of its
@@ -3011,6 +3077,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, the_lag_one_sums_guard_their_own_overflow);
     tcase_add_test(t, a_wide_fold_by_columns_stops_at_a_bad_last_column);
     tcase_add_test(t, the_widest_fold_by_columns_equals_the_rows);
+    tcase_add_test(t, look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
