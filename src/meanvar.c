@@ -245,6 +245,12 @@ int fe__meanvar_block_portable(const double *x, size_t m, fe_meanvar *out)
     return fe__meanvar_summarise(x, m, out, fe__meanvar_sum_lanes_portable,
                                  fe__meanvar_deviate_lanes_portable);
 }
+
+int fe__meanvar_block_sse2(const double *x, size_t m, fe_meanvar *out)
+{
+    return fe__meanvar_summarise(x, m, out, fe__meanvar_sum_lanes,
+                                 fe__meanvar_deviate_lanes);
+}
 /* Summarise one block by corrected two-pass ends here */
 /* [[file:../literate/meanvar.org::Fold an array block by block][Fold an array block by block]] */
 int fe_meanvar_add_many(fe_meanvar *a, const double *x, size_t n,

@@ -14,4 +14,9 @@
    FE_ENONFINITE, out untouched, when the sum or M2 is not finite. */
 int fe__meanvar_block_portable(const double *x, size_t m, fe_meanvar *out);
 
+/* fe__meanvar_block_sse2: the same by the SSE2 kernel (the loops where
+   there is no SSE2): the kernel fe_meanvar_add_many uses without AVX2,
+   which the tests run on a processor that has AVX2 too. */
+int fe__meanvar_block_sse2(const double *x, size_t m, fe_meanvar *out);
+
 #endif /* FOLDEST_MEANVAR_PRIVATE_H */

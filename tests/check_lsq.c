@@ -643,6 +643,18 @@ START_TEST(blocked_rows_stop_exactly_at_the_bad_row)
     fe_lsq_reset(&fast);
     ck_assert_int_eq(fe_lsq_add_rows(&fast, J, Q, r, NULL, N, &done), FE_ENONFINITE);
     ck_assert_uint_eq(done, BAD);
+    /* And in the response alone: a NaN, then a value whose square
+       overflows, with every regressor finite. */
+    J[BAD * Q + 3] = 0.5;
+    for (int b = 0; b < 2; b++) {
+        double keep = r[BAD];
+        r[BAD] = b == 0 ? NAN : 1e300;
+        fe_lsq_reset(&fast);
+        ck_assert_int_eq(fe_lsq_add_rows(&fast, J, Q, r, NULL, N, &done), FE_ENONFINITE);
+        ck_assert_uint_eq(done, BAD);
+        ck_assert_uint_eq(fast.n, BAD);
+        r[BAD] = keep;
+    }
 }
 END_TEST
 

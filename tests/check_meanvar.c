@@ -233,23 +233,30 @@ START_TEST(every_kernel_gives_the_loops_bits)
         x[i] = 1e6 * (double)(i % 3) + (1.0 + 1e3 * (double)(i % 8)) * fe_rng_normal(&r);
     for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
         size_t m = sizes[k];
-        fe_meanvar fast = FE_MEANVAR_EMPTY, loops = FE_MEANVAR_EMPTY;
+        fe_meanvar fast = FE_MEANVAR_EMPTY, loops = FE_MEANVAR_EMPTY, sse2 = FE_MEANVAR_EMPTY;
         long double ss, mean;
         reference_moments(x, m, &mean, &ss);
         ck_assert_int_eq(fe_meanvar_add_many(&fast, x, m, NULL), FE_OK);
         ck_assert_int_eq(fe__meanvar_block_portable(x, m, &loops), FE_OK);
+        ck_assert_int_eq(fe__meanvar_block_sse2(x, m, &sse2), FE_OK);
         ck_assert_uint_eq(fast.n, m);
         ck_assert_uint_eq(loops.n, m);
+        ck_assert_uint_eq(sse2.n, m);
 #if !defined(__FMA__)
         ck_assert_msg(fast.mean == loops.mean && fast.m2 == loops.m2,
                       "m = %zu: kernel (%.17g, %.17g), loops (%.17g, %.17g)", m,
                       fast.mean, fast.m2, loops.mean, loops.m2);
+        ck_assert_msg(sse2.mean == loops.mean && sse2.m2 == loops.m2,
+                      "m = %zu: SSE2 (%.17g, %.17g), loops (%.17g, %.17g)", m,
+                      sse2.mean, sse2.m2, loops.mean, loops.m2);
 #endif
         FE_ASSERT_REL(fast.mean, (double)mean, 1e-15);
         FE_ASSERT_REL(loops.mean, (double)mean, 1e-15);
+        FE_ASSERT_REL(sse2.mean, (double)mean, 1e-15);
         if (m > 1) {
             FE_ASSERT_REL(fast.m2, (double)ss, 1e-13);
             FE_ASSERT_REL(loops.m2, (double)ss, 1e-13);
+            FE_ASSERT_REL(sse2.m2, (double)ss, 1e-13);
         }
     }
     x[9] = NAN;
