@@ -1441,10 +1441,19 @@ START_TEST(monitor_scans_and_refuses)
         fe_kalman_report bad = {1, NAN, 0, NULL, NULL, NULL};
         fe_kalman_report neg = {1, -1.0, 0, NULL, NULL, NULL};
         fe_kalman_report nob = {0, 1.0, 0, NULL, NULL, NULL};
+        /* A whitened innovation not finite in a component the monitor
+           reads (the second of two), then in one it does not (the fifth
+           of five: only FE_KALMAN_MONITOR_DIM = 4 are read). */
+        double wh[5] = {0.5, NAN, 0.1, 0.2, INFINITY};
+        fe_kalman_report badw = {2, 1.0, 0, NULL, wh, NULL};
+        fe_kalman_report past = {5, 1.0, 0, NULL, wh, NULL};
         ck_assert_int_eq(fe_kalman_monitor_add(&m, &bad), FE_ENONFINITE);
         ck_assert_int_eq(fe_kalman_monitor_add(&m, &neg), FE_EINVAL);
         ck_assert_int_eq(fe_kalman_monitor_add(&m, &nob), FE_EINVAL);
+        ck_assert_int_eq(fe_kalman_monitor_add(&m, &badw), FE_ENONFINITE);
         ck_assert_mem_eq(&m, &before, sizeof m);
+        wh[1] = -0.3;
+        ck_assert_int_eq(fe_kalman_monitor_add(&m, &past), FE_OK);
     }
     p.scale_down = 2.0;
     ck_assert_int_eq(fe_kalman_monitor_init(&m, &p), FE_EINVAL);
