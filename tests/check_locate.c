@@ -268,6 +268,15 @@ START_TEST(merge_of_consecutive_parts_equals_whole)
         ck_assert_int_eq(rc, FE_OK);
         ck_assert_int_eq(fe_innovations_merge(&p[0], &p[2]), FE_EMISMATCH);
         ck_assert_int_eq(fe_innovations_merge(&p[1], &p[2]), FE_OK);
+        {
+            /* An empty part between them changes nothing, to the byte:
+               not the row before the cut, nor the recording count. */
+            fe_innovations empty, before;
+            memcpy(&before, &p[0], sizeof before);
+            ck_assert_int_eq(fe_innovations_init(&empty, K, N, cut1), FE_OK);
+            ck_assert_int_eq(fe_innovations_merge(&p[0], &empty), FE_OK);
+            ck_assert_mem_eq(&p[0], &before, sizeof before);
+        }
         ck_assert_int_eq(fe_innovations_merge(&p[0], &p[1]), FE_OK);
         ck_assert_uint_eq(p[0].n, N);
         ck_assert_int_eq(p[0].recording, whole.recording);
@@ -861,6 +870,20 @@ START_TEST(the_largest_statistic_after_the_terms_looks_at_the_regions)
     for (int k = 0; k < 3; k++) {
         double w = k == 0 ? 1.0 : k == 1 ? 0.5 : 0.05;
         ck_assert_double_eq_tol(fe_residual_map_largest_after(&m, w), sqrt(20.0 * w), 1e-12);
+    }
+    {
+        /* The statistics are ratios: residuals a thousand times smaller
+           (a sum of squares of 4e-5) give the same. */
+        fe_residual_map small;
+        ck_assert_int_eq(fe_residual_map_init(&small, 4, 40, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+        for (int i = 0; i < 40; i++) {
+            fe_sample s = {0};
+            double e = i % 2 ? 1.0 : -1.0;
+            s.t = i;
+            s.velocity = 0.5 * e;
+            ck_assert_int_eq(fe_residual_map_add(&small, &s, 1e-3 * e, 1e-3 * e), FE_OK);
+        }
+        ck_assert_double_eq_tol(fe_residual_map_largest_after(&small, 1.0), sqrt(20.0), 1e-9);
     }
     /* The four speed bands split 0 .. vmax (here 1) in quarters. */
     {
