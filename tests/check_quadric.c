@@ -851,6 +851,20 @@ START_TEST(blocks_add_many_is_the_step_repeated)
         ck_assert_mem_eq(&many, &upto, sizeof many);
         ck_assert_double_eq(many.all.m[0], (double)k);
     }
+    /* Every block full, so that the next sample halves them first: a run
+       refused at its first sample leaves the accumulation as it was,
+       unhalved, to the byte. */
+    fe_quadric_blocks_init(&many);
+    for (size_t i = 0; many.nblocks < FE_QUADRIC_BLOCKS
+                       || many.block[many.nblocks - 1].m[0] < (double)many.block_len; i++)
+        ck_assert_int_eq(fe_quadric_blocks_add(&many, x + 3 * (i % 3000)), FE_OK);
+    memcpy(&upto, &many, sizeof upto);
+    {
+        double y[6] = {NAN, 0, 0, 1, 2, 3};
+        ck_assert_int_eq(fe_quadric_blocks_add_many(&many, y, 2, &done), FE_ENONFINITE);
+        ck_assert_uint_eq(done, 0);
+        ck_assert_mem_eq(&many, &upto, sizeof many);
+    }
 }
 END_TEST
 
