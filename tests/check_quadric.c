@@ -865,6 +865,16 @@ START_TEST(blocks_add_many_is_the_step_repeated)
         ck_assert_uint_eq(done, 0);
         ck_assert_mem_eq(&many, &upto, sizeof many);
     }
+    /* An all-zero struct is an empty accumulation (block_len 0 read as
+       1): the same blocks as an initialised one. */
+    memset(&many, 0, sizeof many);
+    fe_quadric_blocks_init(&upto);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&many, x, 2999, NULL), FE_OK);
+    ck_assert_int_eq(fe_quadric_blocks_add_many(&upto, x, 2999, NULL), FE_OK);
+    ck_assert_uint_eq(many.nblocks, upto.nblocks);
+    ck_assert_uint_eq(many.block_len, upto.block_len);
+    for (uint32_t b = 0; b < upto.nblocks; b++)
+        ck_assert_double_eq(many.block[b].m[0], upto.block[b].m[0]);
 }
 END_TEST
 
