@@ -63,6 +63,23 @@ START_TEST(spec_refusals_at_their_edges)
 }
 END_TEST
 
+/* The input's three phases are drawn from the seed, each in [0, 2 pi):
+   another seed draws three others. */
+START_TEST(every_phase_comes_from_the_seed)
+{
+    fe_synth g, h;
+    fe_synth_spec s = fe_synth_default_spec("quadratic_drag", 3);
+    ck_assert_int_eq(fe_synth_init(&g, &s), FE_OK);
+    s.seed = 4;
+    ck_assert_int_eq(fe_synth_init(&h, &s), FE_OK);
+    for (int i = 0; i < 3; i++) {
+        ck_assert(g.phase[i] >= 0.0 && g.phase[i] < 2.0 * 3.14159265358979324);
+        ck_assert(h.phase[i] >= 0.0 && h.phase[i] < 2.0 * 3.14159265358979324);
+        ck_assert_double_ne(g.phase[i], h.phase[i]);
+    }
+}
+END_TEST
+
 START_TEST(rows_carry_the_central_difference_of_sim)
 {
     /* dsim of row i is (sim[i+1] - sim[i-1]) / (t[i+1] - t[i-1]), one-sided
@@ -264,6 +281,7 @@ Suite *fe_synth_suite(void)
     tcase_add_test(t, thermal_rig_follows_its_equations);
     tcase_add_test(t, mechanical_rig_follows_its_equations);
     tcase_add_test(t, noise_is_its_ar1_recursion);
+    tcase_add_test(t, every_phase_comes_from_the_seed);
     tcase_add_test(t, rows_carry_the_central_difference_of_sim);
     suite_add_tcase(s, t);
     return s;
