@@ -2449,6 +2449,58 @@ START_TEST(look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms)
 }
 END_TEST
 
+/* The statistics do not depend on the unit of the residual: r and 1000 r
+   (here r about 1e-3, so that a candidate's mean share over the blocks
+   lies between 0 and 1 in the first and above 1 in the second) give the
+   same statistic, under batch means and under the noise model; each
+   carries its effect's sign (x positive, y negative). */
+START_TEST(statistics_do_not_depend_on_the_residual_unit)
+{
+    enum { N = 2000, K = 20, M = 3 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st[2] = {malloc(nst * sizeof(double)), malloc(nst * sizeof(double))};
+    double *w = malloc(nw * sizeof *w);
+    fe_discover_acc a[2];
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"x", 1, 1}, {"y", 2, 1}};
+    size_t base[1] = {0};
+    fe_discover_result *r[2] = {malloc(sizeof(fe_discover_result)),
+                                malloc(sizeof(fe_discover_result))};
+    fe_rng g = fe_rng_seed(31);
+    for (int u = 0; u < 2; u++)
+        ck_assert_int_eq(fe_discover_acc_init(&a[u], M, K, N, 0, st[u], nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M], res;
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&g);
+        phi[2] = fe_rng_normal(&g);
+        res = 1e-4 * phi[1] - 1e-4 * phi[2] + 1e-3 * fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(&a[0], phi, res), FE_OK);
+        ck_assert_int_eq(fe_discover_add(&a[1], phi, 1e3 * res), FE_OK);
+    }
+    for (int noise = 0; noise < 2; noise++) {
+        fe_discover_options o = fe_discover_default_options();
+        o.base = base;
+        o.nbase = 1;
+        o.max_steps = 0;
+        o.noise = noise ? FE_DISCOVER_NOISE_BATCH : FE_DISCOVER_NOISE_AR;
+        for (int u = 0; u < 2; u++)
+            ck_assert_int_eq(fe_discover_select(&a[u], groups, M, &o, r[u], w, nw), FE_OK);
+        ck_assert_uint_eq(r[0]->nranked[0], 2);
+        for (size_t i = 0; i < 2; i++) {
+            FE_ASSERT_REL(r[0]->ranking[0][i].statistic, r[1]->ranking[0][i].statistic, 1e-9);
+            FE_ASSERT_REL(r[0]->ranking[0][i].p_value, r[1]->ranking[0][i].p_value, 1e-9);
+        }
+        ck_assert_double_gt(r[0]->ranking[0][0].statistic, 0.0);    /* x, a positive effect */
+        ck_assert_double_lt(r[0]->ranking[0][1].statistic, 0.0);    /* y, a negative one */
+    }
+    for (int u = 0; u < 2; u++) {
+        free(st[u]);
+        free(r[u]);
+    }
+    free(w);
+}
+END_TEST
+
 START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
 {
     /* r = x1 + x2 + noise, and a candidate x3 = x1 + x2 + a little of its
@@ -3078,6 +3130,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_wide_fold_by_columns_stops_at_a_bad_last_column);
     tcase_add_test(t, the_widest_fold_by_columns_equals_the_rows);
     tcase_add_test(t, look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms);
+    tcase_add_test(t, statistics_do_not_depend_on_the_residual_unit);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
