@@ -30,10 +30,10 @@ static const char *const fe__calibrate_help[] = {
     "                  from 1; default: the table's columns when it has three\n"
     "  --skip N        skip N lines before the header (default: found\n"
     "                  automatically after metadata lines)\n"
-    "  --threads N     parse a regular file on N threads (default: the\n"
-    "                  processors online); the samples are folded in file\n"
-    "                  order, so the result is the same for any N; standard\n"
-    "                  input, pipes and gzip files are read by one thread\n"
+    "  --threads N     read a regular file on N threads (default: the\n"
+    "                  processors online); it is cut the same way for any N,\n"
+    "                  so the result is the same for any N; standard input,\n"
+    "                  pipes and gzip files are read by one thread\n"
     "  --json          print one JSON object: model, n, offset, offset_se,\n"
     "                  offset_se_iid, se_blocks, matrix (3x3, to the unit\n"
     "                  sphere), matrix_se, radius, axes, params,\n"
@@ -353,10 +353,11 @@ static void fe__calibrate_flag(fe__calibrate_flags *fl, const fe_quadric_blocks 
 typedef int fe__calibrate_visit(void *ctx, const double x[3]);
 
 /* A pass's state for its rows, handed in file order by fe_cli_table_each
-   (cli.org, "Every core on one file"): the rows may be parsed on several
-   threads, but every sample below is folded on the calling thread, in the
-   order of the file, so every pass gives the one-thread result bit for
-   bit, the gate's and the flags' included. */
+   (cli.org, "Every core on one file") when the pass has a gate, flags or
+   output: the rows may be parsed on several threads, but every sample
+   below is folded on the calling thread, in the order of the file, so
+   the pass gives the one-thread result bit for bit, the gate's and the
+   flags' included. */
 typedef struct fe__calibrate_rows {
     size_t ncols;
     fe_still *gate;             /* --static, or NULL */
@@ -438,6 +439,23 @@ static int fe__calibrate_fold_row(void *ctx, fe_cli_table *t, const double *x)
     return 0;
 }
 
+/* Without a gate or flags the rows are the samples, and the moments take
+   them as the threads parsed them, a batch at a time, in file order
+   (fe_cli_table_fold, in_order: the blocks follow the count of samples). */
+static int fe__calibrate_moments_rows(void *ctx, const void *config, const double *x, size_t n,
+                                      size_t *done)
+{
+    (void)config;
+    return fe_quadric_blocks_add_many(ctx, x, n, done);
+}
+
+static int fe__calibrate_moments_refused(void *ctx, fe_cli_table *t, const void *part, int rc)
+{
+    (void)ctx;
+    (void)part;
+    return fe__calibrate_refused_at(t, rc);
+}
+
 /* Fold the samples, or with a gate (--static) the still ones, which it
    hands back `window` samples late, and the rest at the end; flag them
    when asked. */
@@ -451,7 +469,14 @@ static int fe__calibrate_fold(fe_cli_table *t, const size_t cols[6], size_t ncol
     r.fl = fl;
     r.q = q;
     fe_quadric_blocks_init(q);
-    rc = fe_cli_table_each(t, cols, ncols, threads, fe__calibrate_fold_row, &r, err, sizeof err);
+    if (gate == NULL && fl == NULL && ncols == 3) {
+        const fe_cli_parts parts = {1, 0, NULL, NULL, fe__calibrate_moments_rows,
+                                    fe__calibrate_moments_refused};
+        rc = fe_cli_table_fold(t, cols, 3, threads, &parts, q, err, sizeof err);
+    } else {
+        rc = fe_cli_table_each(t, cols, ncols, threads, fe__calibrate_fold_row, &r, err,
+                               sizeof err);
+    }
     /* The samples still waiting come before a malformed row. */
     if ((rc == FE_END || err[0] != '\0') && fe__calibrate_fold_run(&r, t) != 0)
         return FE_CLI_INPUT;
@@ -570,40 +595,57 @@ static int fe__calibrate_robust_keep(void *ctx, const double x[3])
    no gate), written in any case. */
 enum { FE__CAL_HIST = 80 };
 
-typedef struct fe__calibrate_measure {
+/* What the pass measures of the samples it keeps: a part of a fold
+   (fe_cli_table_fold), so that each thread can measure its own batches. */
+typedef struct fe__calibrate_tally {
     unsigned char hit[FE_QUADRIC_REGIONS];
     double ss, n;
     double region_n[FE_QUADRIC_REGIONS];  /* --report: samples per region */
-    double hist[FE__CAL_HIST], hist_lo, hist_w;   /* radial errors, % */
+    double hist[FE__CAL_HIST];  /* --report: radial errors, % */
+} fe__calibrate_tally;
+
+typedef struct fe__calibrate_measure {
+    fe__calibrate_tally tally;
+    const fe_sphere_fit *fit;
+    double hist_lo, hist_w;     /* the histogram's bins (--report) */
     FILE *samples;              /* --report: samples.dat, or NULL */
     unsigned long seen, stride;
     double reject;              /* --robust: |e| beyond it not measured */
     FILE *apply;
 } fe__calibrate_measure;
 
-static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit,
-                              const fe_sphere_scaled *sc, const double x[3], int still)
+/* Measure one sample the fit kept (m is read, not written). */
+static void fe__calibrate_tally_add(fe__calibrate_tally *a, const fe__calibrate_measure *m,
+                                    const double x[3])
 {
     double y[3], len;
     int r;
+    if (m->reject > 0.0 && fabs(fe_sphere_radial(m->fit, x)) > m->reject)
+        return;
+    fe_sphere_apply(m->fit, x, y);
+    r = fe_quadric_region(y);
+    if (r >= 0)
+        a->hit[r] = 1;
+    len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+    a->ss += (len - 1.0) * (len - 1.0);
+    a->n += 1.0;
+    if (r >= 0)
+        a->region_n[r] += 1.0;
+    if (m->hist_w > 0.0) {
+        double b = floor((100.0 * (len - 1.0) - m->hist_lo) / m->hist_w);
+        if (b >= 0.0 && b < FE__CAL_HIST)
+            a->hist[(int)b] += 1.0;
+    }
+}
+
+static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit,
+                              const fe_sphere_scaled *sc, const double x[3], int still)
+{
+    double y[3];
+    if (still)
+        fe__calibrate_tally_add(&m->tally, m, x);
     if (still && m->reject > 0.0 && fabs(fe_sphere_radial(fit, x)) > m->reject)
         still = 0;
-    if (still) {
-        fe_sphere_apply(fit, x, y);
-        r = fe_quadric_region(y);
-        if (r >= 0)
-            m->hit[r] = 1;
-        len = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-        m->ss += (len - 1.0) * (len - 1.0);
-        m->n += 1.0;
-        if (r >= 0)
-            m->region_n[r] += 1.0;
-        if (m->hist_w > 0.0) {
-            double b = floor((100.0 * (len - 1.0) - m->hist_lo) / m->hist_w);
-            if (b >= 0.0 && b < FE__CAL_HIST)
-                m->hist[(int)b] += 1.0;
-        }
-    }
     if (m->samples != NULL && m->seen++ % m->stride == 0) {
         fe_sphere_apply(fit, x, y);
         fprintf(m->samples, "%.10g %.10g %.10g %.8g %.8g %.8g %.6g %d\n", x[0], x[1], x[2],
@@ -614,6 +656,41 @@ static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit
         fe_sphere_scaled_apply(sc, x, y);
         fprintf(m->apply, "%.10g,%.10g,%.10g\n", y[0], y[1], y[2]);
     }
+}
+
+/* The pass in parts, when it writes nothing and has no gate: the rows are
+   the samples, and they are measured on the threads that parse them. */
+static void fe__calibrate_tally_start(void *part, const void *config)
+{
+    static const fe__calibrate_tally empty;
+    (void)config;
+    *(fe__calibrate_tally *)part = empty;
+}
+
+static int fe__calibrate_tally_rows(void *part, const void *config, const double *x, size_t n,
+                                    size_t *done)
+{
+    for (size_t i = 0; i < n; i++)
+        fe__calibrate_tally_add(part, config, x + 3 * i);
+    *done = n;
+    return FE_OK;
+}
+
+static int fe__calibrate_tally_merge(void *ctx, fe_cli_table *t, const void *part, int refused)
+{
+    fe__calibrate_tally *a = ctx;
+    const fe__calibrate_tally *b = part;
+    (void)t;
+    (void)refused;              /* the rows are never refused */
+    for (int r = 0; r < FE_QUADRIC_REGIONS; r++) {
+        a->hit[r] |= b->hit[r];
+        a->region_n[r] += b->region_n[r];
+    }
+    a->ss += b->ss;
+    a->n += b->n;
+    for (int i = 0; i < FE__CAL_HIST; i++)
+        a->hist[i] += b->hist[i];
+    return 0;
 }
 
 static int fe__calibrate_measure_row(void *ctx, fe_cli_table *t, const double *x)
@@ -684,12 +761,19 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     if (gate != NULL)
         fe_still_init(gate, &gate->opt, gate->ring, fe_still_workspace(gate->opt.window));
+    m.fit = fit;
     r = fe__calibrate_rows_start(ncols, gate);
     r.m = &m;
     r.fit = fit;
     r.sc = sc;
-    rc = fe_cli_table_each(t, cols, ncols, a->threads, fe__calibrate_measure_row, &r, err,
-                           sizeof err);
+    if (gate == NULL && ncols == 3 && m.samples == NULL && m.apply == NULL) {
+        const fe_cli_parts parts = {0, sizeof(fe__calibrate_tally), &m, fe__calibrate_tally_start,
+                                    fe__calibrate_tally_rows, fe__calibrate_tally_merge};
+        rc = fe_cli_table_fold(t, cols, 3, a->threads, &parts, &m.tally, err, sizeof err);
+    } else {
+        rc = fe_cli_table_each(t, cols, ncols, a->threads, fe__calibrate_measure_row, &r, err,
+                               sizeof err);
+    }
     fe_cli_progress_done(t);
     if (rc == FE_END)
         while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
@@ -713,9 +797,9 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     }
     out->done = 1;
     for (int r = 0; r < FE_QUADRIC_REGIONS; r++)
-        out->regions += m.hit[r];
-    memcpy(out->region_n, m.region_n, sizeof out->region_n);
-    memcpy(out->hist, m.hist, sizeof out->hist);
+        out->regions += m.tally.hit[r];
+    memcpy(out->region_n, m.tally.region_n, sizeof out->region_n);
+    memcpy(out->hist, m.tally.hist, sizeof out->hist);
     out->hist_lo = m.hist_lo;
     out->hist_w = m.hist_w;
     if (m.samples != NULL && fclose(m.samples) != 0) {
@@ -723,7 +807,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
         fe_cli_table_close(t);
         return FE_CLI_IO;
     }
-    out->rms_radial_percent = m.n > 0 ? 100.0 * sqrt(m.ss / m.n) : 0.0;
+    out->rms_radial_percent = m.tally.n > 0 ? 100.0 * sqrt(m.tally.ss / m.tally.n) : 0.0;
     fe_cli_table_close(t);
     return FE_CLI_OK;
 }

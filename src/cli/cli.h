@@ -61,6 +61,7 @@ typedef struct fe_cli_table {
     int threads;                /* parse on this many threads (0, 1: one) */
     int serial;                 /* 1: the input cannot be cut */
     void *pass;                 /* the threads' pass, while one runs */
+    const struct fe_cli_parts *parts;   /* fe_cli_table_fold's, while it runs */
     off_t at;                   /* the bytes the batches have handed out,
                                    for progress; 0: ask zlib */
 } fe_cli_table;
@@ -128,6 +129,44 @@ typedef int fe_cli_row_fn(void *ctx, fe_cli_table *t, const double *row);
 int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
                       int threads, fe_cli_row_fn *fn, void *ctx,
                       char *err, size_t errlen);
+
+/* A fold in parts, for fe_cli_table_fold.  A part is `size` bytes that
+   start(part, config) makes empty; rows(part, config, x, n, &done) folds the n
+   rows x[0..n*k-1] into it and returns FE_OK, or the library's refusal
+   of row *done (the rows before it folded); merge(ctx, t, part, refused)
+   folds a part into the command's own accumulation ctx.  start and rows
+   run on whichever thread parsed the rows, so they may read only
+   `config` (which must not change while the fold runs) and their part;
+   merge runs on the calling thread, part after part in file order.  It
+   is called with refused = FE_OK, or with a refusal, t->line then the
+   refused row's line; it returns 0 to go on, or an exit status (having
+   said why) to stop, which it must do after a refusal.
+   A fold that is not a monoid sets in_order: then the threads only parse,
+   and rows(ctx, config, ...) folds run after run of rows into ctx itself
+   on the calling thread, in file order (start is not called, and merge
+   only after a refusal, with part NULL). */
+typedef struct fe_cli_parts {
+    int in_order;
+    size_t size;
+    const void *config;
+    void (*start)(void *part, const void *config);
+    int (*rows)(void *part, const void *config, const double *x, size_t n, size_t *done);
+    int (*merge)(void *ctx, fe_cli_table *t, const void *part, int refused);
+} fe_cli_parts;
+
+/* Fold the rows of a table (columns cols[0..k-1]) in parts: a regular,
+   uncompressed file is cut into batches of lines that do not depend on
+   `threads`, each batch is parsed and folded into a part of its own on
+   one of `threads` threads, and the parts are merged in file order; the
+   looked-ahead rows and any other input (a pipe, a gzip file, a file too
+   small to cut) make one part on the calling thread.  So the result is
+   the same, bit for bit, for every number of threads, and equal to one
+   part's up to the rounding of the merges.  Returns FE_END after the
+   last row; an exit status with `err` = "FILE:LINE:COLUMN: message" for
+   the first malformed row in file order; or merge's nonzero return,
+   with err empty.  t->rows counts the rows, t->line is the last one's. */
+int fe_cli_table_fold(fe_cli_table *t, const size_t *cols, size_t k, int threads,
+                      const fe_cli_parts *parts, void *ctx, char *err, size_t errlen);
 
 /* The threads to use by default: the processors online (1 when unknown;
    at most FE_CLI_THREADS_MAX).  fe_cli_parse_threads: --threads N, N from

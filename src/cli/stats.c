@@ -15,64 +15,98 @@ static const char fe__stats_help[] =
     "in one pass.  Columns are named by header name or number from 1; default:\n"
     "every column.  The header is found automatically among metadata lines;\n"
     "--skip N skips N lines first.  Malformed input: FILE:LINE:COLUMN: message.\n"
-    "--threads N parses a regular file on N threads (default: the processors\n"
-    "online); the rows are folded in file order, so the result is the same for\n"
+    "--threads N reads a regular file on N threads (default: the processors\n"
+    "online); it is cut the same way for any N, so the result is the same for\n"
     "any N.  Standard input, pipes and gzip files are read by one thread.\n";
 
-/* The fold, in file order (fe_cli_table_each): the rows wait in a run of
-   FE__STATS_RUN, column by column, with their lines, and each column's run
-   goes to fe_meanvar_add_many, the mean and variance's block kernel. */
-enum { FE__STATS_RUN = 512 };
+/* A part of the fold (fe_cli_table_fold): each column's mean and
+   variance and extremes (valid when the column has values). */
+typedef struct fe__stats_column {
+    fe_meanvar mv;
+    double lo, hi;
+} fe__stats_column;
 
+typedef struct fe__stats_part {
+    size_t k;
+    fe__stats_column col[];
+} fe__stats_part;
+
+/* The command's own accumulation: the part all the others merge into. */
 typedef struct fe__stats_fold {
-    size_t k, nrun;             /* columns; rows in the run */
-    double *lo, *hi;
-    fe_meanvar *mv;
-    double *run;                /* k x FE__STATS_RUN: column j at j * FE__STATS_RUN */
-    size_t run_line[FE__STATS_RUN];
+    fe__stats_part *all;
 } fe__stats_fold;
 
-/* Fold the rows waiting in the run.  A value the fold refuses is reported
-   at the first row, in file order, that holds one (a later column may
-   refuse an earlier row): the row the one-value-at-a-time fold stops at. */
-static int fe__stats_fold_run(fe__stats_fold *s, fe_cli_table *t)
+static void fe__stats_start(void *part, const void *config)
 {
-    size_t first = s->nrun;
+    fe__stats_part *p = part;
+    p->k = *(const size_t *)config;
+    for (size_t j = 0; j < p->k; j++) {
+        static const fe__stats_column empty = {FE_MEANVAR_EMPTY, 0.0, 0.0};
+        p->col[j] = empty;
+    }
+}
+
+/* Fold n rows of k columns, column by column in runs of FE__STATS_RUN.
+   A refused value stops at the first row, in file order, that holds one
+   (a later column may refuse an earlier row): the row the
+   one-value-at-a-time fold stops at. */
+enum { FE__STATS_RUN = 512 };
+
+static int fe__stats_rows(void *part, const void *config, const double *x, size_t n,
+                          size_t *done)
+{
+    fe__stats_part *p = part;
+    (void)config;
+    double run[FE__STATS_RUN];
+    size_t first = n;
     int refused = FE_OK;
-    for (size_t j = 0; j < s->k; j++) {
-        const double *x = s->run + j * FE__STATS_RUN;
-        size_t done;
-        int rc = fe_meanvar_add_many(&s->mv[j], x, s->nrun, &done);
-        if (rc != FE_OK && done < first) {
-            first = done;
-            refused = rc;
-        }
-        for (size_t i = 0; i < done; i++) {
-            if (s->mv[j].n == done - i || x[i] < s->lo[j])  /* the column's first value */
-                s->lo[j] = x[i];
-            if (s->mv[j].n == done - i || x[i] > s->hi[j])
-                s->hi[j] = x[i];
+    for (size_t j = 0; j < p->k; j++) {
+        fe__stats_column *c = &p->col[j];
+        for (size_t i0 = 0; i0 < n && i0 < first; i0 += FE__STATS_RUN) {
+            size_t m = n - i0 < FE__STATS_RUN ? n - i0 : FE__STATS_RUN, got;
+            int rc;
+            for (size_t i = 0; i < m; i++)
+                run[i] = x[(i0 + i) * p->k + j];
+            rc = fe_meanvar_add_many(&c->mv, run, m, &got);
+            for (size_t i = 0; i < got; i++) {
+                if (c->mv.n == got - i || run[i] < c->lo)   /* the column's first value */
+                    c->lo = run[i];
+                if (c->mv.n == got - i || run[i] > c->hi)
+                    c->hi = run[i];
+            }
+            if (rc != FE_OK) {
+                if (i0 + got < first) {
+                    first = i0 + got;
+                    refused = rc;
+                }
+                break;
+            }
         }
     }
-    s->nrun = 0;
+    *done = first;
+    return refused;
+}
+
+static int fe__stats_merge(void *ctx, fe_cli_table *t, const void *part, int refused)
+{
+    fe__stats_part *all = ((fe__stats_fold *)ctx)->all;
+    const fe__stats_part *p = part;
+    for (size_t j = 0; j < p->k && refused == FE_OK; j++) {
+        fe__stats_column *a = &all->col[j];
+        const fe__stats_column *b = &p->col[j];
+        if (b->mv.n == 0)
+            continue;
+        if (a->mv.n == 0 || b->lo < a->lo)
+            a->lo = b->lo;
+        if (a->mv.n == 0 || b->hi > a->hi)
+            a->hi = b->hi;
+        refused = fe_meanvar_merge(&a->mv, &b->mv);
+    }
     if (refused == FE_OK)
         return 0;
     fe_cli_progress_done(t);
-    fprintf(stderr, "foldest stats: %s:%zu: %s\n", t->name, s->run_line[first],
-            fe_strerror(refused));
+    fprintf(stderr, "foldest stats: %s:%zu: %s\n", t->name, t->line, fe_strerror(refused));
     return FE_CLI_INPUT;
-}
-
-static int fe__stats_row(void *ctx, fe_cli_table *t, const double *row)
-{
-    fe__stats_fold *s = ctx;
-    for (size_t j = 0; j < s->k; j++)
-        s->run[j * FE__STATS_RUN + s->nrun] = row[j];
-    s->run_line[s->nrun++] = t->line;
-    if (s->nrun == FE__STATS_RUN && fe__stats_fold_run(s, t) != 0)
-        return FE_CLI_INPUT;
-    fe_cli_progress(t);
-    return 0;
 }
 
 static const fe_cli_option fe__stats_options[] = {
@@ -86,9 +120,9 @@ int fe_cli_stats(int argc, char **argv)
     int json = 0, rc, threads = fe_cli_threads_default();
     fe_cli_table t;
     size_t k = 0, *cols = NULL;
-    double *lo = NULL, *hi = NULL, *run = NULL;
-    fe_meanvar *mv = NULL;
-    fe__stats_fold fold;
+    fe__stats_fold fold = {NULL};
+    fe_cli_parts parts = {0, 0, NULL, fe__stats_start, fe__stats_rows, fe__stats_merge};
+    const fe__stats_column *col;
 
     rc = fe_cli_options("stats", fe__stats_options, &argc, &argv);
     if (rc != FE_CLI_OK)
@@ -155,24 +189,14 @@ int fe_cli_stats(int argc, char **argv)
         for (k = 0; k < t.ncols; k++)
             cols[k] = k;
     }
-    lo = calloc(k + 1, sizeof *lo);            /* + 1: never calloc(0) */
-    hi = calloc(k + 1, sizeof *hi);
-    mv = calloc(k + 1, sizeof *mv);
-    run = calloc((k + 1) * FE__STATS_RUN, sizeof *run);
-    if (lo == NULL || hi == NULL || mv == NULL || run == NULL)
+    parts.size = sizeof(fe__stats_part) + k * sizeof(fe__stats_column);
+    parts.config = &k;
+    fold.all = malloc(parts.size);
+    if (fold.all == NULL)
         goto out_of_memory;
-    fold.k = k;
-    fold.nrun = 0;
-    fold.lo = lo;
-    fold.hi = hi;
-    fold.mv = mv;
-    fold.run = run;
-    rc = fe_cli_table_each(&t, cols, k, threads, fe__stats_row, &fold, err, sizeof err);
-    /* The rows still waiting come before the end, or a malformed row. */
-    if ((rc == FE_END || err[0] != '\0') && fe__stats_fold_run(&fold, &t) != 0) {
-        rc = FE_CLI_INPUT;
-        goto done;
-    }
+    fe__stats_start(fold.all, &k);
+    col = fold.all->col;
+    rc = fe_cli_table_fold(&t, cols, k, threads, &parts, &fold, err, sizeof err);
     fe_cli_progress_done(&t);
     if (rc != FE_END) {
         if (err[0] != '\0')
@@ -194,13 +218,13 @@ int fe_cli_stats(int argc, char **argv)
             printf("%s{\"name\": ", j ? ", " : "");
             fe_cli_json_string(stdout, t.names[cols[j]]);
             printf(", \"mean\": ");
-            fe_cli_json_number(stdout, fe_meanvar_mean(&mv[j]));
+            fe_cli_json_number(stdout, fe_meanvar_mean(&col[j].mv));
             printf(", \"stddev\": ");
-            fe_cli_json_number(stdout, fe_meanvar_stddev(&mv[j]));
+            fe_cli_json_number(stdout, fe_meanvar_stddev(&col[j].mv));
             printf(", \"min\": ");
-            fe_cli_json_number(stdout, lo[j]);
+            fe_cli_json_number(stdout, col[j].lo);
             printf(", \"max\": ");
-            fe_cli_json_number(stdout, hi[j]);
+            fe_cli_json_number(stdout, col[j].hi);
             printf("}");
         }
         printf("]}\n");
@@ -209,7 +233,8 @@ int fe_cli_stats(int argc, char **argv)
                "mean", "stddev", "min", "max");
         for (size_t j = 0; j < k; j++)
             printf("%-24.24s %15.6g %15.6g %15.6g %15.6g\n", t.names[cols[j]],
-                   fe_meanvar_mean(&mv[j]), fe_meanvar_stddev(&mv[j]), lo[j], hi[j]);
+                   fe_meanvar_mean(&col[j].mv), fe_meanvar_stddev(&col[j].mv), col[j].lo,
+                   col[j].hi);
     }
     rc = FE_CLI_OK;
     goto done;
@@ -218,10 +243,7 @@ out_of_memory:
     rc = FE_CLI_IO;
 done:
     free(cols);
-    free(lo);
-    free(hi);
-    free(mv);
-    free(run);
+    free(fold.all);
     fe_cli_table_close(&t);
     return rc;
 }

@@ -458,6 +458,7 @@ enum { FE__CLI_ONE = -1 };
 static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
                              double *out, char *err, size_t errlen);
 static void fe__cli_pass_end(fe_cli_table *t);
+static void fe__cli_progress_show(fe_cli_table *t);
 
 /* One line: a row, FE_END, an error, or FE__CLI_SKIPPED for a bad row
    that --skip-bad-rows counted (the caller reads on: a loop, not a
@@ -476,7 +477,7 @@ static int fe__cli_table_row(fe_cli_table *t, const size_t *cols, size_t k,
             line = t->scratch;
             strcpy(line, t->pending[t->next_pending]);
             t->line = t->pending_line[t->next_pending++];
-        } else if (t->threads > 1 && !t->serial && !t->view
+        } else if ((t->threads > 1 || t->parts != NULL) && !t->serial && !t->view
                    && (rc = fe__cli_pass_next(t, cols, k, out, err, errlen)) != FE__CLI_ONE) {
             return rc;          /* a row parsed on a thread, or the end */
         } else {
@@ -608,7 +609,8 @@ void fe_cli_table_close(fe_cli_table *t)
 }
 /* Read the next row ends here */
 /* [[file:../../literate/cli.org::Parallel Pass Private Data][Parallel Pass Private Data]] */
-enum { FE__CLI_BATCH = 1 << 20, FE__CLI_BATCH_MIN = 1 << 16, FE__CLI_SLOTS = 4 };
+enum { FE__CLI_BATCH = 1 << 20, FE__CLI_BATCH_MIN = 1 << 16, FE__CLI_SLOTS = 4,
+       FE__CLI_RUN = 512, FE__CLI_PART = -3 };
 
 /* Rows --skip-bad-rows skipped before row `row` of a batch, by reason:
    the counts so far (bad rows are few; the list grows as needed). */
@@ -617,8 +619,14 @@ typedef struct fe__cli_skipped {
 } fe__cli_skipped;
 
 /* One batch's rows, parsed by whichever thread claimed it. */
+/* A slot is written row by row by the thread that parses into it, so
+   slots (and parts) start on a cache line of their own
+   (FE__CLI_CACHE_LINE): two threads writing neighbours' counters each
+   row would cost a third of the run in cache misses. */
+enum { FE__CLI_CACHE_LINE = 64 };
+
 typedef struct fe__cli_batch {
-    double *rows;               /* n rows of k doubles */
+    _Alignas(FE__CLI_CACHE_LINE) double *rows;  /* n rows of k doubles */
     size_t *line;               /* each row's line within the batch, from 2 */
     size_t n, cap;
     size_t lines;               /* the lines the batch holds */
@@ -628,6 +636,11 @@ typedef struct fe__cli_batch {
     int status;                 /* FE_END: all read; else the error after row n */
     int ready;
     char err[1024];
+    /* fe_cli_table_fold: the rows go to the part in runs of FE__CLI_RUN,
+       and only the run being parsed is kept (rows and line from run0). */
+    void *part;
+    size_t run0, last_line;     /* the run's first row; the last row's line */
+    int fold_rc;                /* FE_OK, or the refusal of row run0 */
 } fe__cli_batch;
 
 /* The state the threads share, under `lock`. */
@@ -635,6 +648,7 @@ typedef struct fe__cli_pass {
     const fe_cli_table *t;      /* read-only while the pass runs */
     const size_t *cols;
     size_t k;
+    const fe_cli_parts *parts;  /* fe_cli_table_fold's, or NULL */
     off_t data, size, step;     /* D, the file's size, the batch size S */
     size_t nbatches, nslots;
     fe__cli_batch *slot;        /* batch b in slot b % nslots */
@@ -728,6 +742,23 @@ static int fe__cli_note_skipped(fe__cli_batch *s, const fe_cli_table *v)
     return 0;
 }
 
+/* Fold the run of rows parsed since the last into the batch's part;
+   FE_OK, or the refusal (s->fold_rc, with s->run0 the refused row and
+   s->last_line its line). */
+static int fe__cli_fold_run(const fe__cli_pass *p, fe__cli_batch *s)
+{
+    size_t done;
+    int rc = p->parts->rows(s->part, p->parts->config, s->rows, s->n - s->run0, &done);
+    if (rc != FE_OK) {
+        s->fold_rc = rc;
+        s->last_line = s->line[done];
+        s->run0 += done;
+        return rc;
+    }
+    s->run0 = s->n;
+    return FE_OK;
+}
+
 static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
                                 fe__cli_batch *s)
 {
@@ -736,10 +767,14 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
     fe_cli_table v;
     off_t start = fe__cli_batch_start(p, b), end = fe__cli_batch_start(p, b + 1);
     size_t skipped = 0;
+    int folds = p->parts != NULL && !p->parts->in_order;     /* here, into a part */
 
-    s->n = s->lines = s->nskipped = 0;
+    s->n = s->lines = s->nskipped = s->run0 = 0;
     s->end = end;
     s->err[0] = '\0';
+    s->fold_rc = FE_OK;
+    if (folds)
+        p->parts->start(s->part, p->parts->config);
     if (start < 0 || end < 0) {
         s->status = fe__cli_at(t, 1, 1, FE_CLI_IO, s->err, sizeof s->err,
                                "read error: %s", strerror(errno));
@@ -763,7 +798,11 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
     v.reader.line = 1;          /* not the first line: no byte-order mark */
     for (;;) {
         int rc;
-        if (s->n == s->cap) {
+        if (folds && s->n - s->run0 == FE__CLI_RUN && fe__cli_fold_run(p, s) != FE_OK) {
+            s->status = FE_END;     /* nothing after the refusal counts */
+            return;
+        }
+        if (s->n - s->run0 == s->cap) {
             size_t cap = s->cap ? 2 * s->cap : 4096;
             double *rows = realloc(s->rows, cap * (p->k + 1) * sizeof *rows);
             size_t *line = rows != NULL ? realloc(s->line, cap * sizeof *line) : NULL;
@@ -777,7 +816,8 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
             s->line = line;
             s->cap = cap;
         }
-        rc = fe_cli_table_next(&v, p->cols, p->k, s->rows + s->n * p->k, s->err, sizeof s->err);
+        rc = fe_cli_table_next(&v, p->cols, p->k, s->rows + (s->n - s->run0) * p->k, s->err,
+                               sizeof s->err);
         if (v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3] > skipped
             && fe__cli_note_skipped(s, &v) != 0) {
             s->status = fe__cli_at(t, v.reader.line, 1, FE_CLI_IO, s->err, sizeof s->err,
@@ -786,7 +826,7 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
         }
         skipped = v.bad[0] + v.bad[1] + v.bad[2] + v.bad[3];
         if (rc == FE_OK) {
-            s->line[s->n++] = v.line;
+            s->line[s->n++ - s->run0] = s->last_line = v.line;
             continue;
         }
         s->status = rc;
@@ -794,6 +834,8 @@ static void fe__cli_parse_batch(fe__cli_pass *p, fe__cli_worker *w, size_t b,
             s->lines = v.reader.line - 1;
         break;
     }
+    if (folds && s->n > s->run0)        /* the rows before the end or an error */
+        fe__cli_fold_run(p, s);
 }
 /* Parse one batch on a worker ends here */
 /* [[file:../../literate/cli.org::Claim batches until none is left][Claim batches until none is left]] */
@@ -814,7 +856,7 @@ static void fe__cli_fill(fe__cli_pass *p, fe__cli_worker *w, size_t b)
     fe__cli_parse_batch(p, w, b, s);
     pthread_mutex_lock(&p->lock);
     s->ready = 1;
-    if (s->status != FE_END && b < p->failed)
+    if ((s->status != FE_END || s->fold_rc != FE_OK) && b < p->failed)
         p->failed = b;
     pthread_cond_broadcast(&p->ready);
 }
@@ -903,6 +945,7 @@ static void fe__cli_pass_end(fe_cli_table *t)
         free(p->slot[i].rows);
         free(p->slot[i].line);
         free(p->slot[i].skipped);
+        free(p->slot[i].part);
     }
     for (size_t i = 0; i < p->nslots / FE__CLI_SLOTS; i++) {     /* the threads */
         free(p->w[i].buffer);
@@ -912,6 +955,12 @@ static void fe__cli_pass_end(fe_cli_table *t)
     free(p->w);
     free(p);
     t->pass = NULL;
+}
+
+/* n bytes rounded up to whole cache lines (aligned_alloc's sizes). */
+static size_t fe__cli_lines(size_t n)
+{
+    return (n + FE__CLI_CACHE_LINE - 1) / FE__CLI_CACHE_LINE * FE__CLI_CACHE_LINE;
 }
 
 /* Cut the file and start the workers; FE__CLI_ONE when it cannot be cut
@@ -928,7 +977,9 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     if (fstat(t->fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > t->size)
         t->size = st.st_size;   /* a log that grew since it was opened */
     data = fe__cli_data_offset(t);
-    step = (data > 0 ? t->size - data : 0) / (4 * (off_t)t->threads);
+    /* Parts are cut the same way on any number of threads (16 batches,
+       four each for four threads), so that they merge the same way. */
+    step = (data > 0 ? t->size - data : 0) / (t->parts != NULL ? 16 : 4 * (off_t)t->threads);
     step = step > FE__CLI_BATCH ? FE__CLI_BATCH : step;
     if (batch > 0)
         step = (off_t)batch;
@@ -944,6 +995,7 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     p->t = t;
     p->cols = cols;
     p->k = k;
+    p->parts = t->parts;
     p->data = data;
     p->size = t->size;
     p->step = step;
@@ -951,7 +1003,9 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     p->failed = p->nbatches;
     p->nslots = FE__CLI_SLOTS * (size_t)t->threads;
     p->base = t->look_end;
-    p->slot = calloc(p->nslots, sizeof *p->slot);
+    p->slot = aligned_alloc(FE__CLI_CACHE_LINE, p->nslots * sizeof *p->slot);
+    if (p->slot != NULL)
+        memset(p->slot, 0, p->nslots * sizeof *p->slot);
     p->w = calloc((size_t)t->threads, sizeof *p->w);
     if (p->slot == NULL || p->w == NULL) {
         free(p->slot);
@@ -963,6 +1017,12 @@ static int fe__cli_pass_start(fe_cli_table *t, const size_t *cols, size_t k,
     pthread_cond_init(&p->ready, NULL);
     pthread_cond_init(&p->room, NULL);
     t->pass = p;
+    for (size_t i = 0; p->parts != NULL && !p->parts->in_order && i < p->nslots; i++)
+        if ((p->slot[i].part = aligned_alloc(FE__CLI_CACHE_LINE, fe__cli_lines(p->parts->size)))
+            == NULL) {
+            fe__cli_pass_end(t);
+            goto out_of_memory;
+        }
     for (int i = 0; i < t->threads; i++) {
         p->w[i].pass = p;
         p->w[i].buffer = malloc(FE_CLI_LINE_MAX);
@@ -1010,6 +1070,21 @@ static void fe__cli_count_skipped(fe__cli_pass *p, fe_cli_table *t, const fe__cl
     }
 }
 
+/* Batch s (the one handed out) is done: its lines are counted and its
+   slot is free for a worker. */
+static void fe__cli_batch_done(fe__cli_pass *p, fe_cli_table *t, fe__cli_batch *s)
+{
+    p->base += s->lines;
+    t->at = s->end;
+    pthread_mutex_lock(&p->lock);
+    s->ready = 0;
+    p->taken++;
+    pthread_cond_broadcast(&p->room);
+    pthread_mutex_unlock(&p->lock);
+    p->cur++;
+    p->have = 0;
+}
+
 static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
                              double *out, char *err, size_t errlen)
 {
@@ -1043,6 +1118,8 @@ static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
             p->have = 1;
             p->pos = p->bad_seen = 0;
         }
+        if (p->parts != NULL)
+            return FE__CLI_PART;    /* fe_cli_table_fold takes the part */
         if (p->pos < s->n) {
             fe__cli_count_skipped(p, t, s, p->pos);
             memcpy(out, s->rows + p->pos * p->k, p->k * sizeof *out);
@@ -1057,17 +1134,10 @@ static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
             snprintf(err, errlen, "%s", s->err);
             return s->status;
         }
-        p->base += s->lines;
-        t->at = s->end;
-        pthread_mutex_lock(&p->lock);
-        s->ready = 0;
-        p->taken++;
-        pthread_cond_broadcast(&p->room);
-        pthread_mutex_unlock(&p->lock);
-        p->cur++;
-        p->have = 0;
+        fe__cli_batch_done(p, t, s);
     }
 }
+
 
 int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
                       int threads, fe_cli_row_fn *fn, void *ctx,
@@ -1088,6 +1158,162 @@ int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
         }
     fe__cli_pass_end(t);        /* cols may go once this returns */
     free(row);
+    return rc;
+}
+
+/* Fold the calling thread's run of *n rows into `into`: 0, or after a
+   refusal merge's exit status, with t->rows and t->line at the refused
+   row. */
+static int fe__cli_run_fold(fe_cli_table *t, const fe_cli_parts *parts, void *ctx, void *into,
+                            const double *run, const size_t *line, size_t *n)
+{
+    size_t done;
+    int rc = *n > 0 ? parts->rows(into, parts->config, run, *n, &done) : FE_OK;
+    if (rc != FE_OK) {
+        t->rows -= *n - done - 1;
+        t->line = line[done];
+        return parts->merge(ctx, t, parts->in_order ? NULL : into, rc);
+    }
+    *n = 0;
+    return 0;
+}
+
+/* The batch handed out is done (its rows folded): count its lines, free
+   its slot, show progress; FE_OK, or the batch's own error, which comes
+   after its rows. */
+static int fe__cli_pass_batch_end(fe_cli_table *t, size_t rows_before, char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s = &p->slot[p->cur % p->nslots];
+    fe__cli_count_skipped(p, t, s, (size_t)-1);
+    if (s->status != FE_END) {
+        p->done = 1;
+        fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
+        snprintf(err, errlen, "%s", s->err);
+        return s->status;
+    }
+    fe__cli_batch_done(p, t, s);
+    if (rows_before >> 16 != t->rows >> 16)
+        fe__cli_progress_show(t);
+    return FE_OK;
+}
+
+/* A fold in parts: merge the part of the batch handed out
+   (fe__cli_pass_next said FE__CLI_PART), counting its rows as handing
+   them out one by one would have.  FE_OK to go on; else merge's exit
+   status (err empty) or the batch's error. */
+static int fe__cli_pass_part(fe_cli_table *t, const fe_cli_parts *parts, void *ctx,
+                             char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s = &p->slot[p->cur % p->nslots];
+    size_t rows = t->rows;
+    int rc;
+    if (s->fold_rc != FE_OK) {  /* the rows before the refused one, then it */
+        fe__cli_count_skipped(p, t, s, s->run0);
+        t->rows += s->run0 + 1;
+        t->line = p->base + s->last_line - 1;
+        p->done = 1;
+        err[0] = '\0';
+        return parts->merge(ctx, t, s->part, s->fold_rc);
+    }
+    t->rows += s->n;
+    if (s->n > 0)
+        t->line = p->base + s->last_line - 1;
+    if ((rc = parts->merge(ctx, t, s->part, FE_OK)) != 0) {
+        p->done = 1;
+        err[0] = '\0';
+        return rc;
+    }
+    return fe__cli_pass_batch_end(t, rows, err, errlen);
+}
+
+/* A fold in order: the rows of the batch handed out join the calling
+   thread's run (run, line, *n) as if read one by one, and each full run
+   is folded, so that the runs are the one reader's.  FE_OK to go on;
+   merge's exit status after a refusal (err empty); or the batch's error,
+   the run then holding the rows before it. */
+static int fe__cli_pass_rows(fe_cli_table *t, const fe_cli_parts *parts, void *ctx,
+                             double *run, size_t *line, size_t *n, char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s = &p->slot[p->cur % p->nslots];
+    size_t rows = t->rows;
+    for (size_t i = 0; i < s->n; i++) {
+        fe__cli_count_skipped(p, t, s, i);
+        memcpy(run + *n * p->k, s->rows + i * p->k, p->k * sizeof *run);
+        t->line = line[(*n)++] = p->base + s->line[i] - 1;
+        t->rows++;
+        if (*n == FE__CLI_RUN) {
+            int rc = fe__cli_run_fold(t, parts, ctx, ctx, run, line, n);
+            if (rc != 0) {
+                p->done = 1;
+                err[0] = '\0';
+                return rc;
+            }
+        }
+    }
+    return fe__cli_pass_batch_end(t, rows, err, errlen);
+}
+
+int fe_cli_table_fold(fe_cli_table *t, const size_t *cols, size_t k, int threads,
+                      const fe_cli_parts *parts, void *ctx, char *err, size_t errlen)
+{
+    size_t line[FE__CLI_RUN], n = 0;
+    double *run = malloc(FE__CLI_RUN * (k + 1) * sizeof *run);
+    void *mine = malloc(parts->in_order ? 1 : parts->size);
+    void *into = parts->in_order ? ctx : mine;      /* where this thread's rows go */
+    int rc;
+    err[0] = '\0';
+    if (run == NULL || mine == NULL) {
+        free(run);
+        free(mine);
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        return FE_CLI_IO;
+    }
+    fe_cli_table_threads(t, threads);
+    t->parts = parts;
+    if (!parts->in_order)
+        parts->start(mine, parts->config);
+    for (;;) {
+        int stop;
+        rc = fe_cli_table_next(t, cols, k, run + n * k, err, errlen);
+        if (rc == FE_OK) {
+            line[n++] = t->line;
+            fe_cli_progress(t);
+            if (n < FE__CLI_RUN)
+                continue;
+        } else if (rc == FE__CLI_PART && parts->in_order) {
+            rc = fe__cli_pass_rows(t, parts, ctx, run, line, &n, err, errlen);
+            if (rc == FE_OK)
+                continue;
+            if (err[0] == '\0')
+                break;          /* refused, and said so */
+        }
+        /* A full run, the end, a malformed row or a part: the rows this
+           thread read come first. */
+        if ((stop = fe__cli_run_fold(t, parts, ctx, into, run, line, &n)) != 0) {
+            rc = stop;
+            err[0] = '\0';
+            break;
+        }
+        if (rc == FE_OK)
+            continue;
+        if (!parts->in_order) {
+            if ((stop = parts->merge(ctx, t, mine, FE_OK)) != 0) {
+                rc = stop;
+                err[0] = '\0';
+                break;
+            }
+            parts->start(mine, parts->config);
+        }
+        if (rc != FE__CLI_PART || (rc = fe__cli_pass_part(t, parts, ctx, err, errlen)) != FE_OK)
+            break;
+    }
+    fe__cli_pass_end(t);        /* cols may go once this returns */
+    t->parts = NULL;
+    free(run);
+    free(mine);
     return rc;
 }
 
@@ -1334,8 +1560,14 @@ int fe_cli_spawn(char *const argv[])
 /* [[file:../../literate/cli.org::Show progress][Show progress]] */
 void fe_cli_progress(fe_cli_table *t)
 {
+    if ((t->rows & 0xffff) == 0)
+        fe__cli_progress_show(t);
+}
+
+static void fe__cli_progress_show(fe_cli_table *t)
+{
     off_t at;
-    if (!t->progress || (t->rows & 0xffff) != 0)
+    if (!t->progress)
         return;
     at = t->at > 0 ? t->at : t->gz != NULL ? (off_t)gzoffset((gzFile)t->gz) : (off_t)-1;
     if (at >= 0)
