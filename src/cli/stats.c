@@ -64,14 +64,14 @@ static int fe__stats_rows(void *part, const void *config, const double *x, size_
         fe__stats_column *c = &p->col[j];
         for (size_t i0 = 0; i0 < n && i0 < first; i0 += FE__STATS_RUN) {
             size_t m = n - i0 < FE__STATS_RUN ? n - i0 : FE__STATS_RUN, got;
-            int rc;
+            int rc, empty = c->mv.n == 0;
             for (size_t i = 0; i < m; i++)
                 run[i] = x[(i0 + i) * p->k + j];
             rc = fe_meanvar_add_many(&c->mv, run, m, &got);
-            for (size_t i = 0; i < got; i++) {
-                if (c->mv.n == got - i || run[i] < c->lo)   /* the column's first value */
+            for (size_t i = 0; i < got && i < m; i++) {
+                if ((empty && i == 0) || run[i] < c->lo)    /* the column's first value */
                     c->lo = run[i];
-                if (c->mv.n == got - i || run[i] > c->hi)
+                if ((empty && i == 0) || run[i] > c->hi)
                     c->hi = run[i];
             }
             if (rc != FE_OK) {
