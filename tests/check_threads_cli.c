@@ -375,6 +375,118 @@ START_TEST(discover_same_on_every_cut)
 }
 END_TEST
 
+/* Remove the lines that say where discover cut a pass; how many there
+   were. */
+static int strip_cut(char *out)
+{
+    int n = 0;
+    char *at;
+    while ((at = strstr(out, "foldest: discover: a pass cut at row ")) != NULL) {
+        char *nl = strchr(at, '\n');
+        memmove(at, nl != NULL ? nl + 1 : at + strlen(at), strlen(nl != NULL ? nl + 1 : "") + 1);
+        n++;
+    }
+    return n;
+}
+
+/* A record of 20,000 rows: discover cuts passes 2 and 3 in two parts
+   (the later on a thread of its own with second readers of the files, or
+   after the earlier one on one thread, or when a file is gzip'd), so its
+   JSON is the same bit for bit on 1, 2 and 3 threads, from a pipe and
+   from a gzip file, and the one-piece fold's (FOLDEST_CUT=0) but for the
+   rounding of the merges.  A term that is not finite in the later part is
+   reported at its line, and one in the earlier part first. */
+START_TEST(discover_same_in_two_parts)
+{
+    static char one[OUT], cut[OUT], many[OUT];
+    char real[256], sim[256], gate[300], cmd[4096], args[2048];
+    temp_path(real, sizeof real, ".real.csv");
+    temp_path(sim, sizeof sim, ".sim.csv");
+    snprintf(gate, sizeof gate, "%s.gate.csv", real);
+    snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --rows 20000 --real %s --sim %s",
+             FE_TEST_CLI, real, sim);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, one, sizeof one), 0);
+    snprintf(args, sizeof args, "--sim %s --channel acceleration --role position=position "
+             "--role velocity=velocity --role input=input --base bias,gain --holdout 0.3 --json",
+             sim);
+    snprintf(cmd, sizeof cmd, "FOLDEST_CUT=0 %s discover --real %s %s --threads 2", FE_TEST_CLI,
+             real, args);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, one, sizeof one), 0);
+    ck_assert_msg(strip_cut(one) == 0, "%s", one);
+    snprintf(cmd, sizeof cmd, "FOLDEST_CUT=1 %s discover --real %s %s --threads 1", FE_TEST_CLI,
+             real, args);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, cut, sizeof cut), 0);
+    ck_assert_msg(strip_cut(cut) == 2, "passes 2 and 3 not cut: %s", cut);
+    ck_assert_msg(same_but_rounding(one, cut, 1e-12), "cut:\n%.1500s\nin one piece:\n%.1500s", cut, one);
+    for (int t = 2; t <= 3; t++) {
+        snprintf(cmd, sizeof cmd, "FOLDEST_CUT=1 %s discover --real %s %s --threads %d",
+                 FE_TEST_CLI, real, args, t);
+        ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, many, sizeof many), 0);
+        ck_assert_int_eq(strip_cut(many), 2);
+        ck_assert_msg(strcmp(cut, many) == 0, "--threads %d:\n%.1500s\none thread:\n%.1500s", t, many, cut);
+    }
+    /* The recording from a pipe (copied to a temporary file, read in
+       parts), the simulation gzip'd (read after the earlier part). */
+    snprintf(cmd, sizeof cmd, "gzip -k %s && cat %s | FOLDEST_CUT=1 %s discover --real - --sim "
+             "%s.gz --channel acceleration --role position=position --role velocity=velocity "
+             "--role input=input --base bias,gain --holdout 0.3 --json --threads 2", sim, real,
+             FE_TEST_CLI, sim);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, many, sizeof many), 0);
+    ck_assert_msg(strcmp(strstr(cut, "\"rows\""), strstr(many, "\"rows\"")) == 0,
+                  "a pipe and gzip:\n%.1500s\nfiles:\n%.1500s", many, cut);
+    /* A column `gate`, 0 on line 15002 (and 5002): 1/gate is refused there. */
+    for (int early = 0; early < 2; early++) {
+        char status_one[512];
+        snprintf(cmd, sizeof cmd, "awk -F, 'NR == 1 { print $0 \",gate\"; next } "
+                 "{ print $0 \",\" ((NR == 15002 || (%d && NR == 5002)) ? 0 : 1) }' %s > %s",
+                 early, real, gate);
+        ck_assert_int_eq(system(cmd), 0);
+        for (int t = 1; t <= 2; t++) {
+            char *out = t == 1 ? status_one : many;
+            size_t len = t == 1 ? sizeof status_one : sizeof many;
+            char want[512];
+            snprintf(cmd, sizeof cmd, "%s discover --real %s %s --term 'inv=1/gate' --threads %d",
+                     FE_TEST_CLI, gate, args, t);
+            ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, out, len), 3);
+            snprintf(want, sizeof want, "%s:%d: term 'inv' is infinite at t = ", gate,
+                     early ? 5002 : 15002);
+            ck_assert_msg(strstr(out, want) != NULL, "want %s, got %s", want, out);
+        }
+        ck_assert_str_eq(status_one, many);
+    }
+    /* Two recordings, 12,000 and 8,000 rows, the second held out whole:
+       the later part reads the end of the first and all of the second
+       from its start; it says the second is held out. */
+    snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --seed 7 --rows 12000 --real %s "
+             "--sim %s 2>/dev/null && %s synth --effect viscous_friction --seed 8 --rows 8000 --real %s.2 "
+             "--sim %s.2", FE_TEST_CLI, real, sim, FE_TEST_CLI, real, sim);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, many, sizeof many), 0);
+    snprintf(args, sizeof args, "--real %s --sim %s --real %s.2 --sim %s.2 --channel acceleration "
+             "--role position=position --role velocity=velocity --role input=input --base "
+             "bias,gain --holdout 0.4 --json", real, sim, real, sim);
+    snprintf(cmd, sizeof cmd, "FOLDEST_CUT=0 %s discover %s", FE_TEST_CLI, args);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, one, sizeof one), 0);
+    ck_assert_msg(strstr(one, "\"recording\": 2, \"rows\": 8000, \"heldout\": true") != NULL,
+                  "%s", one);
+    for (int t = 1; t <= 2; t++) {
+        snprintf(cmd, sizeof cmd, "FOLDEST_CUT=1 %s discover %s --threads %d", FE_TEST_CLI, args, t);
+        ck_assert_int_eq(fe_test_run(cmd, FE_TEST_BOTH, t == 1 ? cut : many, OUT), 0);
+        ck_assert_int_eq(strip_cut(t == 1 ? cut : many), 2);
+    }
+    ck_assert_msg(same_but_rounding(one, cut, 1e-12), "cut:\n%.1500s\nin one piece:\n%.1500s", cut, one);
+    ck_assert_msg(strcmp(cut, many) == 0, "two threads:\n%.1500s\none:\n%.1500s", many, cut);
+    snprintf(cmd, sizeof cmd, "%s.gz", sim);
+    unlink(cmd);
+    snprintf(cmd, sizeof cmd, "%s.2", sim);
+    unlink(cmd);
+    snprintf(cmd, sizeof cmd, "%s.2", real);
+    unlink(cmd);
+    unlink(real);
+    unlink(sim);
+    unlink(gate);
+}
+END_TEST
+
 /* --threads takes 1 to 64, in every command that reads tables. */
 START_TEST(threads_option_checked)
 {
@@ -404,6 +516,7 @@ Suite *fe_threads_cli_suite(void)
     tcase_add_test(t, pipes_and_gzip_keep_one_reader);
     tcase_add_test(t, fewer_rows_than_threads);
     tcase_add_test(t, discover_same_on_every_cut);
+    tcase_add_test(t, discover_same_in_two_parts);
     tcase_add_test(t, threads_option_checked);
     suite_add_tcase(s, t);
     return s;

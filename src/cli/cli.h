@@ -62,6 +62,8 @@ typedef struct fe_cli_table {
     int serial;                 /* 1: the input cannot be cut */
     void *pass;                 /* the threads' pass, while one runs */
     const struct fe_cli_parts *parts;   /* fe_cli_table_fold's, while it runs */
+    off_t part_at;              /* a part's reader (fe_cli_table_open_part): the
+                                   next byte it reads */
     off_t at;                   /* the bytes the batches have handed out,
                                    for progress; 0: ask zlib */
 } fe_cli_table;
@@ -167,6 +169,19 @@ typedef struct fe_cli_parts {
    with err empty.  t->rows counts the rows, t->line is the last one's. */
 int fe_cli_table_fold(fe_cli_table *t, const size_t *cols, size_t k, int threads,
                       const fe_cli_parts *parts, void *ctx, char *err, size_t errlen);
+
+/* A second reader of t's file, for a later part of a pass that another
+   thread reads (discover's folds): `part` reads the rows after line
+   `line` as t would, as if `rows` rows had been read, with buffers of its
+   own and pread (t's offset is untouched); it shares t's descriptor,
+   column names and conventions, so t must stay open while part is used,
+   and t may be read meanwhile.  A part counts its bad rows in part->bad
+   only and shows no progress.  FE_CLI_IO with a message when t's input
+   cannot be read so (a gzip file) or without memory; nothing to close
+   then.  fe_cli_table_close_part frees what a part holds. */
+int fe_cli_table_open_part(fe_cli_table *part, const fe_cli_table *t, size_t line, size_t rows,
+                           char *err, size_t errlen);
+void fe_cli_table_close_part(fe_cli_table *part);
 
 /* The threads to use by default: the processors online (1 when unknown;
    at most FE_CLI_THREADS_MAX).  fe_cli_parse_threads: --threads N, N from

@@ -5,6 +5,8 @@
 
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -278,9 +280,10 @@ static int fe__pair_rewind(fe__pair *p, char *err, size_t errlen)
 }
 /* Align a recording with its simulation ends here */
 /* [[file:../../literate/cli_discover.org::A panel of rows][A panel of rows]] */
-/* Rows waiting to be folded, with where each came from. */
+/* Rows waiting to be folded, with where each came from; nbreak: the
+   breaks between pairs of files that come before them. */
 typedef struct fe__panel {
-    size_t n;
+    size_t n, nbreak;
     double vars[FE_DISCOVER_PANEL_ROWS][FE__MAX_VARS];
     double phi[FE_DISCOVER_PANEL_ROWS][FE_DISCOVER_MAX_COLUMNS];
     double r[FE_DISCOVER_PANEL_ROWS], t[FE_DISCOVER_PANEL_ROWS];
@@ -289,21 +292,30 @@ typedef struct fe__panel {
 } fe__panel;
 
 /* Evaluate the catalog's terms on the panel's rows (work: for
-   fe_catalog_eval_rows) and fold them; on a refusal, p->n is the refused
-   row's index (the rows before it are folded, unless a term was not
-   finite: then none of the panel is).  With c NULL the panel's columns
-   are already there (the signatures of --order). */
-static int fe__flush_panel(const fe_catalog *c, fe_discover_acc *acc, fe__panel *p,
-                           double *work)
+   fe_catalog_eval_rows); with c NULL the panel's columns are already
+   there (the signatures of --order).  On a term that is not finite, p->n
+   is its row's index, and none of the panel may be folded. */
+static int fe__panel_terms(const fe_catalog *c, fe__panel *p, double *work)
 {
     size_t done = 0;
     int rc = FE_OK;
-    if (p->n == 0)
-        return FE_OK;
-    if (c != NULL)
+    if (c != NULL && p->n > 0)
         rc = fe_catalog_eval_rows(c, p->vars[0], FE__MAX_VARS, p->n, p->phi[0],
                                   FE_DISCOVER_MAX_COLUMNS, work, &done);
-    if (rc == FE_OK)
+    if (rc != FE_OK)
+        p->n = done;
+    return rc;
+}
+
+/* Fold the panel's breaks and rows; on a refusal, p->n is the refused
+   row's index (the rows before it are folded). */
+static int fe__panel_fold(fe_discover_acc *acc, fe__panel *p)
+{
+    size_t done = 0;
+    int rc = FE_OK;
+    for (; p->nbreak > 0; p->nbreak--)
+        fe_discover_break(acc);
+    if (p->n > 0)
         rc = fe_discover_add_rows(acc, p->phi[0], FE_DISCOVER_MAX_COLUMNS, p->r, p->n, &done);
     p->n = rc == FE_OK ? 0 : done;
     return rc;
@@ -1944,6 +1956,16 @@ typedef struct fe__run {
     fe__outcome out;
     fe__user_terms terms;               /* --term, --terms */
     double *term_work;                  /* fe_catalog_eval_rows's */
+    /* Passes 2 and 3 in two parts: pass 1's marks; the later part's
+       accumulation, residual map and per-recording fits, with their
+       storage, and its workspace. */
+    struct fe__mark *marks;
+    size_t nmarks, mark_stride;
+    fe_discover_acc acc2;
+    double *storage2, *term_work2;
+    fe_residual_map *map2;
+    fe_lsq *per2;
+    double *per_g2, *per_held2;
     char err[2048];
 } fe__run;
 
@@ -1970,6 +1992,13 @@ static void fe__run_free(fe__run *u)
     free(u->out.per_held);
     fe__terms_free(&u->terms);
     free(u->term_work);
+    free(u->marks);
+    free(u->storage2);
+    free(u->term_work2);
+    free(u->map2);
+    free(u->per2);
+    free(u->per_g2);
+    free(u->per_held2);
 }
 
 #define FE__OOM(u) (snprintf((u)->err, sizeof (u)->err, "out of memory or internal error"), \
@@ -1994,6 +2023,225 @@ static void fe__run_probes(fe__run *u)
     u->nprobes = u->cat.count - before;
 }
 
+enum { FE__MARKS = 32, FE__MARK_STRIDE = 1024, FE__SPLIT_MIN = 8192 };
+
+/* Where the stream stood after `row` rows: in pair `cur`, with that
+   pair's window and counters, its files having given lines real_line and
+   sim_line (real_rows and sim_rows rows). */
+typedef struct fe__mark {
+    size_t row, cur;
+    fe__simrow w[4];
+    double min_step, last_real_t, first_real_t;
+    int started;
+    size_t skipped, outside[3];
+    size_t real_line, real_rows, sim_line, sim_rows;
+} fe__mark;
+
+/* Pass 1, after each row: mark the stream every mark_stride rows. */
+static void fe__mark_row(fe__run *u)
+{
+    const fe__pair *p = &u->a.pairs[u->st.cur];
+    fe__mark *m;
+    if (u->marks == NULL || u->out.rows % u->mark_stride != 0)
+        return;
+    if (u->nmarks == FE__MARKS) {       /* keep every other, twice as far apart */
+        for (size_t j = 0; j < FE__MARKS / 2; j++)
+            u->marks[j] = u->marks[2 * j + 1];
+        u->nmarks = FE__MARKS / 2;
+        u->mark_stride *= 2;
+        if (u->out.rows % u->mark_stride != 0)
+            return;
+    }
+    m = &u->marks[u->nmarks++];
+    m->row = u->out.rows;
+    m->cur = u->st.cur;
+    memcpy(m->w, p->w, sizeof m->w);
+    m->min_step = p->min_step;
+    m->last_real_t = p->last_real_t;
+    m->first_real_t = p->first_real_t;
+    m->started = p->started;
+    m->skipped = p->skipped;
+    memcpy(m->outside, p->outside, sizeof m->outside);
+    m->real_line = p->real.line;
+    m->real_rows = p->real.rows;
+    m->sim_line = p->sim.line;
+    m->sim_rows = p->sim.rows;
+}
+
+/* The mark to cut pass 2 at: the one nearest the middle, or NULL. */
+static const fe__mark *fe__cut(const fe__run *u)
+{
+    const char *env = getenv("FOLDEST_CUT");    /* the tests' switch and witness */
+    const fe__mark *best = NULL;
+    if (u->a.order != 0 || u->out.rows < FE__SPLIT_MIN || (env != NULL && strcmp(env, "0") == 0))
+        return NULL;
+    for (size_t j = 0; j < u->nmarks; j++) {
+        const fe__mark *m = &u->marks[j];
+        if (m->row > 0 && m->row < u->out.rows
+            && (best == NULL || (m->row > u->out.rows / 2 ? m->row - u->out.rows / 2
+                                                          : u->out.rows / 2 - m->row)
+                                < (best->row > u->out.rows / 2 ? best->row - u->out.rows / 2
+                                                               : u->out.rows / 2 - best->row)))
+            best = m;
+    }
+    if (env != NULL && best != NULL)
+        fprintf(stderr, "foldest: discover: a pass cut at row %zu of %zu\n", best->row,
+                u->out.rows);
+    return best;
+}
+
+/* A part of pass 2 or 3: its stream, accumulation (pass 2) or residual
+   map and per-recording fits (pass 3), panel and workspace, its first
+   row and the rows it folds (limit), and how it ended.  A part on
+   another thread only reads u. */
+typedef struct fe__part {
+    fe__run *u;
+    fe__stream *st;
+    fe_discover_acc *acc;
+    fe__panel *p;
+    double *term_work;
+    fe_residual_map *map;
+    fe_lsq *per;
+    double *per_held;
+    size_t row0, limit;
+    int rc, refused;            /* the stream's end or error; the fold's refusal */
+    char err[2048];
+} fe__part;
+
+/* Fold the part's rows, a panel at a time (--order 0 only: the terms by
+   fe_catalog_eval_rows, the lagged products by fe_discover_add_rows);
+   on a refusal p->n is the refused row's index. */
+static void fe__part_fold(fe__part *w)
+{
+    fe__panel *p = w->p;
+    fe_sample s;
+    size_t done = 0;
+    int new_pair, rc = FE_END;
+    w->refused = FE_OK;
+    w->err[0] = '\0';
+    p->n = p->nbreak = 0;
+    while (done < w->limit
+           && (rc = fe__stream_next(w->st, &s, &new_pair, w->err, sizeof w->err)) == FE_OK) {
+        const fe__pair *pr = &w->st->a->pairs[w->st->cur];
+        size_t k = p->n;
+        if ((new_pair || k == FE_DISCOVER_PANEL_ROWS) && (k > 0 || p->nbreak > 0)
+            && ((w->refused = fe__panel_terms(&w->u->cat, p, w->term_work)) != FE_OK
+                || (w->refused = fe__panel_fold(w->acc, p)) != FE_OK))
+            break;                              /* p->n: the refused row */
+        if (new_pair)
+            p->nbreak++;
+        k = p->n;
+        p->line[k] = pr->real.line;
+        p->file[k] = pr->real.name;
+        p->t[k] = s.t;
+        p->r[k] = s.real - s.sim;
+        fe__terms_row(&w->u->terms, pr, &s, p->vars[k]);
+        p->n++;
+        done++;
+        rc = FE_END;
+    }
+    if (rc == FE_END && w->refused == FE_OK
+        && (w->refused = fe__panel_terms(&w->u->cat, p, w->term_work)) == FE_OK)
+        w->refused = fe__panel_fold(w->acc, p);
+    w->rc = rc;
+}
+
+static void *fe__part_run(void *arg)
+{
+    fe__part_fold(arg);
+    return NULL;
+}
+
+static void fe__part_map(fe__part *w);
+
+static void *fe__part_run_map(void *arg)
+{
+    fe__part_map(arg);
+    return NULL;
+}
+
+/* The later part's own readers: copies of the pairs from the mark's on,
+   their tables second readers of the files, the mark's pair at the mark. */
+typedef struct fe__later {
+    fe__discover_args a;
+    fe__stream st;
+    size_t first, opened;       /* pairs first .. first + opened - 1 have readers */
+} fe__later;
+
+static void fe__later_close(fe__later *l)
+{
+    for (size_t i = l->first; i < l->first + l->opened; i++) {
+        fe_cli_table_close_part(&l->a.pairs[i].real);
+        fe_cli_table_close_part(&l->a.pairs[i].sim);
+    }
+    free(l->a.pairs);
+    l->a.pairs = NULL;
+}
+
+/* The line after which a table's data begin. */
+static size_t fe__data_line(const fe_cli_table *t)
+{
+    return t->npending > 0 ? t->pending_line[0] - 1 : t->look_end;
+}
+
+static void fe__mark_restore(fe__pair *p, const fe__mark *m);
+
+static int fe__later_open(fe__later *l, const fe__run *u, const fe__mark *m)
+{
+    char err[1024];
+    memset(l, 0, sizeof *l);
+    l->a = u->a;
+    l->first = m->cur;
+    if ((l->a.pairs = malloc(u->a.npairs * sizeof *l->a.pairs)) == NULL)
+        return FE_CLI_IO;
+    memcpy(l->a.pairs, u->a.pairs, u->a.npairs * sizeof *l->a.pairs);
+    for (size_t i = m->cur; i < u->a.npairs; i++) {
+        fe__pair *p = &l->a.pairs[i];
+        const fe__pair *o = &u->a.pairs[i];
+        int at = i == m->cur;
+        if (fe_cli_table_open_part(&p->real, &o->real, at ? m->real_line : fe__data_line(&o->real),
+                                   at ? m->real_rows : 0, err, sizeof err) != FE_CLI_OK)
+            break;
+        if (fe_cli_table_open_part(&p->sim, &o->sim, at ? m->sim_line : fe__data_line(&o->sim),
+                                   at ? m->sim_rows : 0, err, sizeof err) != FE_CLI_OK) {
+            fe_cli_table_close_part(&p->real);
+            break;
+        }
+        l->opened++;
+        p->span_checked = 1;    /* pass 1 has warned */
+    }
+    if (l->opened < u->a.npairs - m->cur) {
+        fe__later_close(l);
+        return FE_CLI_IO;
+    }
+    fe__mark_restore(&l->a.pairs[m->cur], m);
+    l->st.a = &l->a;
+    l->st.cur = m->cur;
+    return FE_CLI_OK;
+}
+
+/* The calling thread's readers parse on n threads: one while a later
+   part has the other core, --threads again after. */
+static void fe__pairs_threads(fe__run *u, int n)
+{
+    for (size_t i = 0; i < u->a.npairs; i++) {
+        fe_cli_table_threads(&u->a.pairs[i].real, n);
+        fe_cli_table_threads(&u->a.pairs[i].sim, n);
+    }
+}
+
+/* The mark's pair as it stood at the mark. */
+static void fe__mark_restore(fe__pair *p, const fe__mark *m)
+{
+    memcpy(p->w, m->w, sizeof p->w);
+    p->min_step = m->min_step;
+    p->last_real_t = m->last_real_t;
+    p->first_real_t = m->first_real_t;
+    p->started = m->started;
+    p->skipped = m->skipped;
+    memcpy(p->outside, m->outside, sizeof p->outside);
+}
+
 /* Pass 1: the catalog's scale, the state's ranges, the rows compared. */
 static int fe__run_scan(fe__run *u)
 {
@@ -2007,6 +2255,9 @@ static int fe__run_scan(fe__run *u)
         u->vlo[v] = INFINITY;
         u->vhi[v] = -INFINITY;
     }
+    u->marks = u->a.order == 0 ? malloc(FE__MARKS * sizeof *u->marks) : NULL;  /* none: no cut */
+    u->nmarks = 0;
+    u->mark_stride = FE__MARK_STRIDE;
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         double row[FE_CATALOG_VARS];
         fe_catalog_row(&s, row);
@@ -2026,6 +2277,7 @@ static int fe__run_scan(fe__run *u)
             u->hi[v] = x > u->hi[v] ? x : u->hi[v];
         }
         u->out.rows++;
+        fe__mark_row(u);
     }
     if (rc != FE_END)
         return rc;
@@ -2248,13 +2500,18 @@ static int fe__run_columns(fe__run *u, fe_sample *s, int new_pair, double *phi)
     return FE_OK;
 }
 
+
 /* Pass 2: every candidate term of every row into the engine's
    accumulation, a panel at a time (the terms by fe_catalog_eval_rows,
    the lagged products by fe_discover_add_rows' matrix products), the
-   panel flushed before a break. */
+   panel flushed before a break.  --order 0 folds in two parts when pass 1
+   marked a cut (above); --order K folds the signatures row by row. */
+static int fe__run_fold_parts(fe__run *u, const fe__mark *m, size_t nst);
+
 static int fe__run_fold(fe__run *u)
 {
     size_t nst = fe_discover_acc_doubles(u->cat.count, (size_t)u->a.blocks);
+    const fe__mark *cut = fe__cut(u);
     fe__panel *p;
     fe_sample s;
     int rc, new_pair;
@@ -2262,7 +2519,7 @@ static int fe__run_fold(fe__run *u)
     if (u->storage == NULL) {           /* a second fold (--order) reuses them */
         u->storage = malloc(nst * sizeof *u->storage);
         u->work = malloc(u->nwork * sizeof *u->work);
-        u->panel = malloc(sizeof *u->panel);
+        u->panel = malloc(2 * sizeof *u->panel);
         u->term_work = malloc(fe_catalog_work_doubles(FE_DISCOVER_PANEL_ROWS)
                               * sizeof *u->term_work);
     }
@@ -2275,12 +2532,15 @@ static int fe__run_fold(fe__run *u)
         return FE__OOM(u);
     if ((rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
         return rc;
+    if (cut != NULL)
+        return fe__run_fold_parts(u, cut, nst);
     fe_dynamics_sens_restart(&u->sens);
-    p->n = 0;
+    p->n = p->nbreak = 0;
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         size_t k = p->n;
         if ((new_pair || k == FE_DISCOVER_PANEL_ROWS)
-            && fe__flush_panel(u->a.order == 0 ? &u->cat : NULL, &u->acc, p, u->term_work) != FE_OK)
+            && (fe__panel_terms(u->a.order == 0 ? &u->cat : NULL, p, u->term_work) != FE_OK
+                || fe__panel_fold(&u->acc, p) != FE_OK))
             break;                              /* p->n: the refused row */
         if (new_pair)
             fe_discover_break(&u->acc);
@@ -2299,7 +2559,8 @@ static int fe__run_fold(fe__run *u)
         p->n++;
     }
     if (rc == FE_OK
-        || (rc == FE_END && fe__flush_panel(u->a.order == 0 ? &u->cat : NULL, &u->acc, p, u->term_work) != FE_OK)) {
+        || (rc == FE_END && (fe__panel_terms(u->a.order == 0 ? &u->cat : NULL, p, u->term_work)
+                             != FE_OK || fe__panel_fold(&u->acc, p) != FE_OK))) {
         const char *bad = NULL;
         double x = 0.0;
         for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
@@ -2317,6 +2578,89 @@ static int fe__run_fold(fe__run *u)
         return FE_CLI_INPUT;
     }
     return rc == FE_END ? FE_CLI_OK : rc;
+}
+
+/* Pass 2 in two parts, cut at mark m: the later part on its own thread
+   with second readers when it can, else after the earlier one on the
+   calling thread; then the later merged into the earlier. */
+static int fe__run_fold_parts(fe__run *u, const fe__mark *m, size_t nst)
+{
+    fe__part part[2];
+    fe__later later;
+    pthread_t thread;
+    int threaded = 0;
+    if (u->storage2 == NULL) {
+        u->storage2 = malloc(nst * sizeof *u->storage2);
+        u->term_work2 = malloc(fe_catalog_work_doubles(FE_DISCOVER_PANEL_ROWS)
+                               * sizeof *u->term_work2);
+    }
+    if (u->storage2 == NULL || u->term_work2 == NULL
+        || fe_discover_acc_init(&u->acc2, u->cat.count, (size_t)u->a.blocks, u->out.fit, m->row,
+                                u->storage2, nst) != FE_OK
+        || fe_discover_set_lags(&u->acc2, (size_t)u->a.lags) != FE_OK)
+        return FE__OOM(u);
+    memset(part, 0, sizeof part);
+    part[0].u = part[1].u = u;
+    part[0].st = &u->st;
+    part[0].acc = &u->acc;
+    part[0].p = &u->panel[0];
+    part[0].term_work = u->term_work;
+    part[0].limit = m->row;
+    part[1].acc = &u->acc2;
+    part[1].p = &u->panel[1];
+    part[1].term_work = u->term_work2;
+    part[1].limit = (size_t)-1;
+    if (u->a.threads > 1 && fe__later_open(&later, u, m) == FE_CLI_OK) {
+        sigset_t all, mask;
+        part[1].st = &later.st;
+        sigfillset(&all);       /* signals stay the calling thread's */
+        pthread_sigmask(SIG_BLOCK, &all, &mask);
+        threaded = pthread_create(&thread, NULL, fe__part_run, &part[1]) == 0;
+        pthread_sigmask(SIG_SETMASK, &mask, NULL);
+        if (!threaded)
+            fe__later_close(&later);
+    }
+    if (threaded)
+        fe__pairs_threads(u, 1);
+    fe__part_fold(&part[0]);
+    if (threaded) {
+        pthread_join(thread, NULL);
+        fe__later_close(&later);
+        fe__pairs_threads(u, u->a.threads);
+    } else if (part[0].rc == FE_END && part[0].refused == FE_OK) {
+        part[1].st = &u->st;    /* on from where the earlier part stopped */
+        fe__part_fold(&part[1]);
+    }
+    for (int i = 0; i < 2; i++) {
+        const fe__part *w = &part[i];
+        if (w->refused != FE_OK) {
+            const fe__panel *p = w->p;
+            const char *bad = NULL;
+            double x = 0.0;
+            for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
+                if (!isfinite(p->phi[p->n][j])) {
+                    bad = u->cat.terms[j].name;
+                    x = p->phi[p->n][j];
+                }
+            if (bad != NULL)
+                snprintf(u->err, sizeof u->err, "%.1000s:%zu: term '%s' is %s at t = %g: refused, "
+                         "nothing reported", p->file[p->n], p->line[p->n], bad,
+                         isnan(x) ? "NaN" : "infinite", p->t[p->n]);
+            else
+                snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
+                         p->file[p->n], p->line[p->n], p->t[p->n]);
+            return FE_CLI_INPUT;
+        }
+        if (w->rc != FE_END) {
+            snprintf(u->err, sizeof u->err, "%s", w->err);
+            return w->rc;
+        }
+    }
+    if (fe_discover_merge(&u->acc, &u->acc2) != FE_OK) {
+        snprintf(u->err, sizeof u->err, "a lagged product is not finite: refused, nothing reported");
+        return FE_CLI_INPUT;
+    }
+    return FE_CLI_OK;
 }
 
 /* Select the terms (discover.org). */
@@ -2443,45 +2787,53 @@ static int fe__run_per_alloc(fe__run *u)
     return FE_CLI_OK;
 }
 
-/* Pass 3: each row's residual before the discovered terms (simulation and
-   base) and after them, into the residual map (locate.org), the
-   per-recording fits, and every few rows into the plot's points. */
-static int fe__run_map(fe__run *u)
+/* The catalog's terms at a part's sample (--order 0). */
+static int fe__part_terms(const fe__part *w, const fe_sample *s, double *phi)
 {
+    double row[FE__MAX_VARS];
+    fe__terms_row(&w->u->terms, &w->st->a->pairs[w->st->cur], s, row);
+    return fe_catalog_eval_rows(&w->u->cat, row, FE__MAX_VARS, 1, phi, FE_DISCOVER_MAX_COLUMNS,
+                                w->term_work, NULL);
+}
+
+/* Pass 3's rows of a part: each row's residual before the discovered
+   terms (simulation and base) and after them, into the part's residual
+   map and per-recording fits, and (one part: the report) every few rows
+   into the plot's points. */
+static void fe__part_map(fe__part *w)
+{
+    fe__run *u = w->u;
     const fe_discover_result *r = u->res;
-    size_t i = 0, stride = u->out.rows / FE__PLOT_POINTS + 1;
-    int rc, new_pair, pair = 0;
+    size_t i = w->row0, stride = u->out.rows / FE__PLOT_POINTS + 1, done = 0;
+    int rc = FE_END, new_pair, pair = (int)w->st->cur;
     fe_sample s;
     double phi[FE_DISCOVER_MAX_COLUMNS];
-    if ((u->map = malloc(sizeof *u->map)) == NULL)
-        return FE__OOM(u);
-    if (fe_residual_map_init(u->map, (size_t)u->a.blocks, u->out.fit, 0, u->roles, u->lo,
-                             u->hi) != FE_OK)
-        return FE__OOM(u);
-    if ((rc = fe__run_open_report(u)) != FE_CLI_OK || (rc = fe__run_per_alloc(u)) != FE_CLI_OK
-        || (rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
-        return rc;
-    fe_dynamics_sens_restart(&u->sens);
-    while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
+    w->refused = FE_OK;
+    w->err[0] = '\0';
+    while (done < w->limit
+           && (rc = fe__stream_next(w->st, &s, &new_pair, w->err, sizeof w->err)) == FE_OK) {
         double before = s.real - s.sim, after;
-        for (; new_pair && pair < (int)u->st.cur; pair++)     /* a recording ends */
+        for (; new_pair && pair < (int)w->st->cur; pair++)     /* a recording ends */
             if (i > 0)
-                fe_residual_map_break(u->map);
-        pair = (int)u->st.cur;
+                fe_residual_map_break(w->map);
+        pair = (int)w->st->cur;
         if (i >= u->out.fit)
-            u->out.per_held[pair] += 1.0;
-        if (fe__run_columns(u, &s, new_pair, phi) != FE_OK) {
-            snprintf(u->err, sizeof u->err, "a term is not finite at t = %g", s.t);
-            return FE_CLI_INPUT;
+            w->per_held[pair] += 1.0;
+        if ((u->a.order == 0 ? fe__part_terms(w, &s, phi)
+                             : fe__run_columns(u, &s, new_pair, phi)) != FE_OK) {
+            snprintf(w->err, sizeof w->err, "a term is not finite at t = %g", s.t);
+            w->refused = FE_ENONFINITE;
+            break;
         }
         for (size_t j = 0; j < u->nbase; j++)
             before -= u->out.baseline_coef[j] * phi[u->base[j]];
-        after = s.real - s.sim + u->adj;
+        after = s.real - s.sim + (u->a.order == 0 ? 0.0 : u->adj);
         for (size_t j = 0; j < r->ncols; j++)
             after -= r->coef[j] * phi[r->cols[j]];
-        if (fe_residual_map_add(u->map, &s, before, after) != FE_OK) {
-            snprintf(u->err, sizeof u->err, "a residual is not finite at t = %g", s.t);
-            return FE_CLI_INPUT;
+        if (fe_residual_map_add(w->map, &s, before, after) != FE_OK) {
+            snprintf(w->err, sizeof w->err, "a residual is not finite at t = %g", s.t);
+            w->refused = FE_ENONFINITE;
+            break;
         }
         if (u->pblocks != NULL) {
             double x;
@@ -2507,14 +2859,121 @@ static int fe__run_map(fe__run *u)
             double row[FE_DISCOVER_MAX_COLUMNS];
             for (size_t j = 0; j < r->ncols; j++)
                 row[j] = phi[r->cols[j]];
-            fe_lsq_add(&u->per[pair], row, s.real - s.sim, 1.0);
+            fe_lsq_add(&w->per[pair], row, s.real - s.sim, 1.0);
         }
         if (u->pts != NULL && i % stride == 0)
             fprintf(u->pts, "%.10g %.6g %.6g %.6g %.6g %.6g %.10g %.10g\n", s.t, before, after,
                     s.position, s.velocity, s.temperature, s.real, s.sim);
         i++;
+        done++;
+        rc = FE_END;
     }
-    return rc == FE_END ? FE_CLI_OK : rc;
+    w->rc = rc;
+}
+
+/* Pass 3's parts: the later one's map and fits, then both parts as pass
+   2's (fe__run_fold_parts), merged. */
+static int fe__run_map_parts(fe__run *u, fe__part part[2], const fe__mark *m)
+{
+    size_t np = u->a.npairs, k = u->res->ncols;
+    fe__later later;
+    pthread_t thread;
+    int threaded = 0;
+    u->map2 = malloc(sizeof *u->map2);
+    u->per2 = calloc(np, sizeof *u->per2);
+    u->per_g2 = calloc(np * fe_lsq_storage(k), sizeof *u->per_g2);
+    u->per_held2 = calloc(np, sizeof *u->per_held2);
+    if (u->map2 == NULL || u->per2 == NULL || u->per_g2 == NULL || u->per_held2 == NULL
+        || (u->term_work2 == NULL
+            && (u->term_work2 = malloc(fe_catalog_work_doubles(FE_DISCOVER_PANEL_ROWS)
+                                       * sizeof *u->term_work2)) == NULL)
+        || fe_residual_map_init(u->map2, (size_t)u->a.blocks, u->out.fit, m->row, u->roles,
+                                u->lo, u->hi) != FE_OK)
+        return FE__OOM(u);
+    for (size_t q = 0; q < np && k > 0; q++)
+        fe_lsq_init(&u->per2[q], k, u->per_g2 + q * fe_lsq_storage(k));
+    part[0].limit = m->row;
+    part[1].u = u;
+    part[1].map = u->map2;
+    part[1].per = u->per2;
+    part[1].per_held = u->per_held2;
+    part[1].term_work = u->term_work2;
+    part[1].row0 = m->row;
+    part[1].limit = (size_t)-1;
+    if (u->a.threads > 1 && fe__later_open(&later, u, m) == FE_CLI_OK) {
+        sigset_t all, mask;
+        part[1].st = &later.st;
+        sigfillset(&all);
+        pthread_sigmask(SIG_BLOCK, &all, &mask);
+        threaded = pthread_create(&thread, NULL, fe__part_run_map, &part[1]) == 0;
+        pthread_sigmask(SIG_SETMASK, &mask, NULL);
+        if (!threaded)
+            fe__later_close(&later);
+    }
+    if (threaded)
+        fe__pairs_threads(u, 1);
+    fe__part_map(&part[0]);
+    if (threaded) {
+        pthread_join(thread, NULL);
+        fe__later_close(&later);
+        fe__pairs_threads(u, u->a.threads);
+    } else if (part[0].rc == FE_END && part[0].refused == FE_OK) {
+        part[1].st = &u->st;
+        fe__part_map(&part[1]);
+    }
+    for (int i = 0; i < 2; i++)
+        if (part[i].refused != FE_OK || part[i].rc != FE_END) {
+            snprintf(u->err, sizeof u->err, "%s", part[i].err);
+            return part[i].refused != FE_OK ? FE_CLI_INPUT : part[i].rc;
+        }
+    if (fe_residual_map_merge(u->map, u->map2) != FE_OK) {
+        snprintf(u->err, sizeof u->err, "a residual is not finite");
+        return FE_CLI_INPUT;
+    }
+    for (size_t q = 0; q < np; q++) {
+        if (k > 0 && fe_lsq_merge(&u->per[q], &u->per2[q]) != FE_OK) {
+            snprintf(u->err, sizeof u->err, "a residual is not finite");
+            return FE_CLI_INPUT;
+        }
+        u->out.per_held[q] += u->per_held2[q];
+    }
+    return FE_CLI_OK;
+}
+
+/* Pass 3: the rows into the residual map (locate.org), the per-recording
+   fits and the plot's points; in two parts, as pass 2, when there is no
+   report to write in file order. */
+static int fe__run_map(fe__run *u)
+{
+    const fe__mark *cut;
+    fe__part part[2];
+    int rc;
+    if ((u->map = malloc(sizeof *u->map)) == NULL)
+        return FE__OOM(u);
+    if (fe_residual_map_init(u->map, (size_t)u->a.blocks, u->out.fit, 0, u->roles, u->lo,
+                             u->hi) != FE_OK)
+        return FE__OOM(u);
+    if ((rc = fe__run_open_report(u)) != FE_CLI_OK || (rc = fe__run_per_alloc(u)) != FE_CLI_OK
+        || (rc = fe__stream_rewind(&u->st, u->err, sizeof u->err)) != FE_CLI_OK)
+        return rc;
+    fe_dynamics_sens_restart(&u->sens);
+    memset(part, 0, sizeof part);
+    part[0].u = u;
+    part[0].st = &u->st;
+    part[0].map = u->map;
+    part[0].per = u->per;
+    part[0].per_held = u->out.per_held;
+    part[0].term_work = u->term_work;
+    part[0].limit = (size_t)-1;
+    cut = u->pts == NULL && u->pblocks == NULL ? fe__cut(u) : NULL;
+    if (cut != NULL)
+        return fe__run_map_parts(u, part, cut);
+    fe__part_map(&part[0]);
+    if (part[0].refused != FE_OK || part[0].rc != FE_END) {
+        snprintf(u->err, sizeof u->err, "%s", part[0].err);
+        return part[0].refused != FE_OK ? FE_CLI_INPUT : part[0].rc;
+    }
+    return FE_CLI_OK;
 }
 
 /* The final model refitted on each recording alone (classical errors). */

@@ -1336,6 +1336,76 @@ int fe_cli_parse_threads(const char *text, int *threads, char *err, size_t errle
     return FE_CLI_OK;
 }
 /* Hand the rows out in file order ends here */
+/* [[file:../../literate/cli.org::Open a second reader at a line][Open a second reader at a line]] */
+static long fe__cli_part_read(void *ctx, char *buf, size_t n)
+{
+    fe_cli_table *t = ctx;
+    ssize_t got = pread(t->fd, buf, n, t->part_at);
+    if (got > 0)
+        t->part_at += got;
+    return (long)got;
+}
+
+int fe_cli_table_open_part(fe_cli_table *part, const fe_cli_table *t, size_t line, size_t rows,
+                           char *err, size_t errlen)
+{
+    char buf[1 << 16];
+    unsigned char magic[2];
+    struct stat st;
+    size_t lf = 0;
+    off_t at = 0;
+    memset(part, 0, sizeof *part);
+    part->fd = -1;
+    if (t->fd < 0 || fstat(t->fd, &st) != 0 || !S_ISREG(st.st_mode)
+        || pread(t->fd, magic, 2, 0) != 2 || (magic[0] == 0x1f && magic[1] == 0x8b)) {
+        snprintf(err, errlen, "%s: cannot be read from the middle", t->name);
+        return FE_CLI_IO;
+    }
+    while (lf < line) {         /* line + 1 begins after the line-th LF */
+        ssize_t got = pread(t->fd, buf, sizeof buf, at);
+        const char *q = buf, *end;
+        if (got <= 0) {
+            snprintf(err, errlen, "%s: has no line %zu", t->name, line + 1);
+            return FE_CLI_IO;
+        }
+        for (end = buf + got; lf < line && (q = memchr(q, '\n', (size_t)(end - q))) != NULL; q++)
+            lf++;
+        at = lf < line ? at + got : at + (q - buf);
+    }
+    part->buffer = malloc(FE_CLI_LINE_MAX);
+    part->fields = malloc(FE_CLI_FIELDS_MAX * sizeof *part->fields);
+    if (part->buffer == NULL || part->fields == NULL) {
+        fe_cli_table_close_part(part);
+        snprintf(err, errlen, "%s: out of memory", t->name);
+        return FE_CLI_IO;
+    }
+    part->name = t->name;
+    part->fd = t->fd;
+    part->delimiter = t->delimiter;
+    part->ncols = t->ncols;
+    part->names = t->names;
+    part->has_header = t->has_header;
+    part->decimal_comma = t->decimal_comma;
+    part->size = st.st_size;
+    part->view = 1;             /* no globals, no progress */
+    part->threads = 1;
+    part->part_at = at;
+    fe_csv_reader_init_read(&part->reader, fe__cli_part_read, part, part->buffer,
+                            FE_CLI_LINE_MAX);
+    part->reader.line = line;   /* not the first line: no byte-order mark */
+    part->line = line;
+    part->rows = rows;
+    return FE_CLI_OK;
+}
+
+void fe_cli_table_close_part(fe_cli_table *part)
+{
+    free(part->buffer);
+    free(part->fields);
+    part->buffer = NULL;
+    part->fields = NULL;
+}
+/* Open a second reader at a line ends here */
 /* [[file:../../literate/cli.org::Write output atomically][Write output atomically]] */
 /* The mode a file created with 0666 gets under the current umask. */
 static mode_t fe__cli_umask_mode(void)
