@@ -2068,8 +2068,8 @@ static void fe__mark_row(fe__run *u)
     m->sim_rows = p->sim.rows;
 }
 
-/* The mark to cut pass 2 at: the one nearest the middle, or NULL. */
-static const fe__mark *fe__cut(const fe__run *u)
+/* The mark to cut a pass at: the one nearest row `target`, or NULL. */
+static const fe__mark *fe__cut(const fe__run *u, size_t target)
 {
     const char *env = getenv("FOLDEST_CUT");    /* the tests' switch and witness */
     const fe__mark *best = NULL;
@@ -2077,17 +2077,24 @@ static const fe__mark *fe__cut(const fe__run *u)
         return NULL;
     for (size_t j = 0; j < u->nmarks; j++) {
         const fe__mark *m = &u->marks[j];
+        size_t d = m->row > target ? m->row - target : target - m->row;
         if (m->row > 0 && m->row < u->out.rows
-            && (best == NULL || (m->row > u->out.rows / 2 ? m->row - u->out.rows / 2
-                                                          : u->out.rows / 2 - m->row)
-                                < (best->row > u->out.rows / 2 ? best->row - u->out.rows / 2
-                                                               : u->out.rows / 2 - best->row)))
+            && (best == NULL || d < (best->row > target ? best->row - target : target - best->row)))
             best = m;
     }
     if (env != NULL && best != NULL)
         fprintf(stderr, "foldest: discover: a pass cut at row %zu of %zu\n", best->row,
                 u->out.rows);
     return best;
+}
+
+/* Where pass 2's work is halved: a held-out row costs it about half a
+   fitted one (no lagged products). */
+static size_t fe__fold_middle(const fe__run *u)
+{
+    double half = 0.5 * ((double)u->out.fit + 0.5 * (double)u->out.heldout);
+    return half <= (double)u->out.fit ? (size_t)half
+                                      : u->out.fit + (size_t)(2.0 * (half - (double)u->out.fit));
 }
 
 /* A part of pass 2 or 3: its stream, accumulation (pass 2) or residual
@@ -2511,7 +2518,7 @@ static int fe__run_fold_parts(fe__run *u, const fe__mark *m, size_t nst);
 static int fe__run_fold(fe__run *u)
 {
     size_t nst = fe_discover_acc_doubles(u->cat.count, (size_t)u->a.blocks);
-    const fe__mark *cut = fe__cut(u);
+    const fe__mark *cut = fe__cut(u, fe__fold_middle(u));
     fe__panel *p;
     fe_sample s;
     int rc, new_pair;
@@ -2965,7 +2972,7 @@ static int fe__run_map(fe__run *u)
     part[0].per_held = u->out.per_held;
     part[0].term_work = u->term_work;
     part[0].limit = (size_t)-1;
-    cut = u->pts == NULL && u->pblocks == NULL ? fe__cut(u) : NULL;
+    cut = u->pts == NULL && u->pblocks == NULL ? fe__cut(u, u->out.rows / 2) : NULL;
     if (cut != NULL)
         return fe__run_map_parts(u, part, cut);
     fe__part_map(&part[0]);
