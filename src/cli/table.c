@@ -618,13 +618,13 @@ typedef struct fe__cli_skipped {
     size_t row, bad[FE_CLI_BAD_REASONS];
 } fe__cli_skipped;
 
-/* One batch's rows, parsed by whichever thread claimed it. */
 /* A slot is written row by row by the thread that parses into it, so
    slots (and parts) start on a cache line of their own
    (FE__CLI_CACHE_LINE): two threads writing neighbours' counters each
    row would cost a third of the run in cache misses. */
 enum { FE__CLI_CACHE_LINE = 64 };
 
+/* One batch's rows, parsed by whichever thread claimed it. */
 typedef struct fe__cli_batch {
     _Alignas(FE__CLI_CACHE_LINE) double *rows;  /* n rows of k doubles */
     size_t *line;               /* each row's line within the batch, from 2 */
@@ -1137,7 +1137,6 @@ static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
         fe__cli_batch_done(p, t, s);
     }
 }
-
 
 int fe_cli_table_each(fe_cli_table *t, const size_t *cols, size_t k,
                       int threads, fe_cli_row_fn *fn, void *ctx,
