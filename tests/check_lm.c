@@ -1235,6 +1235,73 @@ START_TEST(emit_and_sessions_refusals_at_their_edges)
 }
 END_TEST
 
+/* The sink's own refusals, where only the cost is wanted (no Jacobian
+   goes to the Schur or dense accumulation that could refuse a row in its
+   stead): at every cost-only evaluation, weight 0 and the last block
+   (1 of 2) are taken, a weight one step below 0 and the block one past
+   the last (2 of 2) refused with FE_EINVAL (lm.h); the count of such
+   evaluations is kept in a static, as ctx may not be modified.  Then the
+   residuals x_0 - 3 and, for each block b, x_{1+b} - 1.  The refusal
+   fails the trial point, which the solver rejects (lm.h), so no step is
+   ever taken: the damping grows as in `quantised` above, 1e-3
+   2^(k(k-1)/2) at row k, past 1e16 at the 12th, long before a step of
+   about 3 / (1 + lambda) from x = 0 falls under xtol (1e-24 there), so
+   the solver gives up as stuck (FE_ENOCONV) with x and the cost of the
+   start. */
+static int cost_only_evaluations;
+
+static int cost_only_edges(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double j[1] = {1.0}, zero[1] = {0.0};
+    (void)ctx;
+    if (!fe_lm_wants_jacobian(s)) {
+        cost_only_evaluations++;
+        ck_assert_int_eq(fe_lm_emit(s, 1.0, 0.0, NULL, 1, NULL), FE_OK);
+        ck_assert_int_eq(fe_lm_emit(s, 1.0, -DBL_TRUE_MIN, NULL, FE_SCHUR_NONE, NULL),
+                         FE_EINVAL);
+        ck_assert_int_eq(fe_lm_emit(s, 1.0, 1.0, NULL, 2, NULL), FE_EINVAL);
+    }
+    for (size_t b = 0; b < 2; b++)
+        fe_lm_emit(s, x[1 + b] - 1.0, 1.0, zero, b, j);
+    return fe_lm_emit(s, x[0] - 3.0, 1.0, j, FE_SCHUR_NONE, NULL);
+}
+
+/* A row given block 0 on a problem without blocks (nl = nb = 0), with its
+   Jacobian, on the dense path: block 0 is out of range there (lm.h), and
+   the dense fold, which would take a block of no columns, must not be
+   reached; the refusal at the starting point is the solver's answer. */
+static int block_without_blocks(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double j[1] = {1.0};
+    (void)ctx;
+    ck_assert_int_eq(fe_lm_emit(s, x[0] - 3.0, 1.0, j, 0, j), FE_EINVAL);
+    return fe_lm_emit(s, x[0] - 3.0, 1.0, j, FE_SCHUR_NONE, NULL);
+}
+
+START_TEST(the_sink_refuses_a_negative_weight_or_a_stray_block_without_a_jacobian)
+{
+    fe_lm_problem p = {1, 1, 2, cost_only_edges, NULL};
+    fe_lm_result r;
+    double x[3] = {0.0, 0.0, 0.0}, *w = lm_work(&p, FE_LM_SCHUR);
+    cost_only_evaluations = 0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, x, w, NULL, NULL, &r), FE_ENOCONV);
+    ck_assert_int_eq(r.stop, FE_LM_STUCK);
+    ck_assert_int_gt(cost_only_evaluations, 0);
+    ck_assert_int_eq(r.accepted, 0);
+    ck_assert_double_eq(x[0], 0.0);
+    ck_assert_double_eq(x[1], 0.0);
+    ck_assert_double_eq(x[2], 0.0);
+    ck_assert_double_eq(r.cost, 5.5);           /* (1/2) (3^2 + 1 + 1), the start */
+    free(w);
+    p = (fe_lm_problem){1, 0, 0, block_without_blocks, NULL};
+    w = lm_work(&p, FE_LM_DENSE);
+    x[0] = 1.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, w, NULL, NULL, &r), FE_EINVAL);
+    ck_assert_double_eq(x[0], 1.0);
+    free(w);
+}
+END_TEST
+
 /* f = x - 3, one residual, one global. */
 static int minus_three(const double *x, fe_lm_sink *s, void *ctx)
 {
@@ -1374,6 +1441,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, magnetometer_sessions_synthetic);
     tcase_add_test(t, magnetometer_sessions_real);
     tcase_add_test(t, emit_and_sessions_refusals_at_their_edges);
+    tcase_add_test(t, the_sink_refuses_a_negative_weight_or_a_stray_block_without_a_jacobian);
     tcase_add_test(t, parameters_at_their_edges);
     tcase_add_test(t, one_and_the_most_sessions_are_fitted);
     suite_add_tcase(s, t);

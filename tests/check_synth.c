@@ -272,6 +272,57 @@ START_TEST(noise_is_its_ar1_recursion)
 }
 END_TEST
 
+START_TEST(order_one_integrates_the_effect_into_the_stands_temperature)
+{
+    /* Order 1 (synth.h, literate/synth.org): the effect enters the real
+       stand's dT/dt and is integrated into its motion; real is that
+       stand's temperature plus the noise.  Recomputed here row by row: the
+       real stand starts at the ambient and steps by explicit Euler,
+       T_r += ((T_a + P - T_r) / tau + c phi) dt with tau = 20 s, the
+       heater P = 60 for the first 300 s of every 600 s, and
+       newton_cooling's phi = T_r - T_a; the noise is the AR(1) recursion
+       of noise_is_its_ar1_recursion with sigma = g.sigma.  c is the
+       coefficient whose static response to the largest forcing is
+       `parting` noise sds, negative (cooling opposes excess heat):
+       -parting sigma / (tau max |T - T_a|), the maximum over the
+       simulated stand's rows.  The effect added to the channel instead
+       (sim + c phi + noise, as for order 0) misses the integrated trace,
+       which parts from the simulated stand by more than one sigma. */
+    enum { N = 20000 };
+    const double tau = 20.0, rho = 0.5;
+    fe_synth g;
+    fe_synth_spec spec = fe_synth_default_spec("newton_cooling", 3);
+    fe_rng z = fe_rng_seed(3 * 2 + 2);
+    fe_sample *row = malloc(N * sizeof *row);
+    double maxphi = 0.0, c, tr, e = 0.0, worst = 0.0, parted = 0.0;
+    ck_assert_ptr_nonnull(row);
+    spec.rows = N;
+    spec.order = 1;
+    spec.noise_rho = rho;
+    ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
+    ck_assert_int_eq(g.thermal, 1);
+    for (size_t i = 0; i < N; i++) {
+        ck_assert_int_eq(fe_synth_next(&g, &row[i]), FE_OK);
+        maxphi = fmax(maxphi, fabs(row[i].temperature - row[i].ambient));
+    }
+    ck_assert_double_gt(maxphi, 0.0);
+    c = -spec.parting * g.sigma / (tau * maxphi);
+    FE_ASSERT_REL(g.coefficient, c, 1e-12);
+    tr = row[0].ambient;
+    for (size_t i = 0; i < N; i++) {
+        double zi = fe_rng_normal(&z), heat = fmod(row[i].t, 600.0) < 300.0 ? 60.0 : 0.0;
+        e = i == 0 ? g.sigma * zi : rho * e + sqrt(1.0 - rho * rho) * g.sigma * zi;
+        worst = fmax(worst, fabs(row[i].real - e - tr));
+        parted = fmax(parted, fabs(tr - row[i].temperature));
+        tr += ((row[i].ambient + heat - tr) / tau + c * (tr - row[i].ambient)) * g.dt;
+    }
+    ck_assert_msg(worst < 1e-9 * g.sigma, "real off the integrated stand by %.3g sigma",
+                  worst / g.sigma);
+    ck_assert_msg(parted > g.sigma, "the stand parts by only %.3g sigma", parted / g.sigma);
+    free(row);
+}
+END_TEST
+
 Suite *fe_synth_suite(void)
 {
     Suite *s = suite_create("synth");
@@ -281,6 +332,7 @@ Suite *fe_synth_suite(void)
     tcase_add_test(t, thermal_rig_follows_its_equations);
     tcase_add_test(t, mechanical_rig_follows_its_equations);
     tcase_add_test(t, noise_is_its_ar1_recursion);
+    tcase_add_test(t, order_one_integrates_the_effect_into_the_stands_temperature);
     tcase_add_test(t, every_phase_comes_from_the_seed);
     tcase_add_test(t, rows_carry_the_central_difference_of_sim);
     suite_add_tcase(s, t);
