@@ -127,6 +127,9 @@ static void fe__discover_lags_panel(fe_discover_acc *a, const double *const *col
     a->nhist = a->nhist + q < P ? a->nhist + q : P;
 }
 
+/* The sums of n columns of q values each, in lanes (below). */
+static void fe__discover_sums(const double *const *z, size_t n, size_t q, double *out);
+
 /* The sum of the q values x[t * ts], in eight running sums added
    together at the end: one chain of q dependent additions (four cycles
    each) was most of a screen's fold. */
@@ -189,7 +192,13 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
 {
     double z[FE_DISCOVER_MAX_COLUMNS + 1];
     int fitted = k < a->blocks;
-    for (size_t c = 0; c <= a->m && fitted; c++)
+    if (fitted && ts == 1) {            /* columns: in lanes */
+        double s[FE_DISCOVER_MAX_COLUMNS + 1];
+        fe__discover_sums(col, a->m + 1, q, s);
+        for (size_t c = 0; c <= a->m; c++)
+            a->bsum[k * (a->m + 1) + c] += s[c];
+    }
+    for (size_t c = 0; c <= a->m && fitted && ts != 1; c++)
         a->bsum[k * (a->m + 1) + c] += fe__discover_sum(col[c], ts, q);
     if (fitted && a->lags > 0)  /* the long range is the AR model's: none in a screen */
         fe__discover_fine_rows(a, col, ts, q, a->row0 + a->n);
@@ -687,6 +696,7 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
 #define FE__L 4
 #define FE__DISCOVER_DOTS_FN fe__discover_dots4
 #define FE__DISCOVER_BAND_FN fe__discover_band4
+#define FE__DISCOVER_SUMS_FN fe__discover_sums4
 #define FE__DISCOVER_TARGET FE__LANES_CLONES
 /* out[4 a + c] += sum_{t < q} x[a][t] y[c][t], a, c < 4. */
 FE__DISCOVER_TARGET
@@ -728,6 +738,35 @@ static void FE__DISCOVER_DOTS_FN(const double *const *x, const double *const *y,
     }
 }
 
+/* out[j] = sum_{t < q} z[j][t] for the n columns z[0 .. n-1], four
+   columns at a time (four chains of additions, not one). */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_SUMS_FN(const double *const *z, size_t n, size_t q, double *out)
+{
+    for (size_t j = 0; j < n; j += 4) {
+        const double *p[4];
+        double s[4][FE__L] = {{0}};
+        size_t t;
+        for (int c = 0; c < 4; c++)
+            p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
+        for (t = 0; t + FE__L <= q; t += FE__L)
+            for (int l = 0; l < FE__L; l++) {
+                s[0][l] += p[0][t + l];
+                s[1][l] += p[1][t + l];
+                s[2][l] += p[2][t + l];
+                s[3][l] += p[3][t + l];
+            }
+        for (int c = 0; c < 4 && j + (size_t)c < n; c++) {
+            double v = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                v += s[c][l];
+            for (size_t u = t; u < q; u++)
+                v += p[c][u];
+            out[j + (size_t)c] = v;
+        }
+    }
+}
+
 /* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
    for d < 3 and j + d < n, four columns j at a time. */
 FE__DISCOVER_TARGET
@@ -773,11 +812,13 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
 #undef FE__L
 #undef FE__DISCOVER_DOTS_FN
 #undef FE__DISCOVER_BAND_FN
+#undef FE__DISCOVER_SUMS_FN
 
 #if defined(FE__LANES_X86)
 #define FE__L 8
 #define FE__DISCOVER_DOTS_FN fe__discover_dots8
 #define FE__DISCOVER_BAND_FN fe__discover_band8
+#define FE__DISCOVER_SUMS_FN fe__discover_sums8
 #define FE__DISCOVER_TARGET FE__LANES_WIDE
 /* out[4 a + c] += sum_{t < q} x[a][t] y[c][t], a, c < 4. */
 FE__DISCOVER_TARGET
@@ -819,6 +860,35 @@ static void FE__DISCOVER_DOTS_FN(const double *const *x, const double *const *y,
     }
 }
 
+/* out[j] = sum_{t < q} z[j][t] for the n columns z[0 .. n-1], four
+   columns at a time (four chains of additions, not one). */
+FE__DISCOVER_TARGET
+static void FE__DISCOVER_SUMS_FN(const double *const *z, size_t n, size_t q, double *out)
+{
+    for (size_t j = 0; j < n; j += 4) {
+        const double *p[4];
+        double s[4][FE__L] = {{0}};
+        size_t t;
+        for (int c = 0; c < 4; c++)
+            p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
+        for (t = 0; t + FE__L <= q; t += FE__L)
+            for (int l = 0; l < FE__L; l++) {
+                s[0][l] += p[0][t + l];
+                s[1][l] += p[1][t + l];
+                s[2][l] += p[2][t + l];
+                s[3][l] += p[3][t + l];
+            }
+        for (int c = 0; c < 4 && j + (size_t)c < n; c++) {
+            double v = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                v += s[c][l];
+            for (size_t u = t; u < q; u++)
+                v += p[c][u];
+            out[j + (size_t)c] = v;
+        }
+    }
+}
+
 /* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
    for d < 3 and j + d < n, four columns j at a time. */
 FE__DISCOVER_TARGET
@@ -864,6 +934,7 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
 #undef FE__L
 #undef FE__DISCOVER_DOTS_FN
 #undef FE__DISCOVER_BAND_FN
+#undef FE__DISCOVER_SUMS_FN
 #endif
 
 static void fe__discover_dots(const double *const *x, const double *const *y, size_t q,
@@ -887,6 +958,17 @@ static void fe__discover_band(const double *const *z, size_t n, size_t q, double
     }
 #endif
     fe__discover_band4(z, n, q, out);
+}
+
+static void fe__discover_sums(const double *const *z, size_t n, size_t q, double *out)
+{
+#if defined(FE__LANES_X86)
+    if (FE__LANES_HAVE_WIDE()) {
+        fe__discover_sums8(z, n, q, out);
+        return;
+    }
+#endif
+    fe__discover_sums4(z, n, q, out);
 }
 /* Compile the discovery kernels ends here */
 /* [[file:../literate/discover.org::Fold a panel of columns][Fold a panel of columns]] */
