@@ -1210,6 +1210,54 @@ START_TEST(information_shards_merge_by_addition)
 }
 END_TEST
 
+/* The workspace of the information form holds, besides (G, g), either a
+   copy of Z and Z^{-1}[A | z] (b^2 + b (n + 1) doubles) or a copy of P0
+   and [I | x0] (n^2 + n (n + 1)); a packet of bmax > n rows needs the
+   first.  Laid out over exactly fe_kalman_info_doubles(n, bmax) doubles,
+   with guard doubles after them, a packet of bmax rows folds to
+   Lambda = A^T Z^{-1} A and eta = A^T Z^{-1} z (Z diagonal: sums of
+   A_ij A_ik / Z_ii, every term exact), and not one guard is written. */
+START_TEST(a_packet_wider_than_the_state_folds_within_the_information_buffer)
+{
+    enum { B = 4, GUARD = 64 };
+    const double Zd[B] = {1.0, 2.0, 4.0, 8.0}, z[B] = {1.0, -2.0, 3.0, -4.0};
+    for (size_t n = 1; n < B; n++) {
+        size_t len = fe_kalman_info_doubles(n, B);
+        double A[B * B], Z[B * B] = {0}, *mem;
+        fe_kalman_info s;
+        fe_kalman_obs o = {B, A, z, Z};
+        ck_assert_uint_gt(len, 0);
+        mem = malloc((len + GUARD) * sizeof *mem);
+        ck_assert_ptr_nonnull(mem);
+        for (size_t i = 0; i < GUARD; i++)
+            mem[len + i] = 12345.0;
+        for (size_t i = 0; i < B; i++) {
+            Z[i * B + i] = Zd[i];
+            for (size_t j = 0; j < n; j++)
+                A[i * n + j] = (double)(i + 2 * j + 1) * (j % 2 ? -1.0 : 1.0);
+        }
+        ck_assert_int_eq(fe_kalman_info_init(&s, n, B, mem, len), FE_OK);
+        ck_assert_int_eq(fe_kalman_info_update(&s, &o), FE_OK);
+        for (size_t j = 0; j < n; j++) {
+            double eta = 0.0;
+            for (size_t i = 0; i < B; i++)
+                eta += A[i * n + j] * z[i] / Zd[i];
+            FE_ASSERT_REL(s.eta[j], eta, 1e-12);
+            for (size_t k = 0; k < n; k++) {
+                double lam = 0.0;
+                for (size_t i = 0; i < B; i++)
+                    lam += A[i * n + j] * A[i * n + k] / Zd[i];
+                FE_ASSERT_REL(s.Lambda[j * n + k], lam, 1e-12);
+            }
+        }
+        for (size_t i = 0; i < GUARD; i++)
+            ck_assert_msg(mem[len + i] == 12345.0, "n = %zu: guard %zu written (%g)", n, i,
+                          mem[len + i]);
+        free(mem);
+    }
+}
+END_TEST
+
 /* --------------------------------------------------- accumulators */
 
 START_TEST(accumulator_fold_equals_loop)
@@ -1805,6 +1853,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, tracker_fast_equals_reference);
     tcase_add_test(t, information_form_equals_covariance_form);
     tcase_add_test(t, information_shards_merge_by_addition);
+    tcase_add_test(t, a_packet_wider_than_the_state_folds_within_the_information_buffer);
     tcase_add_test(t, accumulator_fold_equals_loop);
     tcase_add_test(t, track_accumulator_folds_a_tracker);
     tcase_add_test(t, consistent_model_passes_the_monitor);

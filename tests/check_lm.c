@@ -687,6 +687,54 @@ START_TEST(first_step_is_extended_along_its_line)
 }
 END_TEST
 
+/* f1 = 2 + x (weight 1) and f2 = 4 x^2 (weight 3/4): at x = 0 the second
+   has no slope, so the Gauss-Newton model sees only the first. */
+static int line_min_at_one_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double j1 = 1.0, j2 = 8.0 * x[0];
+    (void)ctx;
+    fe_lm_emit(s, 2.0 + x[0], 1.0, &j1, FE_SCHUR_NONE, NULL);
+    return fe_lm_emit(s, 4.0 * x[0] * x[0], 0.75, &j2, FE_SCHUR_NONE, NULL);
+}
+
+START_TEST(a_step_already_at_its_parabolas_minimum_is_not_extended)
+{
+    /* The first iteration from x = 0 with lambda0 = 3, by hand, every
+       number a short binary fraction: cost (1/2)(2^2) = 2, A = 1, b = -2,
+       h = b / (A (1 + 3)) = -1/2; at x + h, f = (3/2, 1) and the cost is
+       (1/2)(9/4 + 3/4) = 3/2; predicted reduction (1/2) h (b + 3 A h) =
+       7/8, so rho = (1/2) / (7/8) = 4/7, more than 0.25 from 1: the line
+       is looked at.  The parabola through the cost at 0 (2, slope
+       -b h = -1) and at 1 (3/2) is 2 - t + t^2/2, whose minimum is at
+       t* = 1 exactly: the trial point is that minimum, the step is not
+       extended, and the row reports |h| = 1/2. */
+    fe_lm_problem p = {1, 0, 0, line_min_at_one_model, NULL};
+    fe_lm_params par = fe_lm_default_params();
+    double *w = lm_work(&p, FE_LM_DENSE), x = 0.0;
+    struct rows t = {0};
+    fe_lm_result r;
+    const double cost = 2.0, b = -2.0, h = -0.5, cost1 = 1.5, pred = 0.875;
+    const double slope = h * b, c = cost1 - cost + slope;
+    ck_assert_double_eq(slope / (2.0 * c), 1.0);          /* the premises */
+    ck_assert_double_gt(fabs((cost - cost1) / pred - 1.0), 0.25);
+    par.lambda0 = 3.0;
+    par.max_iter = 1;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, &x, w, keep_rows, &t, &r), FE_ENOCONV);
+    ck_assert_int_eq(t.n, 1);
+    ck_assert_double_eq(t.row[0].lambda, 3.0);
+    FE_ASSERT_REL(t.row[0].ratio, 4.0 / 7.0, 1e-15);
+    ck_assert_double_eq(t.row[0].step, 0.5);
+    ck_assert_double_eq(t.row[0].change, cost - cost1);
+    ck_assert_double_eq(t.row[0].cost, cost1);
+    ck_assert_int_eq(t.row[0].accepted, 1);
+    ck_assert_int_eq(r.extended, 0);
+    ck_assert_int_eq(r.accepted, 1);
+    ck_assert_double_eq(r.initial_cost, cost);
+    ck_assert_double_eq(x, h);
+    free(w);
+}
+END_TEST
+
 /* sigma (x^2 - 4): the cost of the scaled square; its gradient. */
 static int scaled_square_model(const double *x, fe_lm_sink *s, void *ctx)
 {
@@ -1436,6 +1484,7 @@ Suite *fe_lm_suite(void)
     tcase_add_test(t, sessions_first_step_from_a_numerical_jacobian);
     tcase_add_test(t, sessions_start_at_the_centroids);
     tcase_add_test(t, first_step_is_extended_along_its_line);
+    tcase_add_test(t, a_step_already_at_its_parabolas_minimum_is_not_extended);
     tcase_add_test(t, second_step_searches_along_the_last_two);
     tcase_add_test(t, undamped_rank_test_is_relative_to_the_diagonal);
     tcase_add_test(t, magnetometer_sessions_synthetic);

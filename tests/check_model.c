@@ -453,6 +453,60 @@ START_TEST(refusals_leave_the_accumulation_unchanged)
 }
 END_TEST
 
+/* A time that is not finite is a value that is not finite (FE_ENONFINITE,
+   the accumulation unchanged), with a finite recording and no term that
+   reads the time (drift, t - t_first, would be refused in its stead): as
+   the first row, where no time precedes it (NaN, +inf, -inf), and after a
+   held row, where +inf would increase (a NaN or -inf there also fails the
+   ordering, so it is left out). */
+START_TEST(a_time_that_is_not_finite_is_refused_without_a_term_of_time)
+{
+    const double first[3] = {NAN, INFINITY, -INFINITY};
+    fe_catalog_scale sc = {0};
+    fe_catalog c;
+    fe_model m = {3, theta0, NULL, rig_predict, rig_jacobian, 0, NULL, NULL};
+    fe_model_acc a, before;
+    size_t nst;
+    double *st, *copy;
+    fe_sample s = {0};
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_INPUT,
+                                     &sc), FE_OK);
+    ck_assert_int_eq(fe_catalog_remove(&c, "drift"), FE_OK);
+    nst = fe_model_acc_doubles(3, c.count, 4);
+    st = malloc(nst * sizeof *st);
+    copy = malloc(nst * sizeof *st);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(copy);
+    ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);
+    s.input = 0.5;
+    s.position = 0.25;
+    s.velocity = -0.125;
+    s.real = 0.3;                              /* finite: only the time is not */
+    memcpy(&before, &a, sizeof a);
+    memcpy(copy, st, nst * sizeof *st);
+    for (int i = 0; i < 3; i++) {
+        s.t = first[i];
+        ck_assert_msg(fe_model_add(&a, &s) == FE_ENONFINITE, "first row, t = %g", s.t);
+        ck_assert_mem_eq(&a, &before, sizeof a);
+        ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    }
+    s.t = 1.0;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+    memcpy(&before, &a, sizeof a);
+    memcpy(copy, st, nst * sizeof *st);
+    s.t = INFINITY;
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    s.t = 2.0;                                 /* the recording goes on */
+    ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
+    ck_assert_int_eq(fe_model_break(&a), FE_OK);
+    ck_assert_uint_eq(a.acc.n, 2);
+    free(st);
+    free(copy);
+}
+END_TEST
+
 START_TEST(arguments_and_failing_callbacks)
 {
     fe_catalog_scale sc = {0};
@@ -766,6 +820,7 @@ Suite *fe_model_suite(void)
     tcase_add_test(t, finite_difference_steps_and_calls);
     tcase_add_test(t, the_fold_is_its_rows);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
+    tcase_add_test(t, a_time_that_is_not_finite_is_refused_without_a_term_of_time);
     tcase_add_test(t, a_held_row_whose_difference_overflows_is_dropped);
     tcase_add_test(t, arguments_and_failing_callbacks);
     tcase_add_test(t, non_finite_prediction_refused_at_its_row);
