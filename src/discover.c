@@ -127,23 +127,10 @@ static void fe__discover_lags_panel(fe_discover_acc *a, const double *const *col
     a->nhist = a->nhist + q < P ? a->nhist + q : P;
 }
 
-/* The sums of n columns of q values each, in lanes (below). */
+/* The sums of n columns of q values each, in lanes (below): one chain of
+   q dependent additions a column (four cycles each) was most of a
+   screen's fold. */
 static void fe__discover_sums(const double *const *z, size_t n, size_t q, double *out);
-
-/* The sum of the q values x[t * ts], in eight running sums added
-   together at the end: one chain of q dependent additions (four cycles
-   each) was most of a screen's fold. */
-static double fe__discover_sum(const double *x, size_t ts, size_t q)
-{
-    double s[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    size_t t = 0;
-    for (; t + 8 <= q; t += 8)
-        for (int l = 0; l < 8; l++)
-            s[l] += x[(t + (size_t)l) * ts];
-    for (; t < q; t++)
-        s[0] += x[t * ts];
-    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
-}
 
 /* The fine blocks: B = 2^J, the most (up to FE_DISCOVER_FINE_BLOCKS) of
    at least FE_DISCOVER_FINE_ROWS fitted rows each; one for short records. */
@@ -179,8 +166,12 @@ static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
         uint64_t end = fe__discover_fine_cut(a, k + 1);
         if (end - (row + t) < (uint64_t)(q - t))
             stop = t + (size_t)(end - (row + t));
-        for (size_t c = 0; c < dim; c++)
-            a->fsum[k * dim + c] += fe__discover_sum(col[c] + t * ts, ts, stop - t);
+        for (size_t c = 0; c < dim; c++) {
+            double s = 0.0;
+            for (size_t i = t; i < stop; i++)
+                s += col[c][i * ts];
+            a->fsum[k * dim + c] += s;
+        }
         t = stop;
     }
 }
@@ -197,9 +188,14 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
         fe__discover_sums(col, a->m + 1, q, s);
         for (size_t c = 0; c <= a->m; c++)
             a->bsum[k * (a->m + 1) + c] += s[c];
+    } else {
+        for (size_t c = 0; c <= a->m && fitted; c++) {
+            double s = 0.0;
+            for (size_t t = 0; t < q; t++)
+                s += col[c][t * ts]; /* NOLINT(clang-analyzer-core.NullDereference): col[0 .. m] are the panel's columns */
+            a->bsum[k * (a->m + 1) + c] += s;
+        }
     }
-    for (size_t c = 0; c <= a->m && fitted && ts != 1; c++)
-        a->bsum[k * (a->m + 1) + c] += fe__discover_sum(col[c], ts, q);
     if (fitted && a->lags > 0)  /* the long range is the AR model's: none in a screen */
         fe__discover_fine_rows(a, col, ts, q, a->row0 + a->n);
     if (a->lags == 0 || !fitted)

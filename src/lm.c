@@ -190,15 +190,17 @@ static int fe__lm_dense_step(const fe_lsq *a, double lambda, double *F,
 /* xt = x + h has cost *trial_cost; try x + t* h with t* the minimum of
    the parabola through the cost at 0 (value cost, slope -slope) and at 1.
    On success xt and *trial_cost describe the new point and t* is
-   returned; otherwise xt is x + h again and 1 is returned. */
+   returned; otherwise xt is x + h again and 1 is returned.  *evaluated
+   says whether the model was evaluated (not when t* is 1 or undefined). */
 static double fe__lm_extend(fe_lm_sink *s, const double *x, const double *h,
                             double *xt, double cost, double slope,
-                            double *trial_cost)
+                            double *trial_cost, int *evaluated)
 {
     size_t p = s->prob->ng + s->prob->nb * s->prob->nl, k;
     double c = *trial_cost - cost + slope, t, ext_cost = 0.0;
     int rc;
 
+    *evaluated = 0;
     if (!(c > 0.0) || !(slope > 0.0))
         return 1.0;
     t = fmin(slope / (2.0 * c), FE__LM_EXTEND_MAX);
@@ -206,6 +208,7 @@ static double fe__lm_extend(fe_lm_sink *s, const double *x, const double *h,
         return 1.0;
     for (k = 0; k < p; k++)
         xt[k] = x[k] + t * h[k];
+    *evaluated = 1;
     rc = fe__lm_eval(s, xt, 0, &ext_cost);
     if (rc == FE_OK && ext_cost < *trial_cost) {
         *trial_cost = ext_cost;
@@ -414,8 +417,9 @@ int fe_lm_solve(const fe_lm_problem *prob, int method,
             row.ratio = rho;
             /* A step the model underrates may go further along its line. */
             if (trial_rc == FE_OK && rho > 0.0 && fabs(rho - 1.0) > FE__LM_LINE_RHO) {
-                double t = fe__lm_extend(&s, x, h, xt, cost, slope, &trial_cost);
-                res.evaluations++;
+                int evaluated;
+                double t = fe__lm_extend(&s, x, h, xt, cost, slope, &trial_cost, &evaluated);
+                res.evaluations += evaluated;
                 row.step *= t;
                 res.extended += t != 1.0;
             }

@@ -688,11 +688,13 @@ START_TEST(first_step_is_extended_along_its_line)
 END_TEST
 
 /* f1 = 2 + x (weight 1) and f2 = 4 x^2 (weight 3/4): at x = 0 the second
-   has no slope, so the Gauss-Newton model sees only the first. */
+   has no slope, so the Gauss-Newton model sees only the first.  Each call
+   is counted in *ctx (an int) when ctx is given. */
 static int line_min_at_one_model(const double *x, fe_lm_sink *s, void *ctx)
 {
     double j1 = 1.0, j2 = 8.0 * x[0];
-    (void)ctx;
+    if (ctx != NULL)
+        ++*(int *)ctx;
     fe_lm_emit(s, 2.0 + x[0], 1.0, &j1, FE_SCHUR_NONE, NULL);
     return fe_lm_emit(s, 4.0 * x[0] * x[0], 0.75, &j2, FE_SCHUR_NONE, NULL);
 }
@@ -707,8 +709,12 @@ START_TEST(a_step_already_at_its_parabolas_minimum_is_not_extended)
        is looked at.  The parabola through the cost at 0 (2, slope
        -b h = -1) and at 1 (3/2) is 2 - t + t^2/2, whose minimum is at
        t* = 1 exactly: the trial point is that minimum, the step is not
-       extended, and the row reports |h| = 1/2. */
-    fe_lm_problem p = {1, 0, 0, line_min_at_one_model, NULL};
+       extended, and the row reports |h| = 1/2; the point t* h, which is
+       the trial point, is not evaluated again, nor counted: the result
+       counts the model's calls, three (the start with its Jacobian, the
+       trial point, and the accepted point's Jacobian) or two. */
+    int calls = 0;
+    fe_lm_problem p = {1, 0, 0, line_min_at_one_model, &calls};
     fe_lm_params par = fe_lm_default_params();
     double *w = lm_work(&p, FE_LM_DENSE), x = 0.0;
     struct rows t = {0};
@@ -729,6 +735,7 @@ START_TEST(a_step_already_at_its_parabolas_minimum_is_not_extended)
     ck_assert_int_eq(t.row[0].accepted, 1);
     ck_assert_int_eq(r.extended, 0);
     ck_assert_int_eq(r.accepted, 1);
+    ck_assert_int_eq(r.evaluations, calls);
     ck_assert_double_eq(r.initial_cost, cost);
     ck_assert_double_eq(x, h);
     free(w);
