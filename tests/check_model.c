@@ -453,6 +453,23 @@ START_TEST(refusals_leave_the_accumulation_unchanged)
 }
 END_TEST
 
+/* fe_model_add's answer to s; a refusal must leave the accumulation a and
+   its storage (nst doubles at st; copy has room for as many) as they
+   were, byte for byte. */
+static int add_unchanged_if_refused(fe_model_acc *a, const fe_sample *s, double *st,
+                                    double *copy, size_t nst)
+{
+    fe_model_acc before = *a;
+    int rc;
+    memcpy(copy, st, nst * sizeof *st);
+    rc = fe_model_add(a, s);
+    if (rc != FE_OK) {
+        ck_assert_mem_eq(a, &before, sizeof *a);
+        ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    }
+    return rc;
+}
+
 /* A time that is not finite is a value that is not finite (FE_ENONFINITE,
    the accumulation unchanged), with a finite recording and no term that
    reads the time (drift, t - t_first, would be refused in its stead): as
@@ -465,7 +482,7 @@ START_TEST(a_time_that_is_not_finite_is_refused_without_a_term_of_time)
     fe_catalog_scale sc = {0};
     fe_catalog c;
     fe_model m = {3, theta0, NULL, rig_predict, rig_jacobian, 0, NULL, NULL};
-    fe_model_acc a, before;
+    fe_model_acc a;
     size_t nst;
     double *st, *copy;
     fe_sample s = {0};
@@ -482,22 +499,15 @@ START_TEST(a_time_that_is_not_finite_is_refused_without_a_term_of_time)
     s.position = 0.25;
     s.velocity = -0.125;
     s.real = 0.3;                              /* finite: only the time is not */
-    memcpy(&before, &a, sizeof a);
-    memcpy(copy, st, nst * sizeof *st);
     for (int i = 0; i < 3; i++) {
         s.t = first[i];
-        ck_assert_msg(fe_model_add(&a, &s) == FE_ENONFINITE, "first row, t = %g", s.t);
-        ck_assert_mem_eq(&a, &before, sizeof a);
-        ck_assert_mem_eq(st, copy, nst * sizeof *st);
+        ck_assert_msg(add_unchanged_if_refused(&a, &s, st, copy, nst) == FE_ENONFINITE,
+                      "first row, t = %g", s.t);
     }
     s.t = 1.0;
     ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
-    memcpy(&before, &a, sizeof a);
-    memcpy(copy, st, nst * sizeof *st);
     s.t = INFINITY;
-    ck_assert_int_eq(fe_model_add(&a, &s), FE_ENONFINITE);
-    ck_assert_mem_eq(&a, &before, sizeof a);
-    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    ck_assert_int_eq(add_unchanged_if_refused(&a, &s, st, copy, nst), FE_ENONFINITE);
     s.t = 2.0;                                 /* the recording goes on */
     ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
     ck_assert_int_eq(fe_model_break(&a), FE_OK);
@@ -682,7 +692,7 @@ START_TEST(non_finite_prediction_refused_at_its_row)
 {
     fe_catalog_scale sc = {0};
     fe_catalog c;
-    fe_model_acc a, before;
+    fe_model_acc a;
     fe_sample s = {0};
     size_t nst;
     double *st, *copy;
@@ -704,14 +714,10 @@ START_TEST(non_finite_prediction_refused_at_its_row)
             s.velocity = -0.2;
             s.real = 0.3;
             ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
-            memcpy(&before, &a, sizeof a);
-            memcpy(copy, st, nst * sizeof *st);
             s.t = 2;
             s.input = k == 0 ? 0.5 : -0.5;      /* NaN, then infinity */
-            ck_assert_msg(fe_model_add(&a, &s) == FE_ENONFINITE, "analytic %d, case %d",
-                          analytic, k);
-            ck_assert_mem_eq(&a, &before, sizeof a);
-            ck_assert_mem_eq(st, copy, nst * sizeof *st);
+            ck_assert_msg(add_unchanged_if_refused(&a, &s, st, copy, nst) == FE_ENONFINITE,
+                          "analytic %d, case %d", analytic, k);
             s.t = 3;
             ck_assert_int_eq(fe_model_add(&a, &s), FE_OK);
             ck_assert_int_eq(fe_model_break(&a), FE_OK);

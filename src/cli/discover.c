@@ -2025,6 +2025,26 @@ static void fe__run_probes(fe__run *u)
     u->nprobes = u->cat.count - before;
 }
 
+/* The refusal of panel row p->n, into u->err: the term that is not
+   finite there, with the row's file, line and time. */
+static void fe__name_refusal(fe__run *u, const fe__panel *p)
+{
+    const char *bad = NULL;
+    double x = 0.0;
+    for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
+        if (!isfinite(p->phi[p->n][j])) {
+            bad = u->cat.terms[j].name;
+            x = p->phi[p->n][j];
+        }
+    if (bad != NULL)
+        snprintf(u->err, sizeof u->err, "%.1000s:%zu: term '%s' is %s at t = %g: refused, "
+                 "nothing reported", p->file[p->n], p->line[p->n], bad,
+                 isnan(x) ? "NaN" : "infinite", p->t[p->n]);
+    else
+        snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
+                 p->file[p->n], p->line[p->n], p->t[p->n]);
+}
+
 enum { FE__MARKS = 32, FE__MARK_STRIDE = 1024, FE__SPLIT_MIN = 8192 };
 
 /* Where the stream stood after `row` rows: in pair `cur`, with that
@@ -2570,20 +2590,7 @@ static int fe__run_fold(fe__run *u)
     if (rc == FE_OK
         || (rc == FE_END && (fe__panel_terms(u->a.order == 0 ? &u->cat : NULL, p, u->term_work)
                              != FE_OK || fe__panel_fold(&u->acc, p) != FE_OK))) {
-        const char *bad = NULL;
-        double x = 0.0;
-        for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
-            if (!isfinite(p->phi[p->n][j])) {
-                bad = u->cat.terms[j].name;
-                x = p->phi[p->n][j];
-            }
-        if (bad != NULL)
-            snprintf(u->err, sizeof u->err, "%.1000s:%zu: term '%s' is %s at t = %g: refused, "
-                     "nothing reported", p->file[p->n], p->line[p->n], bad,
-                     isnan(x) ? "NaN" : "infinite", p->t[p->n]);
-        else
-            snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
-                     p->file[p->n], p->line[p->n], p->t[p->n]);
+        fe__name_refusal(u, p);
         return FE_CLI_INPUT;
     }
     return rc == FE_END ? FE_CLI_OK : rc;
@@ -2643,21 +2650,7 @@ static int fe__run_fold_parts(fe__run *u, const fe__mark *m, size_t nst)
     for (int i = 0; i < 2; i++) {
         const fe__part *w = &part[i];
         if (w->refused != FE_OK) {
-            const fe__panel *p = w->p;
-            const char *bad = NULL;
-            double x = 0.0;
-            for (size_t j = 0; j < u->cat.count && bad == NULL; j++)
-                if (!isfinite(p->phi[p->n][j])) {
-                    bad = u->cat.terms[j].name;
-                    x = p->phi[p->n][j];
-                }
-            if (bad != NULL)
-                snprintf(u->err, sizeof u->err, "%.1000s:%zu: term '%s' is %s at t = %g: refused, "
-                         "nothing reported", p->file[p->n], p->line[p->n], bad,
-                         isnan(x) ? "NaN" : "infinite", p->t[p->n]);
-            else
-                snprintf(u->err, sizeof u->err, "%.1000s:%zu: a term is not finite at t = %g",
-                         p->file[p->n], p->line[p->n], p->t[p->n]);
+            fe__name_refusal(u, w->p);
             return FE_CLI_INPUT;
         }
         if (w->rc != FE_END) {

@@ -1085,14 +1085,34 @@ static void fe__cli_batch_done(fe__cli_pass *p, fe_cli_table *t, fe__cli_batch *
     p->have = 0;
 }
 
+/* The batch handed out is done (its rows handed out or folded): count its lines, free
+   its slot, show progress; FE_OK, or the batch's own error, which comes
+   after its rows. */
+static int fe__cli_pass_batch_end(fe_cli_table *t, size_t rows_before, char *err, size_t errlen)
+{
+    fe__cli_pass *p = t->pass;
+    fe__cli_batch *s = &p->slot[p->cur % p->nslots];
+    fe__cli_count_skipped(p, t, s, (size_t)-1);
+    if (s->status != FE_END) {
+        p->done = 1;
+        fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
+        snprintf(err, errlen, "%s", s->err);
+        return s->status;
+    }
+    fe__cli_batch_done(p, t, s);
+    if (rows_before >> 16 != t->rows >> 16)
+        fe__cli_progress_show(t);
+    return FE_OK;
+}
+
 static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
                              double *out, char *err, size_t errlen)
 {
     fe__cli_pass *p = t->pass;
     fe__cli_batch *s;
+    int rc;
     if (p == NULL) {
-        int rc = fe__cli_pass_start(t, cols, k, err, errlen);
-        if (rc != FE_CLI_OK)
+        if ((rc = fe__cli_pass_start(t, cols, k, err, errlen)) != FE_CLI_OK)
             return rc;
         p = t->pass;
     }
@@ -1127,14 +1147,8 @@ static int fe__cli_pass_next(fe_cli_table *t, const size_t *cols, size_t k,
             t->rows++;
             return FE_OK;
         }
-        fe__cli_count_skipped(p, t, s, (size_t)-1);
-        if (s->status != FE_END) {
-            p->done = 1;
-            fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
-            snprintf(err, errlen, "%s", s->err);
-            return s->status;
-        }
-        fe__cli_batch_done(p, t, s);
+        if ((rc = fe__cli_pass_batch_end(t, t->rows, err, errlen)) != FE_OK)
+            return rc;
     }
 }
 
@@ -1175,26 +1189,6 @@ static int fe__cli_run_fold(fe_cli_table *t, const fe_cli_parts *parts, void *ct
     }
     *n = 0;
     return 0;
-}
-
-/* The batch handed out is done (its rows folded): count its lines, free
-   its slot, show progress; FE_OK, or the batch's own error, which comes
-   after its rows. */
-static int fe__cli_pass_batch_end(fe_cli_table *t, size_t rows_before, char *err, size_t errlen)
-{
-    fe__cli_pass *p = t->pass;
-    fe__cli_batch *s = &p->slot[p->cur % p->nslots];
-    fe__cli_count_skipped(p, t, s, (size_t)-1);
-    if (s->status != FE_END) {
-        p->done = 1;
-        fe__cli_relocate(s->err, sizeof s->err, t->name, p->base);
-        snprintf(err, errlen, "%s", s->err);
-        return s->status;
-    }
-    fe__cli_batch_done(p, t, s);
-    if (rows_before >> 16 != t->rows >> 16)
-        fe__cli_progress_show(t);
-    return FE_OK;
 }
 
 /* A fold in parts: merge the part of the batch handed out
