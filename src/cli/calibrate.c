@@ -369,7 +369,6 @@ typedef struct fe__calibrate_rows {
     fe__calibrate_visit *visit; /* the walks: each sample fitted */
     void *ctx;
     struct fe__calibrate_measure *m;   /* the second pass */
-    const fe_sphere_fit *fit;
     const fe_sphere_scaled *sc;
 } fe__calibrate_rows;
 
@@ -614,14 +613,15 @@ typedef struct fe__calibrate_measure {
     FILE *apply;
 } fe__calibrate_measure;
 
-/* Measure one sample the fit kept (m is read, not written). */
-static void fe__calibrate_tally_add(fe__calibrate_tally *a, const fe__calibrate_measure *m,
-                                    const double x[3])
+/* Measure one sample the fit kept (m is read, not written); 0 when
+   --robust rejects it, unmeasured. */
+static int fe__calibrate_tally_add(fe__calibrate_tally *a, const fe__calibrate_measure *m,
+                                   const double x[3])
 {
     double y[3], len;
     int r;
     if (m->reject > 0.0 && fabs(fe_sphere_radial(m->fit, x)) > m->reject)
-        return;
+        return 0;
     fe_sphere_apply(m->fit, x, y);
     r = fe_quadric_region(y);
     if (r >= 0)
@@ -636,18 +636,17 @@ static void fe__calibrate_tally_add(fe__calibrate_tally *a, const fe__calibrate_
         if (b >= 0.0 && b < FE__CAL_HIST)
             a->hist[(int)b] += 1.0;
     }
+    return 1;
 }
 
-static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_fit *fit,
-                              const fe_sphere_scaled *sc, const double x[3], int still)
+static void fe__calibrate_one(fe__calibrate_measure *m, const fe_sphere_scaled *sc,
+                              const double x[3], int still)
 {
     double y[3];
     if (still)
-        fe__calibrate_tally_add(&m->tally, m, x);
-    if (still && m->reject > 0.0 && fabs(fe_sphere_radial(fit, x)) > m->reject)
-        still = 0;
+        still = fe__calibrate_tally_add(&m->tally, m, x);
     if (m->samples != NULL && m->seen++ % m->stride == 0) {
-        fe_sphere_apply(fit, x, y);
+        fe_sphere_apply(m->fit, x, y);
         fprintf(m->samples, "%.10g %.10g %.10g %.8g %.8g %.8g %.6g %d\n", x[0], x[1], x[2],
                 y[0], y[1], y[2],
                 100.0 * (sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0), still);
@@ -701,7 +700,7 @@ static int fe__calibrate_measure_row(void *ctx, fe_cli_table *t, const double *x
     if (rc != FE_OK)
         return fe__calibrate_refused_at(t, rc);
     if (r->ready)
-        fe__calibrate_one(r->m, r->fit, r->sc, y, r->still);
+        fe__calibrate_one(r->m, r->sc, y, r->still);
     fe_cli_progress(t);
     return 0;
 }
@@ -764,7 +763,6 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     m.fit = fit;
     r = fe__calibrate_rows_start(ncols, gate);
     r.m = &m;
-    r.fit = fit;
     r.sc = sc;
     if (gate == NULL && ncols == 3 && m.samples == NULL && m.apply == NULL) {
         const fe_cli_parts parts = {0, sizeof(fe__calibrate_tally), &m, fe__calibrate_tally_start,
@@ -777,7 +775,7 @@ static int fe__calibrate_second_pass(const fe__calibrate_args *a,
     fe_cli_progress_done(t);
     if (rc == FE_END)
         while (gate != NULL && fe_still_flush(gate, y, &still) == FE_OK)
-            fe__calibrate_one(&m, fit, sc, y, still);
+            fe__calibrate_one(&m, sc, y, still);
     if (rc != FE_END) {
         if (err[0] != '\0')
             fprintf(stderr, "foldest calibrate: %s\n", err);
