@@ -444,9 +444,11 @@ START_TEST(bad_packets_are_refused_and_nothing_changes)
     }
     memcpy(snap, f.mem, sizeof snap);
     desc = f.k;
-    for (int fast = 0; fast < 2; fast++) {
+    /* Each update: the reference, the fast one and Joseph's form. */
+    for (int v = 0; v < 3; v++) {
         int (*upd)(fe_kalman *, const fe_kalman_obs *, fe_kalman_report *) =
-            fast ? fe_kalman_update_fast : fe_kalman_update;
+            v == 1 ? fe_kalman_update_fast : v == 2 ? fe_kalman_update_joseph : fe_kalman_update;
+        int fast = v == 1;
         fe_kalman_obs neg = {1, A1, &z1, &Zneg};          /* D = -5 + small < 0 */
         fe_kalman_obs ind = {2, A2, z2, Zind};            /* D indefinite */
         fe_kalman_obs nan = {2, A2, zbad, Z2};
