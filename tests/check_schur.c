@@ -377,6 +377,48 @@ START_TEST(weights_blocks_and_damping_at_their_edges)
 }
 END_TEST
 
+/* Issue 20: a damped diagonal A_kk (1 + lambda) that overflows is
+   refused with FE_ESINGULAR, in a block and in the reduced system, with
+   the rest of the system harmless.  A_kk = 2^1020 (one row of 2^510,
+   within the DBL_MAX / 4 a diagonal may hold): at lambda = 15 - 2^-49
+   (the double below 15) the damped diagonal is (16 - 2^-49) 2^1020 =
+   DBL_MAX exactly and the system is solved; at lambda = 15 it is 2^1024,
+   infinite.  Block case: a global row x_g = 2 and a block row 2^510 x_l
+   = 0, so x_g = 2 / (1 + lambda) and x_l = 0.  Reduced case: a global
+   row 2^510 x_g = 0 and a block row x_l = 3: x_g = 0, x_l = 3 / (1 +
+   lambda). */
+START_TEST(a_damped_diagonal_that_overflows_is_singular)
+{
+    double st[64], work[64], x[2], rss;
+    const double big = ldexp(1.0, 510), one = 1.0, zero = 0.0;
+    const double below = nextafter(15.0, 0.0);
+    ck_assert_uint_le(fe_schur_storage(1, 1, 1), 64);
+    ck_assert_uint_le(fe_schur_solve_work(1, 1), 64);
+    ck_assert_double_eq(below, 15.0 - ldexp(1.0, -49));
+    ck_assert_double_eq((1.0 + below) * ldexp(1.0, 1020), DBL_MAX);
+    for (int where = 0; where < 2; where++) {
+        fe_schur a;
+        ck_assert_int_eq(fe_schur_init(&a, 1, 1, 1, st), FE_OK);
+        if (where == 0) {           /* the block's diagonal */
+            ck_assert_int_eq(fe_schur_add(&a, &one, FE_SCHUR_NONE, NULL, 2.0, 1.0), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &zero, 0, &big, 0.0, 1.0), FE_OK);
+        } else {                    /* the reduced system's */
+            ck_assert_int_eq(fe_schur_add(&a, &big, FE_SCHUR_NONE, NULL, 0.0, 1.0), FE_OK);
+            ck_assert_int_eq(fe_schur_add(&a, &zero, 0, &one, 3.0, 1.0), FE_OK);
+        }
+        ck_assert_int_eq(fe_schur_solve(&a, below, x, &rss, work), FE_OK);
+        if (where == 0) {
+            ck_assert_double_eq_tol(x[0], 2.0 / 16.0, 1e-15);
+            ck_assert_double_eq(x[1], 0.0);
+        } else {
+            ck_assert_double_eq(x[0], 0.0);
+            ck_assert_double_eq_tol(x[1], 3.0 / 16.0, 1e-15);
+        }
+        ck_assert_int_eq(fe_schur_solve(&a, 15.0, x, &rss, work), FE_ESINGULAR);
+    }
+}
+END_TEST
+
 Suite *fe_schur_suite(void)
 {
     Suite *s = suite_create("schur");
@@ -391,6 +433,7 @@ Suite *fe_schur_suite(void)
     tcase_add_test(t, underdetermined_blocks_are_singular_never_nan);
     tcase_add_test(t, shapes_and_degenerate_dimensions);
     tcase_add_test(t, rank_test_at_its_edge);
+    tcase_add_test(t, a_damped_diagonal_that_overflows_is_singular);
     suite_add_tcase(s, t);
     return s;
 }

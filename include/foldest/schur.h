@@ -81,7 +81,8 @@ size_t fe_schur_solve_work(size_t ng, size_t nl);
    lambda == 0).  `work` holds fe_schur_solve_work(ng, nl) doubles.
    Errors: FE_EINVAL (nulls, lambda < 0 or not finite), FE_ETOOFEW (no
    rows), FE_ESINGULAR (a block or the reduced system is singular to within
-   FE_LSQ_RANK_TOL; x is then unspecified), FE_EINTERNAL.
+   FE_LSQ_RANK_TOL, or a damped diagonal A_kk (1 + lambda) overflows; x
+   is then unspecified), FE_EINTERNAL.
    Cost: O(nb (nl^3 + nl^2 ng + nl ng^2) + ng^3). */
 int fe_schur_solve(const fe_schur *a, double lambda, double *x, double *rss,
                    double *work);
