@@ -1800,6 +1800,44 @@ START_TEST(too_few_samples_and_the_naive_workspace_at_their_edges)
 }
 END_TEST
 
+/* Issue 20: the sample count's two ends for the fits from stored samples.
+   No samples at all are a null pointer with n = 0: not a bad argument
+   but too few (FE_ETOOFEW, FE_SPHERE_TOO_FEW, n = 0), the same answer as
+   an empty array gives, for the stored and the naive fit (the naive one
+   needs 0 doubles of workspace then).  The naive fit hands n to BLAS as
+   an int: n = 2^31 is refused with FE_ESIZE before any sample or the
+   workspace is read, however long the caller says the workspace is (the
+   pointers here hold 3 samples and 10 doubles: a fit that went on would
+   read far past them), and the fit struct is left as it was. */
+START_TEST(no_samples_are_too_few_and_a_count_past_int_is_refused)
+{
+    double x[3 * 3] = {0}, w[10] = {0};
+    const size_t past = (size_t)2147483647u + 1u;   /* 2^31 */
+    for (int model = FE_FIT_SPHERE; model <= FE_FIT_ELLIPSOID; model++) {
+        fe_sphere_fit f, before;
+        ck_assert_int_eq(fe_sphere_fit_stored(NULL, 0, (fe_sphere_model)model, NULL, &f),
+                         FE_ETOOFEW);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
+        ck_assert_uint_eq(f.n, 0);
+        ck_assert_int_eq(fe_sphere_fit_stored(x, 0, (fe_sphere_model)model, NULL, &f),
+                         FE_ETOOFEW);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
+        ck_assert_uint_eq(fe_sphere_naive_workspace(0, (fe_sphere_model)model), 0);
+        ck_assert_int_eq(fe_sphere_fit_naive(NULL, 0, (fe_sphere_model)model, NULL, w, 0, &f),
+                         FE_ETOOFEW);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_TOO_FEW);
+        ck_assert_uint_eq(f.n, 0);
+        memset(&f, 0x5a, sizeof f);
+        before = f;
+        ck_assert_int_eq(fe_sphere_fit_naive(x, past, (fe_sphere_model)model, NULL, w,
+                                             fe_sphere_naive_workspace(past, (fe_sphere_model)model),
+                                             &f),
+                         FE_ESIZE);
+        ck_assert_mem_eq(&f, &before, sizeof f);
+    }
+}
+END_TEST
+
 /* Issue 20: the options' thresholds at their edges, each set from what
    the fit reports: a minimum planarity equal to the samples' is met and
    the next double above is not (FE_SPHERE_PLANAR); the same for the
@@ -1972,6 +2010,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(r, real_recordings_f32_step_agrees);
     tcase_add_test(t, still_and_histogram_refusals_at_their_edges);
     tcase_add_test(t, too_few_samples_and_the_naive_workspace_at_their_edges);
+    tcase_add_test(t, no_samples_are_too_few_and_a_count_past_int_is_refused);
     tcase_add_test(t, option_thresholds_at_their_edges);
     tcase_add_test(t, blocked_errors_begin_at_eight_blocks);
     tcase_add_test(t, fields_windows_and_thresholds_at_their_edges);

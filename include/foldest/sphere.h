@@ -129,7 +129,8 @@ int fe_sphere_fit_algebraic(const fe_quadric *q, const fe_sphere_options *opt,
 
 /* fe_sphere_fit_stored: (ii), the same fit by accumulating J^T J and
    J^T r over the n stored samples xyz[3i..3i+2] at every iteration.
-   Same errors as fe_sphere_fit_moments. */
+   Same errors as fe_sphere_fit_moments; xyz may be NULL for n = 0 (too
+   few, FE_ETOOFEW). */
 int fe_sphere_fit_stored(const double *xyz, size_t n, fe_sphere_model model,
                          const fe_sphere_options *opt, fe_sphere_fit *fit);
 
@@ -138,7 +139,8 @@ int fe_sphere_fit_stored(const double *xyz, size_t n, fe_sphere_model model,
 size_t fe_sphere_naive_workspace(size_t n, fe_sphere_model model);
 
 /* fe_sphere_fit_naive: (i), the same fit materialising J and r in the
-   caller's `work` (work_len doubles; FE_ESIZE if too small). */
+   caller's `work` (work_len doubles; FE_ESIZE if too small, or for n
+   above 2^31 - 1, which BLAS takes as an int: before anything is read). */
 int fe_sphere_fit_naive(const double *xyz, size_t n, fe_sphere_model model,
                         const fe_sphere_options *opt, double *work,
                         size_t work_len, fe_sphere_fit *fit);
