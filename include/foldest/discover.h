@@ -332,7 +332,8 @@ typedef struct fe_discover_rank {
     double statistic;           /* t (one column) or F (several) */
     double p_value;             /* under the noise model (or batch means) */
     double delta_bic;           /* BIC change if added (negative: better) */
-    int redundant;              /* already expressible by the model */
+    int redundant;              /* already expressible by the model: not
+                                   tested (p_value 1, the rest 0) */
 } fe_discover_rank;
 
 /* A summary of a fitted model. */
