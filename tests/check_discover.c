@@ -662,6 +662,16 @@ START_TEST(the_widest_fold_by_columns_equals_the_rows)
     ck_assert_int_eq(fe_discover_add_columns(&cols, col[0], N, r, N, &done), FE_OK);
     ck_assert_uint_eq(done, N);
     assert_same_sums(&cols, &rows);
+    /* The same rows again (held out now) with 1e150 in the last column of
+       row N / 2: from that row to the end of its panel the fold goes
+       through the row step, which gathers each row's M columns into a
+       stack array of FE_DISCOVER_MAX_COLUMNS (full at this width). */
+    col[M - 1][N / 2] = row[N / 2][M - 1] = 1e150;
+    for (size_t t = 0; t < N; t++)
+        ck_assert_int_eq(fe_discover_add(&rows, row[t], r[t]), FE_OK);
+    ck_assert_int_eq(fe_discover_add_columns(&cols, col[0], N, r, N, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    assert_same_sums(&cols, &rows);
     free(s1);
     free(s2);
 }

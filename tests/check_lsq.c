@@ -737,12 +737,59 @@ START_TEST(weights_indices_and_counts_at_their_edges)
     ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, -DBL_TRUE_MIN), FE_EINVAL);
     ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, -DBL_TRUE_MIN), FE_EINVAL);
     ck_assert_int_eq(fe_lsq_add_sparse(&a, past, val, 1, 1.0, 1.0), FE_EINVAL);
+    /* One entry (nnz = 1) without its index or its value, or both, or an
+       accumulation without storage: refused, nothing read or changed. */
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, NULL, val, 1, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, NULL, 1, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, NULL, NULL, 1, 1.0, 1.0), FE_EINVAL);
+    {
+        fe_lsq nog = a;
+        nog.g = NULL;
+        ck_assert_int_eq(fe_lsq_add_sparse(&nog, last, val, 1, 1.0, 1.0), FE_EINVAL);
+        ck_assert_uint_eq(nog.n, 1);
+    }
     ck_assert_mem_eq(&a, &before, sizeof a);
     ck_assert_mem_eq(g, gb, sizeof g);
     ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 0.0), FE_OK);
     ck_assert_uint_eq(a.n, 2);
     ck_assert_double_eq(a.wsum, 1.0);
     ck_assert_mem_eq(g, gb, sizeof g);              /* nothing added */
+    /* A sparse row takes every weight from 0 up, as a dense one: 0 is
+       counted and adds nothing; 1/2 and the double just below 1 add w v^2,
+       w v r and w r^2 (v = 2, r = 1: each sum exact in binary). */
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 0.0), FE_OK);
+    ck_assert_uint_eq(a.n, 3);
+    ck_assert_double_eq(a.wsum, 1.0);
+    ck_assert_mem_eq(g, gb, sizeof g);              /* nothing added */
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 0.5), FE_OK);
+    ck_assert_uint_eq(a.n, 4);
+    ck_assert_double_eq(a.wsum, 1.5);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q - 1), 9.0 + 2.0);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q), 3.0 + 1.0);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q, Q), 1.0 + 0.5);
+    ck_assert_double_eq(fe_lsq_gram(&a, 0, Q - 1), 3.0);
+    /* No entries (nnz = 0, neither array read): the response alone,
+       w r^2 = 9/2 in G[p][p]. */
+    ck_assert_int_eq(fe_lsq_reset(&a), FE_OK);
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, NULL, NULL, 0, 3.0, 0.5), FE_OK);
+    ck_assert_uint_eq(a.n, 1);
+    ck_assert_double_eq(a.wsum, 0.5);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q, Q), 4.5);
+    for (size_t k = 0; k < Q; k++)
+        for (size_t l = 0; l <= Q; l++)
+            ck_assert_double_eq(fe_lsq_gram(&a, k, l), 0.0);
+    ck_assert_int_eq(fe_lsq_reset(&a), FE_OK);     /* alone: its sums exact */
+    ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 1.0 - 0x1p-53), FE_OK);
+    ck_assert_uint_eq(a.n, 1);
+    ck_assert_double_eq(a.wsum, 1.0 - 0x1p-53);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q - 1), 4.0 - 0x1p-51);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q), 2.0 - 0x1p-52);
+    ck_assert_double_eq(fe_lsq_gram(&a, Q, Q), 1.0 - 0x1p-53);
+    ck_assert_double_eq(fe_lsq_gram(&a, 0, 0), 0.0);
+    /* Back to the row (1 2 3 | 1) with weights 1 and 0, then the sparse (0 0 2 | 1). */
+    ck_assert_int_eq(fe_lsq_reset(&a), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 1.0), FE_OK);
+    ck_assert_int_eq(fe_lsq_add(&a, j, 1.0, 0.0), FE_OK);
     ck_assert_int_eq(fe_lsq_add_sparse(&a, last, val, 1, 1.0, 1.0), FE_OK);
     ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q - 1), 9.0 + 4.0);
     ck_assert_double_eq(fe_lsq_gram(&a, Q - 1, Q), 3.0 + 2.0);

@@ -331,6 +331,79 @@ START_TEST(a_buffer_of_one_record_is_enough)
 }
 END_TEST
 
+/* Issue 20: each argument of the source functions alone at fault.  A
+   refusal is FE_EINVAL with nothing read: *done is 0 (it was 99), the
+   accumulation still empty, the visitor never called, and the source still
+   at its first observation.  A source that cannot rewind says so. */
+static int count_calls(const void *acc, size_t index, void *ctx)
+{
+    (void)acc;
+    (void)index;
+    (*(int *)ctx)++;
+    return FE_OK;
+}
+
+START_TEST(each_argument_alone_is_refused_and_nothing_is_read)
+{
+    const double z[3] = {2, 3, 7};
+    fe_array_source st;
+    fe_source src, bad;
+    fe_accumulator f = fe_meanvar_accumulator(), nostep = f;
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    const void *obs = NULL;
+    int visits = 0;
+    nostep.step = NULL;
+    ck_assert_int_eq(fe_source_from_array(&src, &st, z, 3, sizeof(double)), FE_OK);
+    /* fe_source_next: no source, a source without next, nowhere to point. */
+    ck_assert_int_eq(fe_source_next(NULL, &obs), FE_EINVAL);
+    bad = src;
+    bad.next = NULL;
+    ck_assert_int_eq(fe_source_next(&bad, &obs), FE_EINVAL);
+    ck_assert_int_eq(fe_source_next(&src, NULL), FE_EINVAL);
+    ck_assert_ptr_null(obs);
+    ck_assert_uint_eq(st.pos, 0);
+    /* fe_source_rewind: no source; a source that cannot rewind. */
+    bad = src;
+    bad.rewind = NULL;
+    ck_assert_int_eq(fe_source_rewind(NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_source_rewind(&bad), FE_ENOTSUP);
+    /* fe_fold_source and fe_scan_source (with and without a visitor). */
+    for (int v = 0; v < 3; v++) {
+        fe_visit_fn *visit = v == 2 ? count_calls : NULL;
+        for (int c = 0; c < 6; c++) {
+            const fe_accumulator *fc = c == 0 ? NULL : c == 1 ? &nostep : &f;
+            void *acc = c == 2 ? NULL : &a;
+            fe_source *sc = c == 3 ? NULL : c == 4 || c == 5 ? &bad : &src;
+            size_t done = 99;
+            int rc;
+            bad = src;
+            if (c == 4)
+                bad.next = NULL;
+            if (c == 5)
+                bad.obs_size = sizeof(float);
+            rc = v == 0 ? fe_fold_source(fc, acc, sc, &done)
+                        : fe_scan_source(fc, acc, sc, visit, &visits, &done);
+            ck_assert_msg(rc == FE_EINVAL, "case %d, %d: %d", v, c, rc);
+            ck_assert_msg(done == 0, "case %d, %d: done = %zu", v, c, done);
+            ck_assert_int_eq(fe_fold_source(fc, acc, sc, NULL), FE_EINVAL);
+            ck_assert_uint_eq(a.n, 0);
+            ck_assert_uint_eq(st.pos, 0);
+        }
+    }
+    ck_assert_int_eq(visits, 0);
+    /* And with every argument good, the three observations, visited at
+       0, 1, 2 and 3. */
+    {
+        size_t done = 99;
+        ck_assert_int_eq(fe_scan_source(&f, &a, &src, count_calls, &visits, &done), FE_OK);
+        ck_assert_uint_eq(done, 3);
+        ck_assert_int_eq(visits, 4);
+        ck_assert_uint_eq(a.n, 3);
+        ck_assert_double_eq(a.mean, 4.0);
+    }
+}
+END_TEST
+
 Suite *fe_stream_suite(void)
 {
     Suite *s = suite_create("stream");
@@ -346,6 +419,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, fd_source_read_error_is_an_io_error);
     tcase_add_test(t, standard_input_is_a_source);
     tcase_add_test(t, a_buffer_of_one_record_is_enough);
+    tcase_add_test(t, each_argument_alone_is_refused_and_nothing_is_read);
     suite_add_tcase(s, t);
     return s;
 }

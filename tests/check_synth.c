@@ -2,6 +2,8 @@
 /* The synthetic recordings' refusals, each at its edge: equal, just
    inside, just outside (their statistics are checked by the discovery and
    model suites, which fold them). */
+#include <float.h>
+
 #include "foldest.h"
 #include "foldest/synth.h"
 #include "testutil.h"
@@ -58,6 +60,40 @@ START_TEST(spec_refusals_at_their_edges)
             s.order = rig[i].order;
             ck_assert_msg(fe_synth_init(&g, &s) == rig[i].rc, "%s, order %zu", rig[i].effect,
                           rig[i].order);
+        }
+    }
+    /* The parting of an integrated effect (order 1 and 2) must be
+       positive: 0, -DBL_TRUE_MIN and NaN are refused, DBL_TRUE_MIN, 1/2
+       and 1 taken; the coefficient is proportional to it, so 1/2 gives
+       exactly half of 1's (a halving, exact in binary).  Order 0 does
+       not read it. */
+    {
+        static const struct { const char *effect; size_t order; } rig[] = {
+            {"newton_cooling", 1}, {"viscous_friction", 2},
+        };
+        for (size_t i = 0; i < sizeof rig / sizeof rig[0]; i++) {
+            double one;
+            s = fe_synth_default_spec(rig[i].effect, 3);
+            s.rows = 100;
+            s.order = rig[i].order;
+            s.parting = 0.0;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_EINVAL);
+            s.parting = -DBL_TRUE_MIN;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_EINVAL);
+            s.parting = NAN;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_EINVAL);
+            s.parting = DBL_TRUE_MIN;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_OK);
+            s.parting = 1.0;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_OK);
+            one = g.coefficient;
+            ck_assert(isfinite(one) && one != 0.0);
+            s.parting = 0.5;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_OK);
+            ck_assert_double_eq(g.coefficient, 0.5 * one);
+            s.order = 0;
+            s.parting = 0.0;
+            ck_assert_int_eq(fe_synth_init(&g, &s), FE_OK);
         }
     }
 }
