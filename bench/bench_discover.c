@@ -35,7 +35,7 @@
 #include "bench.h"
 #include "foldest.h"
 
-enum { BASE = 3, CAND = 50, K = 20, PANEL = 256, PCOL = 128, NS = 7 };
+enum { BASE = 3, CAND = 50, K = 20, PANEL = FE_DISCOVER_PANEL_ROWS, PCOL = FE_DISCOVER_PANEL_ROWS, NS = 7 };
 
 /* The screen's multiply-adds a row: the base columns' and r's whole rows,
    the band of each candidate, and the lag product among the whole ones. */

@@ -366,11 +366,12 @@ START_TEST(overflowing_rows_are_refused_whole)
     /* Finite values whose products overflow (found by the fuzzer): the row
        is refused and not one double of the accumulation changes; large
        values whose products are finite take the careful path and count. */
-    enum { M = 2, K = 4 };
-    double mem[4096], snap[4096], phi[M];
+    enum { M = 2, K = 4, CAP = 8192 };
+    static double mem[CAP], snap[CAP];
+    double phi[M];
     size_t nd = fe_discover_acc_doubles(M, K);
     fe_discover_acc a, as;
-    ck_assert_uint_le(nd, 4096);
+    ck_assert_uint_le(nd, CAP);
     ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, mem, nd), FE_OK);
     phi[0] = 1.0, phi[1] = 2.0;
     ck_assert_int_eq(fe_discover_add(&a, phi, 0.5), FE_OK);

@@ -35,7 +35,7 @@ enum {
 /* Rows per panel of fe_discover_add_rows, whose scratch (an M x M
    triangle and FE_DISCOVER_PANEL_ROWS + 1 rows) is part of the
    accumulation's storage. */
-enum { FE_DISCOVER_PANEL_ROWS = 128 };
+enum { FE_DISCOVER_PANEL_ROWS = 512 };
 
 /* FE_DISCOVER_ACC_DOUBLES: fe_discover_acc_doubles(m, blocks) as a
    constant expression, for storage sized at compile time.  The values
