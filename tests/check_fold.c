@@ -273,6 +273,38 @@ START_TEST(product_merge_rolls_back_when_a_copy_fails)
 }
 END_TEST
 
+/* A product's copy refuses with the status of the first part whose copy
+   refuses, and copies no part after it: part 0's copy refuses an
+   accumulation with a negative count, so the product's copy returns
+   FE_ENOTSUP with both destinations as they were to the byte; with that
+   count set right, the same copy copies both parts (issue 20: seed
+   9303's fold:174, a part's refusal to copy ignored). */
+START_TEST(product_copy_refuses_with_the_first_part_that_refuses)
+{
+    fe_accumulator t0 = toy(), t1 = toy(), prod;
+    const fe_product_part parts[2] = {{&t0, 0}, {&t1, sizeof(double)}};
+    const fe_product spec = {parts, 2};
+    toy_acc s0 = {-1, 7.0}, s1 = {3, 6.0}, d0 = {9, 9.0}, d1 = {8, 8.0};
+    toy_acc x0 = {0, 0}, x1 = {0, 0}, y0 = {0, 0}, y1 = {0, 0};
+    const toy_acc d0_was = d0, d1_was = d1, s0_was = s0, s1_was = s1;
+    void *sa[2] = {&s0, &s1}, *sx[2] = {&x0, &x1}, *da[2] = {&d0, &d1}, *dx[2] = {&y0, &y1};
+    fe_product_acc ps = {sa, sx}, pd = {da, dx};
+    t0.copy = toy_copy_or_fail;
+    ck_assert_int_eq(fe_product_accumulator(&prod, &spec, 2 * sizeof(double)), FE_OK);
+    ck_assert_int_eq(fe_copy(&prod, &pd, &ps), FE_ENOTSUP);
+    ck_assert_mem_eq(&d0, &d0_was, sizeof d0);
+    ck_assert_mem_eq(&d1, &d1_was, sizeof d1);
+    ck_assert_mem_eq(&s0, &s0_was, sizeof s0);
+    ck_assert_mem_eq(&s1, &s1_was, sizeof s1);
+    s0.count = 2;
+    ck_assert_int_eq(fe_copy(&prod, &pd, &ps), FE_OK);
+    ck_assert_int_eq(d0.count, 2);
+    ck_assert_double_eq(d0.sum, 7.0);
+    ck_assert_int_eq(d1.count, 3);
+    ck_assert_double_eq(d1.sum, 6.0);
+}
+END_TEST
+
 START_TEST(product_rejects_bad_layout)
 {
     fe_accumulator mv = fe_meanvar_accumulator(), prod;
@@ -342,6 +374,7 @@ Suite *fe_fold_suite(void)
     tcase_add_test(t, product_rolls_back_a_partial_step);
     tcase_add_test(t, product_merges_component_wise);
     tcase_add_test(t, product_merge_rolls_back_when_a_copy_fails);
+    tcase_add_test(t, product_copy_refuses_with_the_first_part_that_refuses);
     tcase_add_test(t, product_rejects_bad_layout);
     suite_add_tcase(s, t);
     return s;

@@ -203,6 +203,61 @@ START_TEST(blocks_without_pairs_have_no_autocorrelation_test)
 }
 END_TEST
 
+/* A window the NIS locates in blocks without a lag-one pair carries no
+   autocorrelation figure: its t and lag1 are 0, not a default of 1.  Four
+   blocks of 10 scalar reports of +-3 (NIS 9 each), a break before every
+   report (no pairs; with the whitened vector, then without it: no squares
+   either).  Each block's NIS is 90 on 10 degrees of freedom, whose upper
+   tail is, for an even number 2m of degrees of freedom,
+   e^{-x/2} sum_{k<m} (x/2)^k / k!: p = e^{-45} (1 + 45 + 45^2/2 + 45^3/6
+   + 45^4/24), about 5e-15, far below 0.05 / 8.  Every window found says
+   "nis" with that p-value, z its upper normal quantile to the 1.2e-9 of
+   fe_normal_quantile (the root of 0.5 erfc(z / sqrt 2) = p by Newton's
+   method on the logarithm), the mean NIS 9, and t and lag1 exactly 0
+   (issue 20: seed 9303's locate:244, z_acf starting at 1 for a block
+   without pairs). */
+START_TEST(a_window_without_pairs_has_no_autocorrelation_figure)
+{
+    const double h = 45.0;
+    const double p = exp(-h) * (1.0 + h + h * h / 2.0 + h * h * h / 6.0 + h * h * h * h / 24.0);
+    double z = 8.0;
+    for (int it = 0; it < 60; it++) {
+        double q = 0.5 * erfc(z / sqrt(2.0)), phi = exp(-z * z / 2.0) / sqrt(2.0 * acos(-1.0));
+        z += (log(q) - log(p)) * q / phi;      /* d log q / dz = -phi / q */
+    }
+    FE_ASSERT_REL(0.5 * erfc(z / sqrt(2.0)), p, 1e-13);
+    for (int whitened = 1; whitened >= 0; whitened--) {
+        fe_innovations inn;
+        fe_located loc[4];
+        size_t n = 0;
+        double w = 3.0;
+        ck_assert_int_eq(fe_innovations_init(&inn, 4, 40, 0), FE_OK);
+        for (int i = 0; i < 40; i++) {
+            fe_kalman_report r = {1, 9.0, 0, NULL, whitened ? &w : NULL, NULL};
+            fe_innovations_break(&inn);
+            w = i % 2 ? 3.0 : -3.0;
+            ck_assert_int_eq(fe_innovations_add(&inn, i, &r), FE_OK);
+        }
+        for (int b = 0; b < 4; b++) {
+            ck_assert_double_eq(inn.block[b].acf_terms, 0);
+            ck_assert_double_eq(inn.block[b].sq_terms, whitened ? 10 : 0);
+            ck_assert_double_eq(inn.block[b].nis, 90.0);
+        }
+        ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, loc, 4, &n), FE_OK);
+        ck_assert_uint_ge(n, 1);
+        ck_assert_uint_le(n, 4);
+        for (size_t i = 0; i < n; i++) {
+            ck_assert_str_eq(loc[i].test, "nis");
+            FE_ASSERT_REL(loc[i].p_value, p, 1e-10);
+            FE_ASSERT_REL(loc[i].z, z, 1.2e-9);
+            ck_assert_double_eq(loc[i].mean_nis, 9.0);
+            ck_assert_double_eq(loc[i].t, 0.0);
+            ck_assert_double_eq(loc[i].lag1, 0.0);
+        }
+    }
+}
+END_TEST
+
 /* The lag-one test of a block is the mean product over the mean square:
    four blocks of 10 scalar reports of +-1, alternating, each block cut by
    breaks at its start and middle, so that it holds 8 pairs (each -1) and
@@ -1294,6 +1349,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, cells_of_two_rows_are_tested_and_of_one_not);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
     tcase_add_test(t, the_lag_one_statistic_is_a_mean_product_over_a_mean_square);
+    tcase_add_test(t, a_window_without_pairs_has_no_autocorrelation_figure);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
     tcase_add_test(t, a_lag_one_sum_that_overflows_is_refused);
