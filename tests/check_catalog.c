@@ -293,6 +293,40 @@ START_TEST(every_coefficient_in_words)
 END_TEST
 
 
+/* The terminal speed of quadratic drag is told only for k = -coef > 0:
+   not at coef 0 or -0 (k not positive: sqrt(g/0) would be infinite), nor
+   for a positive coef, the smallest too (sqrt of a negative number).  A
+   buffer too short for the first sentence is truncated, and no byte past
+   its length is written. */
+START_TEST(quadratic_drag_in_words_at_its_edges)
+{
+    const struct { double coef; int terminal; } w[] = {
+        {0.0, 0}, {-0.0, 0}, {DBL_TRUE_MIN, 0}, {0.02, 0}, {-8, 1}, {-0.02, 1},
+    };
+    char buf[256];
+    for (size_t i = 0; i < sizeof w / sizeof w[0]; i++) {
+        ck_assert_int_eq(fe_catalog_explain("quadratic_drag", w[i].coef, 0.1, buf, sizeof buf),
+                         FE_OK);
+        ck_assert_msg(strncmp(buf, "quadratic drag: a = -k v|v| with k = ", 37) == 0, "%s", buf);
+        ck_assert_msg((strstr(buf, "terminal") != NULL) == w[i].terminal, "%g: %s", w[i].coef,
+                      buf);
+    }
+    /* k = 8: sqrt(9.80665 / 8) = sqrt(1.22583125) = 1.1072 (1.1072^2 =
+       1.22589). */
+    ck_assert_int_eq(fe_catalog_explain("quadratic_drag", -8, 0.1, buf, sizeof buf), FE_OK);
+    ck_assert_msg(strstr(buf, "sqrt(g/k) = 1.11 m/s") != NULL, "%s", buf);
+    /* Truncated at 8, 37 and 60 bytes: each byte past the length untouched. */
+    const size_t lens[] = {8, 37, 60};
+    for (size_t i = 0; i < 3; i++) {
+        memset(buf, 'X', sizeof buf);
+        ck_assert_int_eq(fe_catalog_explain("quadratic_drag", -0.02, 0.01, buf, lens[i]), FE_OK);
+        ck_assert_uint_eq(strlen(buf), lens[i] - 1);
+        for (size_t j = lens[i]; j < sizeof buf; j++)
+            ck_assert_msg(buf[j] == 'X', "length %zu: byte %zu written", lens[i], j);
+    }
+}
+END_TEST
+
 START_TEST(three_axis_terms_are_their_formulas)
 {
     /* A sample at distance 5 from the centre in direction (0.6, 0, 0.8),
@@ -514,6 +548,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, expression_terms_through_the_catalog);
     tcase_add_test(t, probes_are_bins_of_a_state_variable);
     tcase_add_test(t, every_coefficient_in_words);
+    tcase_add_test(t, quadratic_drag_in_words_at_its_edges);
     tcase_add_test(t, three_axis_terms_are_their_formulas);
     tcase_add_test(t, three_axis_gain_is_read_from_its_coefficients);
     tcase_add_test(t, three_axis_centre_refused_in_each_coordinate);

@@ -189,6 +189,39 @@ START_TEST(byte_order_mark_semicolons_and_read_functions)
 }
 END_TEST
 
+/* The mark's edges: a first line that is the mark and nothing else (an
+   empty line, its three bytes gone, with and without a newline after it),
+   and first lines of two and three bytes that begin as the mark but are
+   not it (returned as they are). */
+START_TEST(byte_order_mark_at_its_edges)
+{
+    static const struct { const char *text; const char *first; size_t len; } cases[] = {
+        {"\xEF\xBB\xBF\n" "1;2\n", "", 0},
+        {"\xEF\xBB\xBF", "", 0},
+        {"\xEF\xBB\xBF\r\n" "1;2\n", "", 0},
+        {"\xEF\xBB\n" "1;2\n", "\xEF\xBB", 2},
+        {"\xEF\xBBz\n" "1;2\n", "\xEF\xBBz", 3},
+        {"\xEF\xBB\xBE\n" "1;2\n", "\xEF\xBB\xBE", 3},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        struct chunks c = {cases[i].text, 0, 64};
+        fe_csv_reader r;
+        char buf[64], *line;
+        size_t len = 99;
+        ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, buf, sizeof buf), FE_OK);
+        ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+        ck_assert_msg(len == cases[i].len, "case %zu: length %zu", i, len);
+        ck_assert_msg(memcmp(line, cases[i].first, len + 1) == 0, "case %zu", i);
+        if (strchr(cases[i].text, '1') != NULL) {
+            ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+            ck_assert_str_eq(line, "1;2");
+            ck_assert_uint_eq(len, 3);
+        }
+        ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+    }
+}
+END_TEST
+
 struct number_case { const char *text; int rc; double value; };
 
 /* Each case through `parse`: its status, its value, and an untouched
@@ -813,6 +846,7 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, numbers);
     tcase_add_test(t, numbers_equal_strtod_bit_for_bit);
     tcase_add_test(t, byte_order_mark_semicolons_and_read_functions);
+    tcase_add_test(t, byte_order_mark_at_its_edges);
     tcase_add_test(t, strtod_extensions_are_not_numbers);
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
     tcase_add_test(t, number_parsers_refuse_each_missing_argument);

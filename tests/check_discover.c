@@ -1643,6 +1643,72 @@ START_TEST(scale_used_does_not_depend_on_the_order_of_the_columns)
 }
 END_TEST
 
+/* coef and stderr_ of fe_discover_fit_noise are outputs only: filled
+   with 0, with NaN, with +-1e300, with 1 or with 0.3 before the call, the
+   fit of three columns is the same to the bit (coefficients, standard
+   errors, the fit and the noise model), on the rows of noise_rows and on
+   the same columns with a noise of AR(1) coefficient 0.99, where the ten
+   GLS rounds have not settled to the bit and any other start shows.  The
+   GLS starts from the ordinary least squares of all the model's columns,
+   computed into coef (discover:4352 and 4350 of seed 9404's sample, its
+   first coefficient alone or all but the first, left the others as the
+   caller had them). */
+START_TEST(fit_noise_does_not_read_its_outputs)
+{
+    size_t nst = fe_discover_acc_doubles(NM, NK);
+    size_t nw = fe_discover_workspace_doubles(NM, NK);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    static const size_t cols[3] = {0, 1, 2};
+    static const double fill[5][3] = {
+        {0, 0, 0}, {NAN, NAN, NAN}, {NAN, 1e300, -1e300}, {1, 1, 1}, {0.3, 0.3, 0.3}};
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    noise_rows();
+    for (int data = 0; data < 2; data++) {
+        fe_discover_acc a;
+        fe_discover_fit fit[5];
+        fe_discover_noise nz[5];
+        double coef[5][3], se[5][3];
+        fe_rng g = fe_rng_seed(31);
+        double e = 0;
+        ck_assert_int_eq(fe_discover_acc_init(&a, NM, NK, NFIT, 0, st, nst), FE_OK);
+        for (size_t t = 0; t < NN; t++) {
+            double r = nr[t];
+            if (data == 1) {        /* the columns of noise_rows, AR(1) 0.99 noise */
+                e = 0.99 * e + fe_rng_normal(&g);
+                (void)fe_rng_normal(&g);
+                r = 0.3 * nphi[t][1] - 0.2 * nphi[t][2] + 0.1 * e;
+            }
+            ck_assert_int_eq(fe_discover_add(&a, nphi[t], r), FE_OK);
+        }
+        memset(fit, 0, sizeof fit);
+        memset(nz, 0, sizeof nz);
+        for (int k = 0; k < 5; k++) {
+            memcpy(coef[k], fill[k], sizeof coef[k]);
+            memcpy(se[k], fill[(k + 1) % 5], sizeof se[k]);
+            ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 3, 4, coef[k], se[k], &fit[k],
+                                                   &nz[k], w, nw), FE_OK);
+        }
+        ck_assert_uint_gt(nz[0].order, 0);
+        for (int k = 1; k < 5; k++) {
+            for (int i = 0; i < 3; i++) {
+                ck_assert(isfinite(coef[0][i]) && isfinite(se[0][i]));
+                ck_assert_msg(memcmp(&coef[0][i], &coef[k][i], sizeof(double)) == 0,
+                              "data %d, fill %d, coef[%d]: %.17g and %.17g", data, k, i,
+                              coef[0][i], coef[k][i]);
+                ck_assert_msg(memcmp(&se[0][i], &se[k][i], sizeof(double)) == 0,
+                              "data %d, fill %d, se[%d]: %.17g and %.17g", data, k, i,
+                              se[0][i], se[k][i]);
+            }
+            ck_assert(memcmp(&fit[0], &fit[k], sizeof fit[0]) == 0);
+            ck_assert(memcmp(&nz[0], &nz[k], sizeof nz[0]) == 0);
+        }
+    }
+    free(st);
+    free(w);
+}
+END_TEST
+
 /* On the shortest records the engine takes (two rows a block, two
    blocks), every ranked candidate has a finite statistic and a p-value in
    [0, 1], and where the noise model's order leaves no degree of freedom
@@ -3089,6 +3155,66 @@ START_TEST(the_widest_accumulation_folds_and_fits)
 }
 END_TEST
 
+/* The noise fit at the widest accumulation: the model's columns 0 and
+   FE_DISCOVER_MAX_COLUMNS - 1 (the last, whose weight the Haar shares of
+   nz.scale_used write at index 63 of a vector of m + 1 = 65), over 400
+   rows (16 fine blocks: four Haar levels), give the fit of the same two
+   columns accumulated alone: coefficients, standard errors, RSS, the
+   noise model, and every level's share used and ratio. */
+START_TEST(the_widest_noise_fit_equals_the_narrow_one)
+{
+    enum { M = FE_DISCOVER_MAX_COLUMNS, K = 4, N = 400 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    double *st2 = malloc(fe_discover_acc_doubles(2, K) * sizeof *st2);
+    static double phi[N][M];
+    double r[N], two[2], e = 0;
+    const size_t cols[2] = {0, M - 1}, cols2[2] = {0, 1};
+    double coef[2], se[2], coef2[2], se2[2];
+    fe_discover_acc a, b;
+    fe_discover_fit fit, fit2;
+    fe_discover_noise nz, nz2;
+    fe_rng g = fe_rng_seed(79);
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_ptr_nonnull(st2);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, 2, K, N, 0, st2, fe_discover_acc_doubles(2, K)),
+                     FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        for (size_t c = 0; c < M; c++)
+            phi[t][c] = c == 0 ? 1.0 : fe_rng_normal(&g);
+        e = 0.6 * e + 0.1 * fe_rng_normal(&g);       /* AR(1) noise */
+        r[t] = 0.5 - 0.25 * phi[t][M - 1] + e;
+        two[0] = 1.0;
+        two[1] = phi[t][M - 1];
+        ck_assert_int_eq(fe_discover_add(&a, phi[t], r[t]), FE_OK);
+        ck_assert_int_eq(fe_discover_add(&b, two, r[t]), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_fit_noise(&a, cols, 2, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+    ck_assert_int_eq(fe_discover_fit_noise(&b, cols2, 2, 4, coef2, se2, &fit2, &nz2, w, nw),
+                     FE_OK);
+    ck_assert_uint_eq(nz.scales, 4);
+    ck_assert_uint_eq(nz2.scales, 4);
+    ck_assert_uint_eq(nz.order, nz2.order);
+    ck_assert_uint_gt(nz.order, 0);
+    for (int i = 0; i < 2; i++) {
+        FE_ASSERT_REL(coef[i], coef2[i], 1e-10);
+        FE_ASSERT_REL(se[i], se2[i], 1e-10);
+    }
+    FE_ASSERT_REL(fit.rss, fit2.rss, 1e-10);
+    FE_ASSERT_REL(nz.innovation_variance, nz2.innovation_variance, 1e-10);
+    for (size_t t = 0; t <= nz.scales; t++) {
+        ck_assert_double_eq_tol(nz.scale_used[t], nz2.scale_used[t], 1e-9 * (1 + nz2.scale_used[t]));
+        ck_assert_double_eq_tol(nz.scale_model[t], nz2.scale_model[t], 1e-9 * (1 + nz2.scale_model[t]));
+        FE_ASSERT_REL(nz.scale_ratio[t], nz2.scale_ratio[t], 1e-9);
+    }
+    free(st);
+    free(st2);
+    free(w);
+}
+END_TEST
+
 /* The documented refusals of the constructors and of fe_discover_add_row
    at their edges: fit_rows 2 per block (8 of 4 blocks) is enough and 7
    is not; base_cols == m is a full accumulation and m + 1 is refused; a
@@ -3472,6 +3598,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
     tcase_add_test(t, lagged_products_at_one_and_two_lags);
     tcase_add_test(t, scale_used_does_not_depend_on_the_order_of_the_columns);
+    tcase_add_test(t, fit_noise_does_not_read_its_outputs);
     tcase_add_test(t, p_values_are_probabilities_on_the_shortest_records);
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
@@ -3496,6 +3623,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, statistics_do_not_depend_on_the_residual_unit);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
+    tcase_add_test(t, the_widest_noise_fit_equals_the_narrow_one);
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
     tcase_add_test(t, documented_refusals_at_their_edges);
     tcase_add_test(t, a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break);

@@ -174,6 +174,52 @@ START_TEST(block_statistics_match_a_direct_computation)
 }
 END_TEST
 
+/* A window of two hit blocks reports the largest of their NIS
+   statistics, whichever block holds it.  Four blocks of two reports of one
+   degree of freedom each (dof 2 a block, where the chi-square upper tail
+   is exp(-x/2) exactly): NIS 1 + 1 in the first and last (p = e^-1, no
+   hit), 30 + 30 and 20 + 20 in the middle two, in either order (p =
+   e^-30 and e^-20, both below 0.05 / 8).  The window's z is the normal
+   quantile of e^-30, the root of erfc(z / sqrt 2) / 2 = e^-30 (to
+   fe_normal_quantile's documented 1.2e-9), its p-value e^-30,
+   its pooled NIS per degree of freedom (60 + 40) / 4 = 25. */
+START_TEST(a_window_reports_its_largest_nis_statistic)
+{
+    /* z30, the root of erfc(z / sqrt 2) / 2 = e^-30, by bisection on
+       libm's erfc (7.36; e^-20's is 5.88). */
+    double lo = 0, hi = 40, z30;
+    for (int i = 0; i < 200; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (0.5 * erfc(mid / sqrt(2.0)) > exp(-30.0))
+            lo = mid;
+        else
+            hi = mid;
+    }
+    z30 = 0.5 * (lo + hi);
+    ck_assert(z30 > 7.35 && z30 < 7.36);
+    for (int order = 0; order < 2; order++) {
+        const double per[4] = {1, order ? 20 : 30, order ? 30 : 20, 1};
+        fe_innovations inn;
+        fe_located out[2];
+        size_t n = 9;
+        ck_assert_int_eq(fe_innovations_init(&inn, 4, 8, 0), FE_OK);
+        for (int i = 0; i < 8; i++) {
+            fe_kalman_report r = {1, per[i / 2], 0, NULL, NULL, NULL};
+            ck_assert_int_eq(fe_innovations_add(&inn, i, &r), FE_OK);
+        }
+        ck_assert_int_eq(fe_innovations_locate(&inn, 0.05, out, 2, &n), FE_OK);
+        ck_assert_uint_eq(n, 1);
+        ck_assert_double_eq(out[0].t0, 2);
+        ck_assert_double_eq(out[0].t1, 5);
+        ck_assert_double_eq(out[0].n, 4);
+        ck_assert_str_eq(out[0].test, "nis");
+        FE_ASSERT_REL(out[0].p_value, exp(-30.0), 1e-9);
+        FE_ASSERT_REL(out[0].z, z30, 1.2e-9);   /* fe_normal_quantile's bound */
+        FE_ASSERT_REL(out[0].mean_nis, 25.0, 1e-12);
+    }
+}
+END_TEST
+
 START_TEST(blocks_without_pairs_have_no_autocorrelation_test)
 {
     /* A break before every report: no lag-one pair anywhere, so the
@@ -853,6 +899,34 @@ START_TEST(residual_map_locates_a_window_and_a_region)
             FE_ASSERT_REL(loc[0].ms_ratio_before, sq / 400.0 / med, 1e-12);
         }
     }
+    {
+        /* The window's statistics, the larger of its two blocks' (5 and
+           6), from the rows: each block's mean square ms_k and mean over
+           its 200 rows, the median of the twenty ms_k, and z_k = (ms_k /
+           med - 1) / sqrt(2 / 200), t_k = mean_k / sqrt(med / 200). */
+        fe_rng rng = fe_rng_seed(11);
+        double msk[20] = {0}, mean[20] = {0}, srt[20], med, z[2], t[2];
+        for (int i = 0; i < 4000; i++) {
+            double b = fe_rng_normal(&rng) + (i >= 1000 && i < 1400 ? 0.6 : 0.0);
+            msk[i / 200] += b * b / 200.0;
+            mean[i / 200] += b / 200.0;
+        }
+        memcpy(srt, msk, sizeof srt);
+        for (int i = 1; i < 20; i++)
+            for (int j = i; j > 0 && srt[j - 1] > srt[j]; j--) {
+                double x = srt[j];
+                srt[j] = srt[j - 1];
+                srt[j - 1] = x;
+            }
+        med = 0.5 * (srt[9] + srt[10]);
+        for (int k = 0; k < 2; k++) {
+            z[k] = (msk[5 + k] / med - 1.0) / sqrt(2.0 / 200.0);
+            t[k] = mean[5 + k] / sqrt(med / 200.0);
+        }
+        FE_ASSERT_REL(loc[0].z, z[0] > z[1] ? z[0] : z[1], 1e-10);
+        FE_ASSERT_REL(loc[0].t, fabs(t[0]) > fabs(t[1]) ? t[0] : t[1], 1e-10);
+        FE_ASSERT_REL(loc[0].p_value, erfc(fabs(loc[0].t) / sqrt(2.0)), 1e-12);
+    }
     /* Worth a twentieth of a row each (a strongly coloured noise), the same step
        is no longer out of line in time: t falls by sqrt(20), below 2.5. */
     ck_assert_int_eq(fe_residual_map_locate(&m, 0.05, 0.05, loc, 8, &n), FE_OK);
@@ -1345,6 +1419,7 @@ Suite *fe_locate_suite(void)
     TCase *t = tcase_create("locate");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, block_statistics_match_a_direct_computation);
+    tcase_add_test(t, a_window_reports_its_largest_nis_statistic);
     tcase_add_test(t, the_largest_statistic_after_the_terms_looks_at_the_regions);
     tcase_add_test(t, cells_of_two_rows_are_tested_and_of_one_not);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);

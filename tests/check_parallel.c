@@ -842,6 +842,64 @@ START_TEST(exact_prefix_after_refusal)
 }
 END_TEST
 
+/* The hash with a count of the merges that made it (its own and its
+   parts'). */
+typedef struct { hash_acc h; uint64_t merges; } counted_acc;
+
+static int counted_init(void *acc, void *ctx)
+{
+    counted_acc *a = acc;
+    a->merges = 0;
+    return hash_init(&a->h, ctx);
+}
+
+static int counted_step(void *acc, const void *obs, void *ctx)
+{
+    return hash_step(&((counted_acc *)acc)->h, obs, ctx);
+}
+
+static int counted_merge(void *acc, const void *other, void *ctx)
+{
+    counted_acc *a = acc;
+    const counted_acc *b = other;
+    a->merges += 1 + b->merges;
+    return hash_merge(&a->h, &b->h, ctx);
+}
+
+/* Empty chunks (fewer observations than threads) are neither started nor
+   merged (parallel.org, the driver): for n = 0 .. 9 observations on T = 2
+   .. 8 threads, the fold merges exactly the partials whose chunk
+   [floor(t n / T), floor((t + 1) n / T)), t >= 1, is not empty, and its
+   hash is the serial fold's to the bit. */
+START_TEST(empty_chunks_are_not_merged)
+{
+    fe_accumulator f = {"counted", sizeof(counted_acc), sizeof(uint64_t), counted_init,
+                        counted_step, NULL, counted_merge, NULL, NULL};
+    static const uint64_t z[9] = {5, 17, 2, 99, 0, 41, 7, 7, 1234567};
+    counted_acc parts[MAX_T];
+    void *pp[MAX_T];
+    for (int t = 0; t < MAX_T; t++)
+        pp[t] = &parts[t];
+    for (size_t n = 0; n <= 9; n++)
+        for (unsigned T = 2; T <= MAX_T; T++) {
+            counted_acc serial, par;
+            uint64_t want = 0;
+            size_t done = 99;
+            for (unsigned t = 1; t < T; t++)
+                want += (t + 1) * n / T > t * n / T;
+            counted_init(&serial, NULL);
+            counted_init(&par, NULL);
+            ck_assert_int_eq(fe_fold(&f, &serial, z, n, NULL), FE_OK);
+            ck_assert_int_eq(fe_parallel_fold(&f, &par, z, n, T, pp, &done), FE_OK);
+            ck_assert_uint_eq(done, n);
+            ck_assert_msg(par.merges == want, "n %zu, T %u: %llu merges, want %llu", n, T,
+                          (unsigned long long)par.merges, (unsigned long long)want);
+            ck_assert_uint_eq(serial.merges, 0);
+            ck_assert(memcmp(&par.h, &serial.h, sizeof par.h) == 0);
+        }
+}
+END_TEST
+
 START_TEST(merge_refusal_reports_the_chunk)
 {
     /* Two halves with means +1e300 and -1e300: each folds, their merge
@@ -1501,6 +1559,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, product_partial_refusal_is_rolled_back);
     tcase_add_test(t, first_refusal_has_the_lowest_index);
     tcase_add_test(t, exact_prefix_after_refusal);
+    tcase_add_test(t, empty_chunks_are_not_merged);
     tcase_add_test(t, merge_refusal_reports_the_chunk);
     tcase_add_test(t, partial_init_refusal_reports_the_chunk);
     tcase_add_test(t, bad_arguments_fold_nothing);
