@@ -355,10 +355,11 @@ int fe_catalog_explain(const char *name, double coef, double se, char *buf,
     else if (strcmp(name, "quadratic_drag") == 0) {
         int n = snprintf(buf, len, "quadratic drag: a = -k v|v| with k = %.4g +/- %.2g (1/length)",
                          -coef, se);
-        if (-coef > 0 && n > 0 && (size_t)n < len)
+        double vt = -coef > 0 ? sqrt(9.80665 / -coef) : 0.0;
+        /* No terminal speed for k <= 0, nor where g / k overflows. */
+        if (-coef > 0 && isfinite(vt) && n > 0 && (size_t)n < len)
             snprintf(buf + n, len - (size_t)n,
-                     "; terminal speed sqrt(g/k) = %.3g m/s for an acceleration in m/s^2",
-                     sqrt(9.80665 / -coef));
+                     "; terminal speed sqrt(g/k) = %.3g m/s for an acceleration in m/s^2", vt);
     } else if (strcmp(name, "coulomb_friction") == 0)
         snprintf(buf, len, "dry friction: a = -mu sign(v) with mu = %.4g +/- %.2g (channel units)",
                  -coef, se);

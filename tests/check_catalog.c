@@ -302,6 +302,8 @@ START_TEST(quadratic_drag_in_words_at_its_edges)
 {
     const struct { double coef; int terminal; } w[] = {
         {0.0, 0}, {-0.0, 0}, {DBL_TRUE_MIN, 0}, {0.02, 0}, {-8, 1}, {-0.02, 1},
+        /* g / k overflows below k = 9.80665 / DBL_MAX: no speed of inf m/s */
+        {-DBL_TRUE_MIN, 0}, {-1e-308, 0}, {-1e-307, 1},
     };
     char buf[256];
     for (size_t i = 0; i < sizeof w / sizeof w[0]; i++) {
