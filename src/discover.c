@@ -177,13 +177,17 @@ static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
 }
 
 /* Fold q rows of block k given by columns (value c of row t at
-   col[c][t * ts]): the block's sums, and the lagged products. */
+   col[c][t * ts]): the block's sums (the columns' sums given in `sums`,
+   or NULL), and the lagged products. */
 static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
-                                   size_t ts, size_t q, size_t k)
+                                   size_t ts, size_t q, size_t k, const double *sums)
 {
     double z[FE_DISCOVER_MAX_COLUMNS + 1];
     int fitted = k < a->blocks;
-    if (fitted && ts == 1) {            /* columns: in lanes */
+    if (fitted && sums != NULL) {
+        for (size_t c = 0; c <= a->m; c++)
+            a->bsum[k * (a->m + 1) + c] += sums[c];
+    } else if (fitted && ts == 1) {     /* columns: in lanes */
         double s[FE_DISCOVER_MAX_COLUMNS + 1];
         fe__discover_sums(col, a->m + 1, q, s);
         for (size_t c = 0; c <= a->m; c++)
@@ -641,7 +645,7 @@ static void fe__discover_panel(fe_discover_acc *a, size_t k, size_t q)
 
     for (size_t j = 0; j < dim; j++)
         rows[j] = z + j;
-    fe__discover_lags_rows(a, rows, dim, q, k);
+    fe__discover_lags_rows(a, rows, dim, q, k, NULL);
     /* X = Z^T Z, into the block. */
     cblas_dsyrk(CblasRowMajor, CblasUpper, CblasTrans, (int)dim, (int)q, 1.0, z,
                 (int)dim, 0.0, x, (int)dim);
@@ -764,13 +768,16 @@ static void FE__DISCOVER_SUMS_FN(const double *const *z, size_t n, size_t q, dou
 }
 
 /* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
-   for d < 3 and j + d < n, four columns j at a time. */
+   for d < 3 and j + d < n, and sums[j] = sum_t z[j][t], four columns j at
+   a time (the sums ride on the loads the products make, on the adders,
+   which the multiply-adds leave idle). */
 FE__DISCOVER_TARGET
-static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out)
+static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out,
+                                 double *sums)
 {
     for (size_t j = 0; j < n; j += 4) {
         const double *p[6];
-        double s[12][FE__L] = {{0}}, v[12];
+        double s[12][FE__L] = {{0}}, v[12], c1[4][FE__L] = {{0}};
         size_t t;
         for (int c = 0; c < 6; c++)
             p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
@@ -778,6 +785,10 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
             for (int l = 0; l < FE__L; l++) {
                 double u0 = p[0][t + l], u1 = p[1][t + l], u2 = p[2][t + l],
                        u3 = p[3][t + l], u4 = p[4][t + l], u5 = p[5][t + l];
+                c1[0][l] += u0;
+                c1[1][l] += u1;
+                c1[2][l] += u2;
+                c1[3][l] += u3;
                 s[0][l] += u0 * u0;
                 s[1][l] += u0 * u1;
                 s[2][l] += u0 * u2;
@@ -802,6 +813,14 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
         for (size_t a = 0; a < 4 && j + a < n; a++)
             for (size_t d = 0; d < 3 && j + a + d < n; d++)
                 out[3 * (j + a) + d] += v[3 * a + d];
+        for (size_t a = 0; a < 4 && j + a < n; a++) {
+            double w = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                w += c1[a][l];
+            for (size_t u = t; u < q; u++)
+                w += p[a][u];
+            sums[j + a] = w;
+        }
     }
 }
 #undef FE__DISCOVER_TARGET
@@ -886,13 +905,16 @@ static void FE__DISCOVER_SUMS_FN(const double *const *z, size_t n, size_t q, dou
 }
 
 /* For the n columns z[0 .. n-1]: out[3 j + d] += sum_t z[j][t] z[j+d][t]
-   for d < 3 and j + d < n, four columns j at a time. */
+   for d < 3 and j + d < n, and sums[j] = sum_t z[j][t], four columns j at
+   a time (the sums ride on the loads the products make, on the adders,
+   which the multiply-adds leave idle). */
 FE__DISCOVER_TARGET
-static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out)
+static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, double *out,
+                                 double *sums)
 {
     for (size_t j = 0; j < n; j += 4) {
         const double *p[6];
-        double s[12][FE__L] = {{0}}, v[12];
+        double s[12][FE__L] = {{0}}, v[12], c1[4][FE__L] = {{0}};
         size_t t;
         for (int c = 0; c < 6; c++)
             p[c] = z[j + (size_t)c < n ? j + (size_t)c : j];
@@ -900,6 +922,10 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
             for (int l = 0; l < FE__L; l++) {
                 double u0 = p[0][t + l], u1 = p[1][t + l], u2 = p[2][t + l],
                        u3 = p[3][t + l], u4 = p[4][t + l], u5 = p[5][t + l];
+                c1[0][l] += u0;
+                c1[1][l] += u1;
+                c1[2][l] += u2;
+                c1[3][l] += u3;
                 s[0][l] += u0 * u0;
                 s[1][l] += u0 * u1;
                 s[2][l] += u0 * u2;
@@ -924,6 +950,14 @@ static void FE__DISCOVER_BAND_FN(const double *const *z, size_t n, size_t q, dou
         for (size_t a = 0; a < 4 && j + a < n; a++)
             for (size_t d = 0; d < 3 && j + a + d < n; d++)
                 out[3 * (j + a) + d] += v[3 * a + d];
+        for (size_t a = 0; a < 4 && j + a < n; a++) {
+            double w = 0.0;
+            for (int l = 0; l < FE__L; l++)
+                w += c1[a][l];
+            for (size_t u = t; u < q; u++)
+                w += p[a][u];
+            sums[j + a] = w;
+        }
     }
 }
 #undef FE__DISCOVER_TARGET
@@ -945,15 +979,16 @@ static void fe__discover_dots(const double *const *x, const double *const *y, si
     fe__discover_dots4(x, y, q, out);
 }
 
-static void fe__discover_band(const double *const *z, size_t n, size_t q, double *out)
+static void fe__discover_band(const double *const *z, size_t n, size_t q, double *out,
+                              double *sums)
 {
 #if defined(FE__LANES_X86)
     if (FE__LANES_HAVE_WIDE()) {
-        fe__discover_band8(z, n, q, out);
+        fe__discover_band8(z, n, q, out, sums);
         return;
     }
 #endif
-    fe__discover_band4(z, n, q, out);
+    fe__discover_band4(z, n, q, out, sums);
 }
 
 static void fe__discover_sums(const double *const *z, size_t n, size_t q, double *out)
@@ -1007,6 +1042,7 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
     size_t dim = a->m + 1, m = a->m, nb = a->base_cols, nr = nb + 1;
     size_t idx[FE_DISCOVER_MAX_COLUMNS + 1], whole[FE_DISCOVER_MAX_COLUMNS + 1] = {0};
     double band[3 * FE_DISCOVER_MAX_COLUMNS], *out = a->work;  /* nr x dim <= dim x dim */
+    double sums[FE_DISCOVER_MAX_COLUMNS + 1];   /* the columns' sums, with the band */
     double *g = a->gram + k * dim * dim;
     int fitted = k < a->blocks, linked = fitted && a->have_prev;
 
@@ -1019,8 +1055,15 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
        with the base columns are theirs). */
     fe__discover_cross(col, whole, nr, 0, idx, dim, q, out);
     if (nb < m) {
+        const double *wc[FE_DISCOVER_MAX_COLUMNS + 1];
+        double ws[FE_DISCOVER_MAX_COLUMNS + 1];
         memset(band, 0, 3 * (m - nb) * sizeof *band);
-        fe__discover_band(col + nb, m - nb, q, band);
+        fe__discover_band(col + nb, m - nb, q, band, sums + nb);
+        for (size_t u = 0; u < nr; u++)
+            wc[u] = col[whole[u]];
+        fe__discover_sums(wc, nr, q, ws);
+        for (size_t u = 0; u < nr; u++)
+            sums[whole[u]] = ws[u];
     }
     /* The guard, read off the sums: see the text. */
     for (size_t u = 0; u < nr; u++)
@@ -1043,7 +1086,7 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
         for (size_t d = 0; d < 3 && j + d < m; d++)
             g[j * dim + j + d] += band[3 * (j - nb) + d];
     a->counts[k] += (double)q;
-    fe__discover_lags_rows(a, col, 1, q, k);
+    fe__discover_lags_rows(a, col, 1, q, k, nb < m ? sums : NULL);
     if (a->n == 0)
         for (size_t c = 0; c < dim; c++)
             a->first[c] = col[c][0];

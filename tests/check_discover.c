@@ -729,6 +729,14 @@ static void assert_screen_sums(const fe_discover_acc *got, const fe_discover_acc
                               <= 1e-12 * scale,
                           "T[%zu][%zu] = %.17g", i, j, got->lag[i * dim + j]);
         }
+    /* Each fitted block's sum of every column (batch means read them; by
+       columns a screen sums the candidates beside their band). */
+    for (size_t k = 0; k < K; k++)
+        for (size_t i = 0; i < dim; i++)
+            ck_assert_msg(fabs(got->bsum[k * dim + i] - full->bsum[k * dim + i])
+                              <= 1e-12 * sqrt(diag[i] * (double)got->n),
+                          "block %zu sum %zu = %.17g, want %.17g", k, i, got->bsum[k * dim + i],
+                          full->bsum[k * dim + i]);
 }
 
 START_TEST(screen_keeps_what_ranking_reads)
