@@ -178,7 +178,8 @@ static void fe__discover_fine_rows(fe_discover_acc *a, const double *const *col,
 
 /* Fold q rows of block k given by columns (value c of row t at
    col[c][t * ts]): the block's sums (the columns' sums given in `sums`,
-   or NULL), and the lagged products. */
+   as the column path makes them in lanes; NULL: summed here), and the
+   lagged products. */
 static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
                                    size_t ts, size_t q, size_t k, const double *sums)
 {
@@ -187,11 +188,6 @@ static void fe__discover_lags_rows(fe_discover_acc *a, const double *const *col,
     if (fitted && sums != NULL) {
         for (size_t c = 0; c <= a->m; c++)
             a->bsum[k * (a->m + 1) + c] += sums[c];
-    } else if (fitted && ts == 1) {     /* columns: in lanes */
-        double s[FE_DISCOVER_MAX_COLUMNS + 1];
-        fe__discover_sums(col, a->m + 1, q, s);
-        for (size_t c = 0; c <= a->m; c++)
-            a->bsum[k * (a->m + 1) + c] += s[c];
     } else {
         for (size_t c = 0; c <= a->m && fitted; c++) {
             double s = 0.0;
@@ -1064,6 +1060,8 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
         fe__discover_sums(wc, nr, q, ws);
         for (size_t u = 0; u < nr; u++)
             sums[whole[u]] = ws[u];
+    } else {
+        fe__discover_sums(col, dim, q, sums);
     }
     /* The guard, read off the sums: see the text. */
     for (size_t u = 0; u < nr; u++)
@@ -1086,7 +1084,7 @@ static int fe__discover_column_panel(fe_discover_acc *a, size_t k,
         for (size_t d = 0; d < 3 && j + d < m; d++)
             g[j * dim + j + d] += band[3 * (j - nb) + d];
     a->counts[k] += (double)q;
-    fe__discover_lags_rows(a, col, 1, q, k, nb < m ? sums : NULL);
+    fe__discover_lags_rows(a, col, 1, q, k, sums);
     if (a->n == 0)
         for (size_t c = 0; c < dim; c++)
             a->first[c] = col[c][0];

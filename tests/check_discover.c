@@ -1192,6 +1192,19 @@ START_TEST(selection_refuses_empty_blocks_and_collinear_base)
 }
 END_TEST
 
+/* The ranking of a first step with one candidate, group `group`, found
+   redundant: not tested, p-value 1 and no drop. */
+static const fe_discover_rank *assert_only_redundant(const fe_discover_result *r, size_t group)
+{
+    const fe_discover_rank *k = &r->ranking[0][0];
+    ck_assert_uint_eq(r->nranked[0], 1);
+    ck_assert_uint_eq(k->group, group);
+    ck_assert_int_eq(k->redundant, 1);
+    ck_assert_double_eq(k->p_value, 1.0);
+    ck_assert_double_eq(k->rss_drop, 0.0);
+    return k;
+}
+
 /* A candidate the model already spans is not tested: column 2 is twice
    column 1 (exactly: doubling rounds nothing), the base is columns 0 and
    1, and its ranking entry says redundant, with p-value 1 and a
@@ -1221,13 +1234,8 @@ START_TEST(a_candidate_the_model_spans_is_redundant_with_p_value_one)
             ck_assert_int_eq(fe_discover_add(&a, phi, 0.5 * x + fe_rng_normal(&rng)), FE_OK);
         }
         ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_OK);
-        ck_assert_uint_eq(r->nranked[0], 1);
-        k = &r->ranking[0][0];
-        ck_assert_uint_eq(k->group, 2);
-        ck_assert_int_eq(k->redundant, 1);
-        ck_assert_double_eq(k->p_value, 1.0);
+        k = assert_only_redundant(r, 2);
         ck_assert_double_eq(k->statistic, 0.0);
-        ck_assert_double_eq(k->rss_drop, 0.0);
         ck_assert_double_eq(k->delta_bic, 0.0);
     }
     free(st);
@@ -1373,7 +1381,6 @@ START_TEST(redundancy_at_a_tie_with_its_threshold)
     fe_discover_options o = fe_discover_default_options();
     fe_discover_result *res = malloc(sizeof *res);
     fe_discover_acc a;
-    const fe_discover_rank *k;
     /* X^2 in units of 2^-1074 is q + 3/4 to 2^-25 (X 2^537 is exact, its
        square has 25 bits after the point): between 5/8 and 7/8. */
     ck_assert_double_gt(Xs * Xs - q, 0.625);
@@ -1388,12 +1395,7 @@ START_TEST(redundancy_at_a_tie_with_its_threshold)
         ck_assert_int_eq(fe_discover_add(&a, phi, r[i]), FE_OK);
     }
     ck_assert_int_eq(fe_discover_select(&a, g, 2, &o, res, w, nw), FE_OK);
-    ck_assert_uint_eq(res->nranked[0], 1);
-    k = &res->ranking[0][0];
-    ck_assert_uint_eq(k->group, 1);
-    ck_assert_int_eq(k->redundant, 1);
-    ck_assert_double_eq(k->p_value, 1.0);
-    ck_assert_double_eq(k->rss_drop, 0.0);
+    assert_only_redundant(res, 1);
     free(st);
     free(w);
     free(res);
