@@ -2627,7 +2627,10 @@ static void lr_check(uint64_t seed, double wave, int shows, double *slope, doubl
             if (total > 1.0)
                 lam[t] /= total;
             F += lam[t] * (lnv[t] > 0.0 ? exp(lnv[t]) : 1.0);
-            gd[t] = lnv[t] > 0.0 ? lam[t] * exp(lnv[t]) : 0.0;
+            /* Floored: no uncertainty where the residual's own level
+               shows (a weight), that of V = 1 where the line only
+               extrapolates (no weight; always the scaling coefficient). */
+            gd[t] = lnv[t] > 0.0 ? lam[t] * exp(lnv[t]) : t < J && wt[t] > 0.0 ? 0.0 : lam[t];
         }
         if (total > 1.0)
             total = 1.0;
