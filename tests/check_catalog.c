@@ -89,6 +89,43 @@ START_TEST(user_terms_and_a_full_catalog)
 }
 END_TEST
 
+/* A built-in term's name stays reserved after the term is removed from
+   the catalog: an expression term may not take it (catalog.h: "a name
+   already present or of a built-in term"), whichever built-in it is, the
+   table's first ("bias") and last too.  The names are the documented
+   thirteen, written out here, not read from the table. */
+START_TEST(a_removed_builtin_keeps_its_name)
+{
+    static const char *const names[] = {
+        "bias", "drift", "gain", "delay", "viscous_friction", "quadratic_drag",
+        "coulomb_friction", "linear_stiffness", "cubic_stiffness", "thermal_sensitivity",
+        "newton_cooling", "radiative_cooling", "input_gain"};
+    const size_t nn = sizeof names / sizeof names[0];
+    const unsigned all = FE_ROLE_POSITION | FE_ROLE_VELOCITY | FE_ROLE_TEMPERATURE
+                         | FE_ROLE_AMBIENT | FE_ROLE_INPUT;
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_expr e;
+    size_t nv, col = 0;
+    const char *const *vn = fe_catalog_var_names(&nv);
+    ck_assert_int_eq(fe_expr_compile(&e, "2*t", vn, nv, &col, NULL, 0), FE_OK);
+    scale.vmax = 1.0;
+    for (size_t i = 0; i < nn; i++) {
+        ck_assert_int_eq(fe_catalog_init(&c, all, &scale), FE_OK);
+        ck_assert_uint_eq(c.count, nn);
+        ck_assert_int_eq(fe_catalog_remove(&c, names[i]), FE_OK);
+        ck_assert_int_eq(fe_catalog_find(&c, names[i]), -1);
+        ck_assert_msg(fe_catalog_add_expr(&c, names[i], "mine", &e) == FE_EINVAL,
+                      "%s taken by an expression term", names[i]);
+        ck_assert_uint_eq(c.count, nn - 1);
+        ck_assert_int_eq(fe_catalog_find(&c, names[i]), -1);
+        /* A name of no built-in is taken, in the place the other left. */
+        ck_assert_int_eq(fe_catalog_add_expr(&c, "mine", NULL, &e), FE_OK);
+        ck_assert_int_eq(fe_catalog_find(&c, "mine"), (long)nn - 1);
+    }
+}
+END_TEST
+
 /* A term given by expression is a term like the others: it evaluates to
    its formula, from a sample or from a row with the caller's own columns,
    a panel equals its rows, and its refusals leave the catalog as it was. */
@@ -548,6 +585,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, every_builtin_term_is_its_formula);
     tcase_add_test(t, user_terms_and_a_full_catalog);
     tcase_add_test(t, expression_terms_through_the_catalog);
+    tcase_add_test(t, a_removed_builtin_keeps_its_name);
     tcase_add_test(t, probes_are_bins_of_a_state_variable);
     tcase_add_test(t, every_coefficient_in_words);
     tcase_add_test(t, quadratic_drag_in_words_at_its_edges);

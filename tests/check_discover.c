@@ -1164,14 +1164,17 @@ START_TEST(selection_refuses_empty_blocks_and_collinear_base)
         fe_discover_add(&a, phi, fe_rng_normal(&rng));
     }
     ck_assert_int_eq(fe_discover_select(&a, g, 3, &o, r, w, nw), FE_ETOOFEW);
-    /* Each group checked, not only the first: no columns, too many, past
-       the last column, each alone in the second or third place. */
+    /* Each group checked, the first as the others: no columns, too many,
+       past the last column, each alone in the first, second or third
+       place. */
     {
         fe_discover_group bad[3];
         /* {group, first, count}: the others as they are. */
-        const size_t fix[5][3] = {{1, 1, 0}, {1, 0, FE_DISCOVER_MAX_GROUP_SIZE + 1},
-                                  {2, 2, 2}, {2, 3, 1}, {2, 1, 3}};
-        for (int c = 0; c < 5; c++) {
+        const size_t fix[9][3] = {{1, 1, 0}, {1, 0, FE_DISCOVER_MAX_GROUP_SIZE + 1},
+                                  {2, 2, 2}, {2, 3, 1}, {2, 1, 3},
+                                  {0, 0, 0}, {0, 0, FE_DISCOVER_MAX_GROUP_SIZE + 1},
+                                  {0, 3, 1}, {0, 1, 3}};
+        for (int c = 0; c < 9; c++) {
             memcpy(bad, g, sizeof bad);
             bad[fix[c][0]].first = fix[c][1];
             bad[fix[c][0]].count = fix[c][2];
