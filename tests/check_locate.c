@@ -1138,6 +1138,34 @@ START_TEST(residual_map_refusals_at_their_edges)
     ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_ENONFINITE);
     ck_assert_int_eq(fe_residual_map_add(NULL, &s, 1.0, 0.5), FE_EINVAL);
     ck_assert_mem_eq(&m, &keep, sizeof m);
+    /* A sum past the largest double in a cell other than the time block:
+       the temperature bin's sum of temperatures, 1.6e308 twice, while the
+       block's sums (of times and residuals) stay small.  Every cell the
+       row would enter is checked, not only the first. */
+    lo[2] = 1e308;
+    hi[2] = 1.7e308;
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_TEMPERATURE, lo, hi), FE_OK);
+    s.t = 0.0;
+    s.temperature = 1.6e308;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_OK);
+    memcpy(&keep, &m, sizeof m);
+    s.t = 1.0;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_ENONFINITE);
+    ck_assert_mem_eq(&m, &keep, sizeof m);
+    /* And in the time block alone: two rows of one block, in different
+       temperature bins and regions, whose residuals' squares (1.21e308
+       each) add up past the largest double only in the block. */
+    lo[2] = 0;
+    hi[2] = 10.0;
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_TEMPERATURE, lo, hi), FE_OK);
+    s.t = 0.0;
+    s.temperature = 1.0;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.1e154, 0.5), FE_OK);
+    memcpy(&keep, &m, sizeof m);
+    s.t = 1.0;
+    s.temperature = 9.0;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.1e154, 0.5), FE_ENONFINITE);
+    ck_assert_mem_eq(&m, &keep, sizeof m);
     ck_assert_double_eq(fe_residual_map_largest_after(NULL, 1.0), 0.0);
     ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, 0, lo, hi), FE_OK);
     ck_assert_double_eq(fe_residual_map_largest_after(&m, 1.0), 0.0);   /* empty */

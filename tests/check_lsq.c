@@ -455,6 +455,32 @@ START_TEST(sparse_rows_are_refused_like_dense_rows)
                                 : fe_lsq_add(&a, zero, 0.0, DBL_MAX / 8), FE_ENONFINITE);
         ck_assert_mem_eq(&a, &before, sizeof a);
     }
+    /* A diagonal sum at the edge: rows (1, 0) and then rows (0, 0) with
+       residual 1, each of weight DBL_MAX / 8, put w v^2 = DBL_MAX / 8 on
+       one diagonal entry (a parameter's, then the residual's); two reach
+       DBL_MAX / 4 exactly and are taken, a third goes past it.  The total
+       weight stays at its own edge or under it, so the diagonal's test is
+       the one that decides. */
+    for (int sparse = 0; sparse < 2; sparse++)
+        for (int on = 0; on < 2; on++) {
+            const double one0[2] = {1.0, 0.0};
+            const double *v = on == 0 ? one0 : zero;
+            const double res = on == 0 ? 0.0 : 1.0;
+            const size_t k = on == 0 ? 0 : 2;        /* g[k * 3 + k] */
+            fe_lsq_init(&a, 2, g);
+            for (int row = 0; row < 2; row++)
+                ck_assert_int_eq(sparse ? fe_lsq_add_sparse(&a, idx, v, 2, res, DBL_MAX / 8)
+                                        : fe_lsq_add(&a, v, res, DBL_MAX / 8), FE_OK);
+            ck_assert_double_eq(g[k * 3 + k], DBL_MAX / 4);
+            before = a;
+            memcpy(gbefore, g, sizeof g);
+            a.wsum = 0.0;                   /* only the diagonal at its edge */
+            before.wsum = 0.0;
+            ck_assert_int_eq(sparse ? fe_lsq_add_sparse(&a, idx, v, 2, res, DBL_MAX / 8)
+                                    : fe_lsq_add(&a, v, res, DBL_MAX / 8), FE_ENONFINITE);
+            ck_assert_mem_eq(&a, &before, sizeof a);
+            ck_assert_mem_eq(g, gbefore, sizeof g);
+        }
 }
 END_TEST
 
