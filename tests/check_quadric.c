@@ -455,6 +455,43 @@ START_TEST(block_coverage_of_a_hemisphere_inside_the_box)
 }
 END_TEST
 
+/* The coverage's threshold, at its edge: a region counts when it was
+   visited while the box's largest half-width was at least half its final
+   one, equality included (seed 9909's quadric:1905, >= made >).  Each
+   sample's region is taken from the box's centre after it, the sizes
+   worked by hand and exact in float. */
+START_TEST(coverage_counts_a_region_seen_at_exactly_half_the_size)
+{
+    const double s[5][3] = {{-1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0, -3}, {0, 0, -7}};
+    const double px[3] = {1, 0, 0}, pz[3] = {0, 0, 1}, mz[3] = {0, 0, -1};
+    fe_quadric q = FE_QUADRIC_EMPTY, p = FE_QUADRIC_EMPTY;
+    /* Three different regions: +x, +z and -z. */
+    ck_assert_int_ne(fe_quadric_region(px), fe_quadric_region(pz));
+    ck_assert_int_ne(fe_quadric_region(px), fe_quadric_region(mz));
+    ck_assert_int_ne(fe_quadric_region(pz), fe_quadric_region(mz));
+    /* One sample, or the same one twice: a box of no extent, no direction,
+       no region visited. */
+    ck_assert_int_eq(fe_quadric_add(&p, s[1]), FE_OK);
+    ck_assert_int_eq(fe_quadric_regions(&p), 0);
+    ck_assert_int_eq(fe_quadric_add(&p, s[1]), FE_OK);
+    ck_assert_int_eq(fe_quadric_regions(&p), 0);
+    /* (-1, 0, 0): no extent.  (1, 0, 0): half-width 1, centre 0, +x seen
+       at 1.  (0, 0, 1): z in [0, 1], still 1, centre (0, 0, 0.5), +z seen
+       at 1. */
+    for (int i = 0; i < 3; i++)
+        ck_assert_int_eq(fe_quadric_add(&q, s[i]), FE_OK);
+    ck_assert_int_eq(fe_quadric_regions(&q), 2);
+    /* (0, 0, -3): z in [-3, 1], half-width 2, centre (0, 0, -1), -z seen
+       at 2.  Half the final size is 1: +x and +z count, at exactly 1. */
+    ck_assert_int_eq(fe_quadric_add(&q, s[3]), FE_OK);
+    ck_assert_int_eq(fe_quadric_regions(&q), 3);
+    /* (0, 0, -7): z in [-7, 1], half-width 4, -z seen at 4; half of it is
+       2, and the regions seen at 1 no longer count. */
+    ck_assert_int_eq(fe_quadric_add(&q, s[4]), FE_OK);
+    ck_assert_int_eq(fe_quadric_regions(&q), 1);
+}
+END_TEST
+
 START_TEST(compare_a_box_of_one_point_absolutely)
 {
     /* One sample: the box has no extent, every moment's scale N s^d is
@@ -923,6 +960,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, coverage_ignores_an_initial_rest_and_sees_a_hemisphere);
     tcase_add_test(t, block_extremes_in_the_tail_of_a_block);
     tcase_add_test(t, block_coverage_of_a_hemisphere_inside_the_box);
+    tcase_add_test(t, coverage_counts_a_region_seen_at_exactly_half_the_size);
     tcase_add_test(t, compare_a_box_of_one_point_absolutely);
     tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);
