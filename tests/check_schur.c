@@ -245,6 +245,26 @@ START_TEST(shapes_and_degenerate_dimensions)
     ck_assert_int_eq(fe_schur_merge(&a, &b), FE_EMISMATCH);
     ck_assert_int_eq(fe_schur_copy(&a, &b), FE_EMISMATCH);
     ck_assert_int_eq(fe_schur_merge(&a, &a), FE_EINVAL);
+    /* The same global count, so that the global sums alone would merge:
+       another local count, or another number of blocks, is another shape
+       too, refused with a left as it was. */
+    {
+        static const size_t other[2][3] = {{1, 3, 2}, {1, 2, 3}};
+        const double jg = 1.0;
+        double s1before[256];
+        for (int c = 0; c < 2; c++) {
+            fe_schur_init(&a, 1, 2, 2, s1);
+            ck_assert_int_eq(fe_schur_add(&a, &jg, 0, jl, 1.0, 1.0), FE_OK);
+            fe_schur_init(&b, other[c][0], other[c][1], other[c][2], s2);
+            ck_assert_int_eq(fe_schur_add(&b, &jg, 1, jl2, 2.0, 1.0), FE_OK);
+            memcpy(s1before, s1, sizeof s1);
+            ck_assert_int_eq(fe_schur_merge(&a, &b), FE_EMISMATCH);
+            ck_assert_int_eq(fe_schur_copy(&a, &b), FE_EMISMATCH);
+            ck_assert_mem_eq(s1, s1before, sizeof s1);
+            ck_assert_uint_eq(a.nl, 2);
+            ck_assert_uint_eq(a.nb, 2);
+        }
+    }
     /* No global parameters: independent blocks, each solved alone. */
     fe_schur_init(&a, 0, 2, 2, s1);
     ck_assert_int_eq(fe_schur_add(&a, NULL, 0, jl, 1.0, 1.0), FE_OK);
