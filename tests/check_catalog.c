@@ -193,8 +193,16 @@ START_TEST(expression_terms_through_the_catalog)
     ck_assert(one[7] == s[2].velocity * fabs(s[2].velocity));
     /* Rows too short for an expression, phi too narrow: refused. */
     ck_assert_int_eq(fe_catalog_add_expr(&c, "load", NULL, &load), FE_OK);
+    for (size_t i = 0; i < N * 16; i++)
+        phi[i] = 12345.0;
     ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, N, phi, 16, work, NULL),
                      FE_EINVAL);
+    /* Refused before anything is written: not even the expression terms
+       ahead of "load" (seed 9915's catalog:254, the check of what each
+       expression reads left to fe_expr_eval_rows, which refuses "load"
+       only after the terms before it are in phi). */
+    for (size_t i = 0; i < N * 16; i++)
+        ck_assert_msg(phi[i] == 12345.0, "phi[%zu] = %g written", i, phi[i]);
     ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 3, work, NULL), FE_EINVAL);
     ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, LDV, N, phi, 16, NULL, NULL), FE_EINVAL);
     /* A term not finite on row 4 (log of a negative position): that row

@@ -518,6 +518,16 @@ static int keep_all_rows(const fe_lm_iteration *it, void *ctx)
     return 0;
 }
 
+/* f = x - 2, whose gradient is 1 at the start x = 100 and NaN anywhere
+   else: the cost can be had at every point, the Jacobian only at the
+   start. */
+static int gradient_only_at_the_start(const double *x, fe_lm_sink *s, void *ctx)
+{
+    double j = x[0] == 100.0 ? 1.0 : NAN;
+    (void)ctx;
+    return fe_lm_emit(s, x[0] - 2.0, 1.0, &j, FE_SCHUR_NONE, NULL);
+}
+
 START_TEST(model_failures_are_handled)
 {
     fe_lm_problem p = {1, 0, 0, sqrt_model, NULL};
@@ -544,6 +554,15 @@ START_TEST(model_failures_are_handled)
     x[0] = -1.0;
     ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_ENONFINITE);
     ck_assert_double_eq(x[0], -1.0);
+    /* A model that fails at a step already taken, when the solver asks
+       it for the Jacobian there (seed 9915's lm:600): the first step, from
+       100 with lambda 1e-9 to about 2, lowers the cost when only the cost
+       is wanted, is taken, and the Jacobian at the new point is NaN.  The
+       model's error stops the solver and is returned (lm.h). */
+    p.model = gradient_only_at_the_start;
+    x[0] = 100.0;
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r), FE_ENONFINITE);
+    ck_assert_double_ne(x[0], 100.0);
     /* No residuals; a bad block index even if the model ignores it. */
     p.model = silent_model;
     ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, x, w, NULL, NULL, &r), FE_ETOOFEW);

@@ -4,6 +4,7 @@
    trace, and the real recordings of ../shared/data. */
 #define _POSIX_C_SOURCE 200809L
 #include <fcntl.h>
+#include <float.h>
 #include <stdint.h>
 #include <unistd.h>
 
@@ -136,6 +137,52 @@ START_TEST(three_algorithms_agree)
                 ck_assert_double_eq(streaming.matrix_se[i], 0.0);
             }
         }
+    }
+}
+END_TEST
+
+/* A spread so small that sigma^4 is not a normal double is refused as
+   degenerate (seed 9915's sphere:870): fourteen points on a sphere of
+   radius r = 2^-260 about the origin, the six axis points and the eight
+   cube corners (+-1, +-1, +-1) r / sqrt(3).  The box is [-r, r] on every
+   axis, so sigma = r, sigma^4 = 2^-1040 is below DBL_MIN = 2^-1022,
+   while sigma^3 = 2^-780 is not. */
+START_TEST(a_spread_whose_fourth_power_is_not_normal_is_degenerate)
+{
+    double x[3 * 14], r = ldexp(1.0, -260), c = r / sqrt(3.0);
+    size_t n = 0;
+    for (int j = 0; j < 3; j++)
+        for (int s = -1; s <= 1; s += 2) {
+            x[3 * n] = x[3 * n + 1] = x[3 * n + 2] = 0.0;
+            x[3 * n + j] = s * r;
+            n++;
+        }
+    for (int k = 0; k < 8; k++, n++)
+        for (int j = 0; j < 3; j++)
+            x[3 * n + j] = (k >> j & 1) ? c : -c;
+    ck_assert_uint_eq(n, 14);
+    ck_assert_double_lt(pow(r, 4), DBL_MIN);
+    ck_assert_double_ge(pow(r, 3), DBL_MIN);
+    for (int model = 0; model < 3; model++) {
+        fe_quadric q = FE_QUADRIC_EMPTY;
+        fe_sphere_fit f;
+        ck_assert_int_eq(fe_quadric_add_many(&q, x, n, NULL), FE_OK);
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, NULL, &f),
+                         FE_EUNDETERMINED);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_DEGENERATE);
+    }
+    /* The same points at r = 2^-250, where sigma^4 = 2^-1000 is normal
+       (sigma^5 = 2^-1250 would not be, seed 9915's neighbour sphere:869):
+       fitted, every model, to the radius r. */
+    for (size_t i = 0; i < 3 * n; i++)
+        x[i] = ldexp(x[i], 10);
+    for (int model = 0; model < 3; model++) {
+        fe_quadric q = FE_QUADRIC_EMPTY;
+        fe_sphere_fit f;
+        ck_assert_int_eq(fe_quadric_add_many(&q, x, n, NULL), FE_OK);
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, (fe_sphere_model)model, NULL, &f), FE_OK);
+        ck_assert_int_eq(f.refusal, FE_SPHERE_ACCEPTED);
+        FE_ASSERT_REL(f.radius, ldexp(1.0, -250), 1e-12);
     }
 }
 END_TEST
@@ -1978,6 +2025,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_loop_test(t, three_algorithms_agree, 0, 3);
     tcase_add_test(t, extents_are_in_half_widths_of_the_fitted_ellipsoid);
     tcase_add_test(t, calibration_maps_to_the_unit_sphere);
+    tcase_add_test(t, a_spread_whose_fourth_power_is_not_normal_is_degenerate);
     tcase_add_test(t, scale_to_a_known_field);
     tcase_add_test(t, ardupilot_parameters);
     tcase_add_test(t, batch_means_errors_match_the_scatter);
