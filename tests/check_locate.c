@@ -1128,6 +1128,25 @@ START_TEST(residual_map_statistics_by_hand)
 }
 END_TEST
 
+/* Two rows of one time block (of a map of 10 blocks over 20 rows that
+   carry a temperature in [lo, hi]), at temperatures temp0 and temp1, each
+   with residual `before`: the first is taken, the second refused with
+   FE_ENONFINITE and the map left as it was. */
+static void second_row_refused(double lo, double hi, double temp0, double temp1, double before)
+{
+    fe_residual_map m, keep;
+    fe_sample s = {0};
+    double l[3] = {0, 0, lo}, h[3] = {1, 1, hi};
+    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_TEMPERATURE, l, h), FE_OK);
+    s.temperature = temp0;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, before, 0.5), FE_OK);
+    memcpy(&keep, &m, sizeof m);
+    s.t = 1.0;
+    s.temperature = temp1;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, before, 0.5), FE_ENONFINITE);
+    ck_assert_mem_eq(&m, &keep, sizeof m);
+}
+
 START_TEST(residual_map_refusals_at_their_edges)
 {
     fe_residual_map m, keep;
@@ -1170,30 +1189,11 @@ START_TEST(residual_map_refusals_at_their_edges)
        the temperature bin's sum of temperatures, 1.6e308 twice, while the
        block's sums (of times and residuals) stay small.  Every cell the
        row would enter is checked, not only the first. */
-    lo[2] = 1e308;
-    hi[2] = 1.7e308;
-    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_TEMPERATURE, lo, hi), FE_OK);
-    s.t = 0.0;
-    s.temperature = 1.6e308;
-    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_OK);
-    memcpy(&keep, &m, sizeof m);
-    s.t = 1.0;
-    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.0, 0.5), FE_ENONFINITE);
-    ck_assert_mem_eq(&m, &keep, sizeof m);
+    second_row_refused(1e308, 1.7e308, 1.6e308, 1.6e308, 1.0);
     /* And in the time block alone: two rows of one block, in different
        temperature bins and regions, whose residuals' squares (1.21e308
        each) add up past the largest double only in the block. */
-    lo[2] = 0;
-    hi[2] = 10.0;
-    ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, FE_ROLE_TEMPERATURE, lo, hi), FE_OK);
-    s.t = 0.0;
-    s.temperature = 1.0;
-    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.1e154, 0.5), FE_OK);
-    memcpy(&keep, &m, sizeof m);
-    s.t = 1.0;
-    s.temperature = 9.0;
-    ck_assert_int_eq(fe_residual_map_add(&m, &s, 1.1e154, 0.5), FE_ENONFINITE);
-    ck_assert_mem_eq(&m, &keep, sizeof m);
+    second_row_refused(0.0, 10.0, 1.0, 9.0, 1.1e154);
     ck_assert_double_eq(fe_residual_map_largest_after(NULL, 1.0), 0.0);
     ck_assert_int_eq(fe_residual_map_init(&m, 10, 20, 0, 0, lo, hi), FE_OK);
     ck_assert_double_eq(fe_residual_map_largest_after(&m, 1.0), 0.0);   /* empty */
