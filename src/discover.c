@@ -2271,15 +2271,14 @@ static void fe__scale_used(const fe_discover_acc *a, const fe__model *mo,
    variance).  ln V_t is the line through the levels, weighted by
    1 / psi'(k_i/2), with slope >= 0 (their weighted mean otherwise).
    coef[t][i] holds the linear map ln V_t = sum_i coef y_i, which carries
-   the variances of the y_i to any combination.  seen[t] is 1 for a level
-   with coefficients of its own left free (k_i >= 1/2), 0 for one the line
-   reaches only by extrapolation (and for the scaling coefficient). */
+   the variances of the y_i to any combination.  var[i] > 0 marks a level
+   with coefficients of its own left free (k_i >= 1/2); the others, and
+   the scaling coefficient, the line reaches only by extrapolation. */
 typedef struct fe__scalefit {
     size_t levels;                                      /* J (0: none) */
     double lnv[FE_DISCOVER_SCALES + 1];
     double coef[FE_DISCOVER_SCALES + 1][FE_DISCOVER_SCALES];
     double var[FE_DISCOVER_SCALES];
-    int seen[FE_DISCOVER_SCALES + 1];
 } fe__scalefit;
 
 static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
@@ -2304,7 +2303,6 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
             continue;
         ly[i - 1] = log(e[i - 1] / (k * pred)) - (fe_digamma(k / 2.0) - log(k / 2.0));
         sf->var[i - 1] = fe_trigamma(k / 2.0);
-        sf->seen[i - 1] = 1;
         wt[i - 1] = 1.0 / sf->var[i - 1];
         sw += wt[i - 1];
         sx += wt[i - 1] * x;
@@ -2333,7 +2331,7 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
    *share), with the variance of its log in *lnvar.  A level the AR model
    overpredicts is left at the model's own variance: the long range only
    ever widens.  Floored, a level the residual shows adds nothing to
-   *lnvar; one the line only extrapolates to (sf->seen 0) adds its
+   *lnvar; one the line only extrapolates to (no sf->var) adds its
    uncertainty as if V_t were 1 (see the text). */
 static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, double *share,
                              double *lnvar)
@@ -2350,8 +2348,8 @@ static double fe__scale_part(const fe__scalefit *sf, const double *lam_in, doubl
         lam[t] = total > 1.0 ? lam_in[t] / total : lam_in[t];
         F += lam[t] * (sf->lnv[t] > 0.0 ? exp(sf->lnv[t]) : 1.0);
         g[t] = sf->lnv[t] > 0.0 ? lam[t] * exp(sf->lnv[t])   /* d F / d ln V_t */
-               : sf->seen[t]    ? 0.0
-                                : lam[t];
+               : t < J && sf->var[t] > 0.0 ? 0.0   /* a level the residual shows */
+                                           : lam[t];
     }
     *share = total > 1.0 ? 1.0 : total;
     if (!(F > 0.0))
