@@ -1399,13 +1399,17 @@ typedef struct fe__ws {
     double *q;          /* P + 1 lagged sums of a series */
     double *acov;       /* P + 1 whitened autocovariances of a series */
     double *acov_e;     /* P + 1 those of the whitened residual */
+    double *pair;       /* G x G, G = FE_DISCOVER_MAX_GROUPS: candidate
+                           i's BIC change given candidate j, where it
+                           passes (+inf where not): the pair step */
 } fe__ws;
 
 size_t fe_discover_workspace_doubles(size_t m, size_t blocks)
 {
     size_t dim = m + 1, d = FE_DISCOVER_MAX_GROUP_SIZE;
     return dim * dim * 6 + dim * (d + 3) + d * d * 2 + d + blocks * d
-           + blocks * dim + 3 * (FE_DISCOVER_LAGS + 1) + 64;
+           + blocks * dim + 3 * (FE_DISCOVER_LAGS + 1)
+           + FE_DISCOVER_MAX_GROUPS * FE_DISCOVER_MAX_GROUPS + 64;
 }
 
 static int fe__ws_carve(fe__ws *w, double *work, size_t len, size_t m,
@@ -1431,6 +1435,7 @@ static int fe__ws_carve(fe__ws *w, double *work, size_t len, size_t m,
     w->q = w->uv + dim;
     w->acov = w->q + FE_DISCOVER_LAGS + 1;
     w->acov_e = w->acov + FE_DISCOVER_LAGS + 1;
+    w->pair = w->acov_e + FE_DISCOVER_LAGS + 1;
     return FE_OK;
 }
 
@@ -2836,6 +2841,109 @@ int fe_discover_select(const fe_discover_acc *a,
                             && (rk[j].redundant || rk[j].rss_drop <= 0.1 * before[i].rss_drop))
                             res->alike[prev][res->nalike[prev]++] = g;
                 }
+            }
+            if (best == (size_t)-1 && res->steps + 2 <= o.max_steps) {
+                size_t pos[FE_DISCOVER_MAX_GROUPS], np = 0, pf = 0, ps = 0;
+                double best_pair = INFINITY, pair_alpha;
+                for (size_t i = 0; i < nr; i++)
+                    if (!rk[i].redundant)
+                        pos[np++] = i;
+                pair_alpha = o.alpha / ((double)np * (double)(np > 1 ? np - 1 : 1) / 2.0);
+                /* Each candidate in play as the partner j: the model with j fitted, every
+                   other candidate ranked against it (into the next step's ranking, which
+                   is scratch until a pair enters). */
+                for (size_t j = 0; j < np && np > 1; j++) {
+                    size_t with[FE_DISCOVER_MAX_STEPS + 1], c2[FE_DISCOVER_MAX_COLUMNS], nc2, ng;
+                    double b2[FE_DISCOVER_MAX_COLUMNS] = {0};
+                    fe_discover_fit f2;
+                    fe_discover_step s2;
+                    fe_discover_rank *given = res->ranking[step + 1];
+                    memcpy(with, res->added, res->steps * sizeof *with);
+                    with[res->steps] = rk[pos[j]].group;
+                    nc2 = fe__model_columns(groups, o.base, o.nbase, with, res->steps + 1, c2);
+                    rc = fe__fit_step(a, &w, ar, o.max_order, c2, nc2, b2, &f2, &s2);
+                    if (rc != FE_OK)
+                        return rc;
+                    ng = fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, with, res->steps + 1,
+                                      res->aside, res->naside, c2, nc2, b2, &f2, &s2.noise, given, &rc);
+                    if (rc != FE_OK)
+                        return rc;
+                    for (size_t i = 0; i < np; i++) {
+                        double *cell = &w.pair[i * FE_DISCOVER_MAX_GROUPS + j];
+                        *cell = INFINITY;
+                        for (size_t k = 0; k < ng; k++)
+                            if (given[k].group == rk[pos[i]].group && !given[k].redundant
+                                && given[k].p_value < pair_alpha && given[k].delta_bic < 0.0)
+                                *cell = given[k].delta_bic;
+                    }
+                }
+                for (size_t i = 0; i < np; i++)
+                    for (size_t j = i + 1; j < np; j++) {
+                        double bij = w.pair[i * FE_DISCOVER_MAX_GROUPS + j],
+                               bji = w.pair[j * FE_DISCOVER_MAX_GROUPS + i], both;
+                        if (!(bij < INFINITY && bji < INFINITY))
+                            continue;
+                        both = 0.5 * (rk[pos[j]].delta_bic + bij + rk[pos[i]].delta_bic + bji);
+                        if (both < best_pair) {
+                            int i_first = rk[pos[i]].p_value <= rk[pos[j]].p_value;
+                            best_pair = both;
+                            pf = pos[i_first ? i : j];
+                            ps = pos[i_first ? j : i];
+                        }
+                    }
+                if (best_pair < INFINITY) {
+                    size_t gf = rk[pf].group, gs = rk[ps].group, with[FE_DISCOVER_MAX_STEPS + 1];
+                    size_t c2[FE_DISCOVER_MAX_COLUMNS], nc2, k;
+                    double b2[FE_DISCOVER_MAX_COLUMNS] = {0};
+                    fe_discover_fit f2;
+                    fe_discover_step s2;
+                    fe_discover_rank given;
+                    /* The first term's test: given the second. */
+                    memcpy(with, res->added, res->steps * sizeof *with);
+                    with[res->steps] = gs;
+                    nc2 = fe__model_columns(groups, o.base, o.nbase, with, res->steps + 1, c2);
+                    rc = fe__fit_step(a, &w, ar, o.max_order, c2, nc2, b2, &f2, &s2);
+                    if (rc != FE_OK)
+                        return rc;
+                    if (fe__rank_all(a, &w, ar, groups, gf, gf + 1, &o, with, res->steps + 1, NULL, 0, c2, nc2,
+                                     b2, &f2, &s2.noise, &given, &rc) != 1)
+                        return rc != FE_OK ? rc : FE_EINVAL;
+                    res->added[res->steps] = gf;
+                    res->added_rank[res->steps] = given;
+                    res->paired[res->steps] = 1;
+                    res->steps++;
+                    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
+                    res->path[res->steps].added = gf;
+                    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, &res->path[res->steps]);
+                    if (rc != FE_OK)
+                        return rc;
+                    /* The ranking after the first, and the second's test in it. */
+                    step++;
+                    res->nranked[step] = fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, res->added,
+                                                      res->steps, res->aside, res->naside, cols, ncols, beta,
+                                                      &cur, &res->path[res->steps].noise, res->ranking[step], &rc);
+                    if (rc != FE_OK)
+                        return rc;
+                    for (k = 0; k < res->nranked[step] && res->ranking[step][k].group != gs; k++)
+                        ;
+                    if (k == res->nranked[step])
+                        return FE_EINVAL;
+                    res->added[res->steps] = gs;
+                    res->added_rank[res->steps] = res->ranking[step][k];
+                    res->paired[res->steps] = 2;
+                    res->steps++;
+                    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
+                    res->path[res->steps].added = gs;
+                    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, &res->path[res->steps]);
+                    if (rc != FE_OK)
+                        return rc;
+                    continue;
+                }
+                /* None passes: the current model's matrices back into the workspace, for
+                   the set-aside and the probes that follow. */
+                rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, NULL);
+                if (rc != FE_OK)
+                    return rc;
             }
             if (best == (size_t)-1 || step >= o.max_steps)
                 break;

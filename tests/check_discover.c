@@ -2967,6 +2967,86 @@ START_TEST(a_stand_in_is_set_aside_and_selection_runs_again)
 }
 END_TEST
 
+/* The pair of the test below: r = c (x1 - x2) + e with x2 = x1 + 0.05 u, so
+   that neither x1 nor x2 explains r alone (each t below 1) and the two
+   together do (t near 10); x3 is a distractor. */
+static void fold_pair(fe_discover_acc *a, double *st, size_t nst, double c, uint64_t seed)
+{
+    enum { N = 2000, K = 20, M = 4 };
+    fe_rng g = fe_rng_seed(seed);
+    ck_assert_int_eq(fe_discover_acc_init(a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M];
+        phi[0] = 1.0;
+        phi[1] = fe_rng_normal(&g);
+        phi[2] = phi[1] + 0.05 * fe_rng_normal(&g);
+        phi[3] = fe_rng_normal(&g);
+        ck_assert_int_eq(fe_discover_add(a, phi, c * (phi[1] - phi[2]) + fe_rng_normal(&g)),
+                         FE_OK);
+    }
+}
+
+START_TEST(two_candidates_that_only_explain_together_enter_as_a_pair)
+{
+    enum { N = 2000, K = 20, M = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    fe_discover_acc a;
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"x1", 1, 1}, {"x2", 2, 1}, {"x3", 3, 1}};
+    size_t base[3] = {0, 0, 0};
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r), *q = malloc(sizeof *q);
+    o.base = base;
+    o.nbase = 1;
+    for (int noise = 0; noise < 2; noise++) {
+        o.noise = noise ? FE_DISCOVER_NOISE_BATCH : FE_DISCOVER_NOISE_AR;
+        fold_pair(&a, st, nst, 4.5, 23);
+        ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, r, w, nw), FE_OK);
+        /* Alone, neither passes at alpha / 3. */
+        for (size_t i = 0; i < r->nranked[0]; i++)
+            ck_assert(!(r->ranking[0][i].p_value < o.alpha / 3.0
+                        && r->ranking[0][i].delta_bic < 0.0));
+        ck_assert_uint_eq(r->steps, 2);
+        ck_assert_uint_eq(r->added[0] + r->added[1], 3);       /* x1 and x2 */
+        ck_assert_int_eq(r->paired[0], 1);
+        ck_assert_int_eq(r->paired[1], 2);
+        /* Each one's recorded test is its test given the other: the
+           ranking of a selection whose base holds the other. */
+        for (size_t s = 0; s < 2; s++) {
+            base[1] = r->added[1 - s];
+            o.nbase = 2;
+            o.max_steps = 0;
+            ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+            for (size_t i = 0; i < q->nranked[0]; i++)
+                if (q->ranking[0][i].group == r->added[s]) {
+                    FE_ASSERT_REL(r->added_rank[s].statistic, q->ranking[0][i].statistic, 1e-12);
+                    FE_ASSERT_REL(r->added_rank[s].p_value, q->ranking[0][i].p_value, 1e-12);
+                    ck_assert(r->added_rank[s].p_value < o.alpha / 3.0);  /* 3 pairs */
+                }
+            o.nbase = 1;
+            o.max_steps = fe_discover_default_options().max_steps;
+        }
+        /* The coefficients: c and -c, within four standard errors. */
+        for (size_t j = 0; j < r->ncols; j++)
+            if (r->cols[j] == 1 || r->cols[j] == 2)
+                ck_assert(fabs(r->coef[j] - (r->cols[j] == 1 ? 4.5 : -4.5)) < 4.0 * r->stderr_[j]);
+        /* A single step left: no pair. */
+        o.max_steps = 1;
+        ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+        ck_assert_uint_eq(q->steps, 0);
+        o.max_steps = fe_discover_default_options().max_steps;
+        /* The same design without the effect: nothing. */
+        fold_pair(&a, st, nst, 0.0, 23);
+        ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
+        ck_assert_uint_eq(q->steps, 0);
+    }
+    free(r);
+    free(q);
+    free(st);
+    free(w);
+}
+END_TEST
+
 START_TEST(concealed_effects_are_found_and_nulls_are_not)
 {
     size_t ncases, seeds = fe_test_quick() ? 2 : 20;
@@ -3624,6 +3704,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, probes_are_scored_against_the_final_model_and_never_added);
     tcase_add_test(t, a_function_of_the_state_outside_the_terms_is_probed);
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
+    tcase_add_test(t, two_candidates_that_only_explain_together_enter_as_a_pair);
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_numerator_below_one);

@@ -371,6 +371,15 @@ typedef struct fe_discover_result {
     size_t steps;                               /* terms added */
     size_t added[FE_DISCOVER_MAX_STEPS];        /* their groups, in order */
     fe_discover_rank added_rank[FE_DISCOVER_MAX_STEPS];
+    int paired[FE_DISCOVER_MAX_STEPS];          /* 0: the term passed
+                                                   alone; 1: it entered
+                                                   with the next step's
+                                                   term, 2: with the
+                                                   previous step's (no
+                                                   candidate passed alone,
+                                                   each of the two passed
+                                                   given the other, and
+                                                   added_rank is that test) */
     size_t alike[FE_DISCOVER_MAX_STEPS][FE_DISCOVER_MAX_GROUPS];
     size_t nalike[FE_DISCOVER_MAX_STEPS];       /* indistinguishable groups */
     /* The rankings: ranking[s][0..nranked[s]-1] before step s; the last

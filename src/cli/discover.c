@@ -1325,6 +1325,11 @@ static void fe__print_json(FILE *f, const fe__outcome *o)
         fe__json_number(f, r->added_rank[s].statistic);
         fe__json_pair(f, "p_value", r->added_rank[s].p_value);
         fe__json_pair(f, "rss_drop", r->added_rank[s].rss_drop);
+        fprintf(f, ", \"entered_with\": ");
+        if (r->paired[s] != 0)
+            fe_cli_json_string(f, o->c->terms[r->added[r->paired[s] == 1 ? s + 1 : s - 1]].name);
+        else
+            fprintf(f, "null");
         fprintf(f, ", \"explanation\": ");
         fe_cli_json_string(f, words);
         fprintf(f, ", \"indistinguishable_from\": [");
@@ -1530,6 +1535,10 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
                 s + 1, t->name, t->description, c.value, c.se, c.value - c.halfwidth,
                 c.value + c.halfwidth, c.dof < 1.0 ? few : "", r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
+        if (r->paired[s] != 0)
+            fprintf(f, "     entered with %s: no candidate passed alone, and each of the two "
+                       "passes given the other (the statistic above is that test)\n",
+                    o->c->terms[r->added[r->paired[s] == 1 ? s + 1 : s - 1]].name);
         if (r->nalike[s] > 0) {
             fprintf(f, "     indistinguishable on these data from:");
             for (size_t j = 0; j < r->nalike[s]; j++)
