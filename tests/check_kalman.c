@@ -1628,6 +1628,51 @@ START_TEST(the_largest_dimension_is_taken_and_one_more_refused)
 }
 END_TEST
 
+/* Issue 20 (seed 10117's kalman:853): the information form's buffer is the
+   layout kalman.org gives it, no more and no less: eta (n) and Lambda
+   (n x n), the increment (G, g) of a packet (n x n + n), then room for
+   the larger of a copy of Z with the b x (n + 1) block Z^{-1}[A | z]
+   (b x b + b (n + 1)) and a copy of P0 with the n x (n + 1) block
+   [I | x0] (n x n + n (n + 1)).  A buffer of exactly that many doubles
+   takes a prior and a packet of bmax without a write past its end (the
+   guard after it is left as it was), and one double less is FE_ESIZE. */
+START_TEST(information_buffer_is_its_documented_layout)
+{
+    enum { PAD = 8 };
+    static const size_t ns[] = {1, 2, 3, 5, 8}, bs[] = {1, 2, 4, 8};
+    fe_rng rng = fe_rng_seed(10117);
+    for (size_t i = 0; i < sizeof ns / sizeof *ns; i++)
+        for (size_t j = 0; j < sizeof bs / sizeof *bs; j++) {
+            const size_t n = ns[i], b = bs[j];
+            const size_t packet = b * b + b * (n + 1), prior = n * n + n * (n + 1);
+            const size_t len = n + n * n + (n * n + n) + (packet > prior ? packet : prior);
+            double *m, P0[MAXD * MAXD], x0[MAXD], A[MAXD * MAXD], z[MAXD], Z[MAXD * MAXD];
+            fe_kalman_info s;
+            fe_kalman_obs o = {b, A, z, Z};
+            ck_assert_msg(fe_kalman_info_doubles(n, b) == len, "n %zu, bmax %zu: %zu doubles, "
+                          "the layout %zu", n, b, fe_kalman_info_doubles(n, b), len);
+            m = malloc((len + PAD) * sizeof *m);
+            ck_assert_ptr_nonnull(m);
+            for (size_t k = 0; k < len + PAD; k++)
+                m[k] = -7.0;
+            ck_assert_int_eq(fe_kalman_info_init(&s, n, b, m, len - 1), FE_ESIZE);
+            ck_assert_int_eq(fe_kalman_info_init(&s, n, b, m, len), FE_OK);
+            random_spd(&rng, n, 1.0, P0);
+            random_vec(&rng, n, 1.0, x0);
+            ck_assert_int_eq(fe_kalman_info_set_prior(&s, x0, P0), FE_OK);
+            for (size_t k = 0; k < b * n; k++)
+                A[k] = fe_rng_normal(&rng);
+            random_vec(&rng, b, 1.0, z);
+            random_spd(&rng, b, 1.0, Z);
+            ck_assert_int_eq(fe_kalman_info_update(&s, &o), FE_OK);
+            ck_assert_uint_eq(s.count, 1);
+            for (size_t k = len; k < len + PAD; k++)
+                ck_assert_double_eq(m[k], -7.0);
+            free(m);
+        }
+}
+END_TEST
+
 /* Issue 20: the packet size at bmax is folded and bmax + 1 refused with
    FE_ESIZE, the filter unchanged to the byte, by every update and
    tracker step, for a small state (fixed kernels) and one above them. */
@@ -1866,6 +1911,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, cusums_follow_their_recursion);
     tcase_add_test(t, chi_square_quantiles);
     tcase_add_test(t, the_largest_dimension_is_taken_and_one_more_refused);
+    tcase_add_test(t, information_buffer_is_its_documented_layout);
     tcase_add_test(t, a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step);
     tcase_add_test(t, prior_variances_are_refused_just_below_their_edges);
     tcase_add_test(t, a_merge_that_overflows_in_any_one_sum_is_refused);

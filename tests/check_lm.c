@@ -768,6 +768,16 @@ static int scaled_square_model(const double *x, fe_lm_sink *s, void *ctx)
     return fe_lm_emit(s, sg * (x[0] * x[0] - 4.0), 1.0, &j, FE_SCHUR_NONE, NULL);
 }
 
+/* The same, its sigma and a count of the model's calls in ctx. */
+struct counted_square { double sg; int calls; };
+
+static int counted_square_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    struct counted_square *c = ctx;
+    c->calls++;
+    return scaled_square_model(x, s, &c->sg);
+}
+
 static double sq_cost(double sg, double x)
 {
     double f = sg * (x * x - 4.0);
@@ -793,16 +803,19 @@ START_TEST(second_step_searches_along_the_last_two)
     double lambda = fe_lm_default_params().lambda0, nu = 2.0, rowcost[2];
     struct rows t = {0};
     fe_lm_result r;
-    int have = 0, accelerated = 0, extended = 0;
+    int have = 0, accelerated = 0, extended = 0, parabola = 0;
+    int evals = 1;                                  /* the start, with its Jacobian */
     for (int it = 0; it < 2; it++) {
         double f = sg * (y * y - 4.0), J = sg * 2.0 * y, A = J * J, b = -J * f;
         double cost = sq_cost(sg, y), h = b / (A * (1.0 + lambda));
         double pred = 0.5 * h * (b + lambda * A * h), slope = h * b;
         double yt = y + h, ct = sq_cost(sg, yt), rho = (cost - ct) / pred;
+        evals++;                                    /* the trial point */
         if (rho > 0.0 && fabs(rho - 1.0) > 0.25) {
             double c = ct - cost + slope;
             if (c > 0.0 && slope > 0.0) {
                 double ts = fmin(slope / (2.0 * c), 64.0);
+                evals += ts > 0.0 && ts != 1.0;     /* the point along the step */
                 if (ts > 0.0 && ts != 1.0 && sq_cost(sg, y + ts * h) < ct) {
                     yt = y + ts * h;
                     ct = sq_cost(sg, yt);
@@ -816,14 +829,18 @@ START_TEST(second_step_searches_along_the_last_two)
             ya = y;
             y = yt;
             cost = ct;
+            evals++;                                /* the step taken, with its Jacobian */
             if (have) {
                 double f2 = sg * (y * y - 4.0), b2 = -(sg * 2.0 * y) * f2, sl = b2 * d;
                 if (sl > 0.0) {
                     double c1 = sq_cost(sg, y + d), c = c1 - cost + sl, ta, cta;
+                    evals++;                        /* x + d */
                     ta = c > 0.0 ? fmin(sl / (2.0 * c), 64.0) : 64.0;
                     cta = c1;
                     if (ta != 1.0) {
                         cta = sq_cost(sg, y + ta * d);
+                        evals++;                    /* x + t* d */
+                        parabola++;
                         if (!(cta < c1)) {
                             ta = 1.0;
                             cta = c1;
@@ -834,6 +851,7 @@ START_TEST(second_step_searches_along_the_last_two)
                         y += ta * d;
                         cost = sq_cost(sg, y);
                         accelerated++;
+                        evals++;                    /* the move, with its Jacobian */
                     }
                 }
             }
@@ -852,6 +870,25 @@ START_TEST(second_step_searches_along_the_last_two)
     ck_assert_int_ge(r.accelerated, 1);
     ck_assert_int_eq(extended, 0);
     ck_assert_double_eq_tol(x, 2.0, 1e-9);
+    {
+        /* The same two iterations alone (seed 10117's lm:309): the result
+           counts every call of the model (lm.h), the search's point
+           x + t* d among them, as the count by hand does. */
+        struct counted_square cs = {sg, 0};
+        fe_lm_problem pc = {1, 0, 0, counted_square_model, &cs};
+        fe_lm_params par = fe_lm_default_params();
+        int rc;
+        x = 3.0;
+        par.max_iter = 2;
+        ck_assert_int_eq(parabola, 1);              /* the premise: t* != 1 */
+        rc = fe_lm_solve(&pc, FE_LM_DENSE, &par, &x, w, NULL, NULL, &r);
+        ck_assert(rc == FE_ENOCONV || rc == FE_OK);
+        ck_assert_int_eq(r.iterations, 2);
+        ck_assert_int_eq(r.accelerated, 1);
+        ck_assert_int_eq(cs.calls, evals);
+        ck_assert_int_eq(r.evaluations, evals);
+        FE_ASSERT_REL(r.cost, rowcost[1], 1e-12);
+    }
     free(w);
 }
 END_TEST

@@ -746,6 +746,60 @@ START_TEST(residual_map_cells_equal_sums_over_the_rows)
 }
 END_TEST
 
+START_TEST(a_part_numbers_its_recordings_from_zero)
+{
+    /* Seed 10117's locate:764 and its neighbours: the recordings of a part
+       are numbered from 0 (locate.h), and a break starts the next one.
+       A break before the part's first row starts no recording of its own:
+       the whole stream folded after such a break has every block, region
+       and bin of the fold without it, to the byte, and the same recording
+       count; only first_linked says that the first row does not follow a
+       previous part.  A part cut at the break before row 200 numbers that
+       recording 0 and ends in recording 1 (rows 350 on); merged into an
+       empty part it is that part.  A part of rows 199 on has one row of
+       the first recording before the break: its recordings are the whole
+       stream's, so its blocks after the first (rows 240 on) are the
+       whole's to the byte, and it ends in recording 2. */
+    fe_residual_map whole, lead, part, empty;
+    map_fold(&whole, 0, MAP_ROWS);
+    ck_assert_int_eq(fe_residual_map_init(&lead, MAP_BLOCKS, MAP_FIT, 0, map_roles, map_lo,
+                                          map_hi), FE_OK);
+    fe_residual_map_break(&lead);
+    for (int i = 0; i < MAP_ROWS; i++) {
+        fe_sample s;
+        double b, a;
+        map_row(i, &s, &b, &a);
+        if (i == 200 || i == 350)
+            fe_residual_map_break(&lead);
+        ck_assert_int_eq(fe_residual_map_add(&lead, &s, b, a), FE_OK);
+    }
+    ck_assert_int_eq(whole.first_linked, 1);
+    ck_assert_int_eq(lead.first_linked, 0);
+    ck_assert_int_eq(whole.recording, 2);
+    ck_assert_int_eq(lead.recording, 2);
+    ck_assert_int_eq(lead.block[0].pair, 0);
+    ck_assert_mem_eq(lead.block, whole.block, sizeof whole.block);
+    ck_assert_mem_eq(lead.cell, whole.cell, sizeof whole.cell);
+    ck_assert_mem_eq(lead.bin, whole.bin, sizeof whole.bin);
+    map_fold(&part, 200, MAP_ROWS);                 /* a break before its row 200 */
+    ck_assert_int_eq(part.first_linked, 0);
+    ck_assert_int_eq(part.recording, 1);
+    ck_assert_int_eq(part.block[200 * MAP_BLOCKS / MAP_FIT].pair, 0);
+    ck_assert_int_eq(part.block[MAP_BLOCKS].pair1, 1);
+    ck_assert_int_eq(fe_residual_map_init(&empty, MAP_BLOCKS, MAP_FIT, 200, map_roles, map_lo,
+                                          map_hi), FE_OK);
+    ck_assert_int_eq(fe_residual_map_merge(&empty, &part), FE_OK);
+    ck_assert_int_eq(empty.recording, part.recording);
+    ck_assert_mem_eq(empty.block, part.block, sizeof part.block);
+    map_fold(&part, 199, MAP_ROWS);                 /* one row, then the break */
+    ck_assert_int_eq(part.first_linked, 1);
+    ck_assert_int_eq(part.recording, 2);
+    ck_assert_int_eq(part.block[4].pair, 0);        /* rows 199 .. 239 */
+    ck_assert_int_eq(part.block[4].pair1, 1);
+    ck_assert_mem_eq(&part.block[5], &whole.block[5], (MAP_BLOCKS - 4) * sizeof *whole.block);
+}
+END_TEST
+
 START_TEST(residual_map_merge_of_parts_equals_whole)
 {
     /* Cut anywhere (inside a recording, at a break, next to one, in the
@@ -1492,6 +1546,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, a_right_model_locates_nothing);
     tcase_add_test(t, residual_map_cells_equal_sums_over_the_rows);
     tcase_add_test(t, residual_map_merge_of_parts_equals_whole);
+    tcase_add_test(t, a_part_numbers_its_recordings_from_zero);
     tcase_add_test(t, residual_map_locates_a_window_and_a_region);
     tcase_add_test(t, residual_map_statistics_by_hand);
     tcase_add_test(t, a_cell_of_the_callers_own_sums_its_rows);
