@@ -2748,6 +2748,24 @@ static size_t fe__rank_all(const fe_discover_acc *a, const fe__ws *w, int ar,
     return nr;
 }
 
+/* Add the candidate of `rank` as the next step, with the test it passed
+   and how it entered (res->paired: 0 alone, 1 or 2 with the step after or
+   before it), and refit: the path's new step, cols, ncols, beta and cur
+   are the new model's, and w holds its matrices. */
+static int fe__add_step(const fe_discover_acc *a, const fe__ws *w, int ar,
+                        const fe_discover_options *o, const fe_discover_group *groups,
+                        fe_discover_result *res, const fe_discover_rank *rank, int paired,
+                        size_t *cols, size_t *ncols, double *beta, fe_discover_fit *cur)
+{
+    res->added[res->steps] = rank->group;
+    res->added_rank[res->steps] = *rank;
+    res->paired[res->steps] = paired;
+    res->steps++;
+    *ncols = fe__model_columns(groups, o->base, o->nbase, res->added, res->steps, cols);
+    res->path[res->steps].added = rank->group;
+    return fe__fit_step(a, w, ar, o->max_order, cols, *ncols, beta, cur, &res->path[res->steps]);
+}
+
 int fe_discover_select(const fe_discover_acc *a,
                        const fe_discover_group *groups, size_t ngroups,
                        const fe_discover_options *options,
@@ -2908,13 +2926,7 @@ int fe_discover_select(const fe_discover_acc *a,
                     if (fe__rank_all(a, &w, ar, groups, gf, gf + 1, &o, with, res->steps + 1, NULL, 0, c2, nc2,
                                      b2, &f2, &s2.noise, &given, &rc) != 1)
                         return rc != FE_OK ? rc : FE_EINVAL;
-                    res->added[res->steps] = gf;
-                    res->added_rank[res->steps] = given;
-                    res->paired[res->steps] = 1;
-                    res->steps++;
-                    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
-                    res->path[res->steps].added = gf;
-                    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, &res->path[res->steps]);
+                    rc = fe__add_step(a, &w, ar, &o, groups, res, &given, 1, cols, &ncols, beta, &cur);
                     if (rc != FE_OK)
                         return rc;
                     /* The ranking after the first, and the second's test in it. */
@@ -2928,13 +2940,8 @@ int fe_discover_select(const fe_discover_acc *a,
                         ;
                     if (k == res->nranked[step])
                         return FE_EINVAL;
-                    res->added[res->steps] = gs;
-                    res->added_rank[res->steps] = res->ranking[step][k];
-                    res->paired[res->steps] = 2;
-                    res->steps++;
-                    ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
-                    res->path[res->steps].added = gs;
-                    rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur, &res->path[res->steps]);
+                    rc = fe__add_step(a, &w, ar, &o, groups, res, &res->ranking[step][k], 2, cols, &ncols, beta,
+                                      &cur);
                     if (rc != FE_OK)
                         return rc;
                     continue;
@@ -2947,13 +2954,7 @@ int fe_discover_select(const fe_discover_acc *a,
             }
             if (best == (size_t)-1 || step >= o.max_steps)
                 break;
-            res->added[res->steps] = rk[best].group;
-            res->added_rank[res->steps] = rk[best];
-            res->steps++;
-            ncols = fe__model_columns(groups, o.base, o.nbase, res->added, res->steps, cols);
-            res->path[res->steps].added = rk[best].group;
-            rc = fe__fit_step(a, &w, ar, o.max_order, cols, ncols, beta, &cur,
-                              &res->path[res->steps]);
+            rc = fe__add_step(a, &w, ar, &o, groups, res, &rk[best], 0, cols, &ncols, beta, &cur);
             if (rc != FE_OK)
                 return rc;
         }
