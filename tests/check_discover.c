@@ -400,7 +400,7 @@ static void assert_same_sums(const fe_discover_acc *got, const fe_discover_acc *
     }
     for (size_t i = 0; i < dim; i++)
         for (size_t j = 0; j < dim; j++) {
-            double scale = sqrt(diag[i] * diag[j]);
+            double scale = sqrt(diag[i]) * sqrt(diag[j]); /* the product may overflow */
             for (size_t k = 0; k <= K; k++) {
                 size_t at = k * dim * dim + i * dim + j;
                 ck_assert_msg(fabs(got->gram[at] - want->gram[at]) <= 1e-12 * scale,
@@ -717,7 +717,7 @@ static void assert_screen_sums(const fe_discover_acc *got, const fe_discover_acc
         for (size_t j = i; j < dim; j++) {
             int kept = i < nb || j == full->m || j - i < 3;
             int lag_kept = (i < nb || i == full->m) && (j < nb || j == full->m);
-            double scale = sqrt(diag[i] * diag[j]);
+            double scale = sqrt(diag[i]) * sqrt(diag[j]); /* the product may overflow */
             for (size_t k = 0; k <= K; k++) {
                 size_t at = k * dim * dim + i * dim + j;
                 double want = kept ? full->gram[at] : 0.0;
@@ -944,6 +944,60 @@ START_TEST(columns_stop_at_the_first_refused_row)
         free(s1);
         free(s2);
     }
+}
+END_TEST
+
+/* A row with a value above 1e100 hands the row after it to the row step
+   (discover.org, "Fold many rows"), also when that row begins the next
+   call: only the row step checks the lag product the two share.  Rows 198
+   and 199 hold 9e153 in the first two columns (squares 8.1e307, their lag
+   product T_01 = 1.62e308: finite) and end the first call of 200 rows; the
+   second call's 200 ordinary rows pair with row 199.  By rows and by
+   columns, narrow (the column path) and wide (the dsyrk panel, whose
+   identity would add c_0 c_0^T = 8.1e307 to T_01 before subtracting the
+   differences, and overflow): every sum finite, and the same as row by row. */
+START_TEST(rows_after_a_large_row_ending_a_call_take_the_row_step)
+{
+    static const size_t ms[] = {PM, WM};
+    wide_rows();
+    for (size_t c = 0; c < 2; c++)
+        for (int by_columns = 0; by_columns < 2; by_columns++) {
+            size_t m = ms[c], dim = m + 1, nst = fe_discover_acc_doubles(m, PK), done = 0;
+            double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2);
+            double keep[2][2];
+            fe_discover_acc rows, calls;
+            ck_assert_int_eq(fe_discover_acc_init(&rows, m, PK, PFIT, 0, s1, nst), FE_OK);
+            ck_assert_int_eq(fe_discover_acc_init(&calls, m, PK, PFIT, 0, s2, nst), FE_OK);
+            for (size_t i = 0; i < 2; i++)
+                for (size_t j = 0; j < 2; j++) {
+                    keep[i][j] = wide[198 + i][j];
+                    wide[198 + i][j] = wcol[j][198 + i] = 9e153;
+                }
+            add_wide_rows(&rows, 0, 400);
+            for (size_t from = 0; from < 400; from += 200) {
+                ck_assert_int_eq(by_columns
+                                     ? fe_discover_add_columns(&calls, &wcol[0][from], PN,
+                                                               pr + from, 200, &done)
+                                     : fe_discover_add_rows(&calls, wide[from], WM, pr + from,
+                                                            200, &done),
+                                 FE_OK);
+                ck_assert_uint_eq(done, 200);
+            }
+            for (size_t i = 0; i < 2; i++)
+                for (size_t j = 0; j < 2; j++)
+                    wide[198 + i][j] = wcol[j][198 + i] = keep[i][j];
+            /* The case as described: T_01 row by row near the largest double. */
+            ck_assert(rows.lag[1] > 1.6e308 && isfinite(rows.lag[1]));
+            for (size_t i = 0; i < dim * dim; i++) {
+                ck_assert_msg(isfinite(calls.lag[i]), "m %zu, by %s: T[%zu][%zu] = %g", m,
+                              by_columns ? "columns" : "rows", i / dim, i % dim, calls.lag[i]);
+                for (size_t k = 0; k <= PK; k++)
+                    ck_assert(isfinite(calls.gram[k * dim * dim + i]));
+            }
+            assert_same_sums(&calls, &rows);
+            free(s1);
+            free(s2);
+        }
 }
 END_TEST
 
@@ -3691,6 +3745,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, screen_ranks_as_the_full_accumulation);
     tcase_add_test(t, screen_refuses_what_it_cannot_answer);
     tcase_add_test(t, columns_stop_at_the_first_refused_row);
+    tcase_add_test(t, rows_after_a_large_row_ending_a_call_take_the_row_step);
     tcase_add_test(t, lagged_products_match_brute_force_in_every_path);
     tcase_add_test(t, lagged_products_at_one_and_two_lags);
     tcase_add_test(t, scale_used_does_not_depend_on_the_order_of_the_columns);

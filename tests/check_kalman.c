@@ -958,6 +958,50 @@ START_TEST(report_is_the_innovation)
 }
 END_TEST
 
+/* A scalar packet's report by each update, with each buffer asked for
+   alone (the other two NULL) and all three at once: kalman.h says every
+   buffer not NULL receives its value.  With x = (1, -1), P = [[2, 0.5],
+   [0.5, 1]], a = (1, 1), z = 2 and Z = 1: P a = (2.5, 1.5), nu = z - a x
+   = 2, D = Z + a P a^T = 5, whitened nu / sqrt(D), NIS nu^2 / D = 0.8,
+   log det D = log 5; the state x + P a nu / D = (2, -0.4), and P minus
+   (P a)(P a)^T / D = [[0.75, -0.25], [-0.25, 0.55]]. */
+START_TEST(a_scalar_packet_reports_each_buffer_asked_for)
+{
+    typedef int update_fn(fe_kalman *, const fe_kalman_obs *, fe_kalman_report *);
+    static update_fn *const update[3] = {fe_kalman_update, fe_kalman_update_joseph,
+                                         fe_kalman_update_fast};
+    const double x0[2] = {1, -1}, P0[4] = {2, 0.5, 0.5, 1};
+    const double A[2] = {1, 1}, z[1] = {2}, Z[1] = {1};
+    const double x1[2] = {2, -0.4}, P1[4] = {0.75, -0.25, -0.25, 0.55};
+    fe_kalman_obs o = {1, A, z, Z};
+    for (int u = 0; u < 3; u++)
+        for (int ask = 0; ask < 4; ask++) {     /* nu, whitened, D alone; all */
+            double nu = NAN, w = NAN, D = NAN;
+            fe_kalman_report rep = {0, NAN, NAN, ask == 0 || ask == 3 ? &nu : NULL,
+                                    ask == 1 || ask == 3 ? &w : NULL,
+                                    ask == 2 || ask == 3 ? &D : NULL};
+            kf f;
+            kf_make(&f, 2, 1);
+            ck_assert_int_eq(fe_kalman_set_prior(&f.k, x0, P0), FE_OK);
+            ck_assert_int_eq(update[u](&f.k, &o, &rep), FE_OK);
+            ck_assert_uint_eq(rep.b, 1);
+            FE_ASSERT_REL(rep.nis, 0.8, 1e-15);
+            FE_ASSERT_REL(rep.log_det_D, log(5.0), 1e-15);
+            if (rep.innovation != NULL)
+                FE_ASSERT_REL(nu, 2.0, 1e-15);
+            if (rep.whitened != NULL)
+                FE_ASSERT_REL(w, 2.0 / sqrt(5.0), 1e-15);
+            if (rep.D != NULL)
+                FE_ASSERT_REL(D, 5.0, 1e-15);
+            for (int i = 0; i < 2; i++)
+                FE_ASSERT_REL(f.k.x[i], x1[i], 1e-14);
+            for (int i = 0; i < 4; i++)
+                FE_ASSERT_REL(f.k.P[i], P1[i], 1e-14);
+            kf_free(&f);
+        }
+}
+END_TEST
+
 /* --------------------------------------------------- the tracker */
 
 /* The falling object of Kalman Folding 2, simulated with the model's own
@@ -1896,6 +1940,7 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, fast_path_equals_reference);
     tcase_add_test(t, joseph_form_against_long_double);
     tcase_add_test(t, report_is_the_innovation);
+    tcase_add_test(t, a_scalar_packet_reports_each_buffer_asked_for);
     tcase_add_test(t, tracker_errors_within_two_sigma);
     tcase_add_test(t, tracker_fast_equals_reference);
     tcase_add_test(t, information_form_equals_covariance_form);
