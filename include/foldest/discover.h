@@ -423,8 +423,10 @@ typedef struct fe_discover_result {
 size_t fe_discover_workspace_doubles(size_t m, size_t blocks);
 
 /* fe_discover_select: rank the `ngroups` candidate groups, add terms by
-   forward selection, fit them, and summarise baseline and final models,
-   all from the accumulation.  From a screen (fe_discover_screen_init) it
+   forward selection (a pair of them at a step where none passes alone
+   and two pass each given the other, res->paired), fit them, and
+   summarise baseline and final models, all from the accumulation.  From a
+   screen (fe_discover_screen_init) it
    ranks only: max_steps must be 0 and the base groups must lie in the
    screen's base columns.  Errors: FE_EINVAL (also for a screen asked for
    more, or max_order out of range); FE_ETOOFEW (a block is empty);
