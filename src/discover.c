@@ -2880,12 +2880,13 @@ int fe_discover_select(const fe_discover_acc *a,
                     with[res->steps] = rk[pos[j]].group;
                     nc2 = fe__model_columns(groups, o.base, o.nbase, with, res->steps + 1, c2);
                     rc = fe__fit_step(a, &w, ar, o.max_order, c2, nc2, b2, &f2, &s2);
-                    if (rc != FE_OK)
+                    ng = rc == FE_OK ? fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, with,
+                                                    res->steps + 1, res->aside, res->naside, c2, nc2, b2, &f2,
+                                                    &s2.noise, given, &rc)
+                                     : 0;
+                    if (rc != FE_OK && rc != FE_ESINGULAR && rc != FE_ENONFINITE)
                         return rc;
-                    ng = fe__rank_all(a, &w, ar, groups, 0, ngroups - o.nprobes, &o, with, res->steps + 1,
-                                      res->aside, res->naside, c2, nc2, b2, &f2, &s2.noise, given, &rc);
-                    if (rc != FE_OK)
-                        return rc;
+                    rc = FE_OK;         /* a model with j that cannot be fitted pairs j with none */
                     for (size_t i = 0; i < np; i++) {
                         double *cell = &w.pair[i * FE_DISCOVER_MAX_GROUPS + j];
                         *cell = INFINITY;
@@ -2909,6 +2910,22 @@ int fe_discover_select(const fe_discover_acc *a,
                             ps = pos[i_first ? j : i];
                         }
                     }
+                if (best_pair < INFINITY) {
+                    size_t with[FE_DISCOVER_MAX_STEPS + 2], c2[FE_DISCOVER_MAX_COLUMNS], nc2;
+                    double b2[FE_DISCOVER_MAX_COLUMNS] = {0};
+                    fe_discover_fit f2;
+                    memcpy(with, res->added, res->steps * sizeof *with);
+                    with[res->steps] = rk[pf].group;
+                    with[res->steps + 1] = rk[ps].group;
+                    nc2 = fe__model_columns(groups, o.base, o.nbase, with, res->steps + 2, c2);
+                    rc = fe__fit_step(a, &w, ar, o.max_order, c2, nc2, b2, &f2, NULL);
+                    if (rc == FE_ESINGULAR || rc == FE_ENONFINITE) {
+                        best_pair = INFINITY;
+                        rc = FE_OK;
+                    }
+                    if (rc != FE_OK)
+                        return rc;
+                }
                 if (best_pair < INFINITY) {
                     size_t gf = rk[pf].group, gs = rk[ps].group, with[FE_DISCOVER_MAX_STEPS + 1];
                     size_t c2[FE_DISCOVER_MAX_COLUMNS], nc2, k;

@@ -3084,6 +3084,25 @@ START_TEST(two_candidates_that_only_explain_together_enter_as_a_pair)
         for (size_t j = 0; j < r->ncols; j++)
             if (r->cols[j] == 1 || r->cols[j] == 2)
                 ck_assert(fabs(r->coef[j] - (r->cols[j] == 1 ? 4.5 : -4.5)) < 4.0 * r->stderr_[j]);
+        /* The stronger alone enters first. */
+        for (size_t i = 0; i < r->nranked[0]; i++)
+            for (size_t k = 0; k < r->nranked[0]; k++)
+                if (r->ranking[0][i].group == r->added[0] && r->ranking[0][k].group == r->added[1])
+                    ck_assert(r->ranking[0][i].p_value <= r->ranking[0][k].p_value);
+        /* The level: with three candidates in play, three pairs; the pair
+           passes at a level just above three times the larger of its two
+           p-values, and not just below it. */
+        {
+            double pmax = fmax(r->added_rank[0].p_value, r->added_rank[1].p_value);
+            fe_discover_options lv = o;
+            ck_assert_uint_eq(r->nranked[0], 3);
+            lv.alpha = 3.0 * pmax * (1.0 + 1e-9);
+            ck_assert_int_eq(fe_discover_select(&a, groups, M, &lv, q, w, nw), FE_OK);
+            ck_assert_uint_eq(q->steps, 2);
+            lv.alpha = 3.0 * pmax * (1.0 - 1e-9);
+            ck_assert_int_eq(fe_discover_select(&a, groups, M, &lv, q, w, nw), FE_OK);
+            ck_assert_uint_eq(q->steps, 0);
+        }
         /* A single step left: no pair. */
         o.max_steps = 1;
         ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, q, w, nw), FE_OK);
