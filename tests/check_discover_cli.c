@@ -94,6 +94,51 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* Two terms of the user's that explain only together (the pair of
+   check_discover's two_candidates_that_only_explain_together_enter_as_a_pair,
+   written as a recording and its simulation): the story and the JSON say
+   that each entered with the other, and the path shows both. */
+START_TEST(a_pair_that_explains_only_together_is_reported_as_one)
+{
+    static char out[65536];
+    char cmd[2048], path[128];
+    FILE *r, *sm;
+    fe_rng g = fe_rng_seed(23);
+    make_dir();
+    snprintf(path, sizeof path, "%s/r.csv", dir);
+    r = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/s.csv", dir);
+    sm = fopen(path, "w");
+    ck_assert(r != NULL && sm != NULL);
+    fprintf(r, "time,y\n");
+    fprintf(sm, "time,y,x1,x2,x3\n");
+    for (int t = 0; t < 2000; t++) {
+        double x1 = fe_rng_normal(&g), x2 = x1 + 0.05 * fe_rng_normal(&g), x3 = fe_rng_normal(&g);
+        fprintf(sm, "%d,0,%.17g,%.17g,%.17g\n", t, x1, x2, x3);
+        fprintf(r, "%d,%.17g\n", t, 4.5 * (x1 - x2) + fe_rng_normal(&g));
+    }
+    ck_assert_int_eq(fclose(r), 0);
+    ck_assert_int_eq(fclose(sm), 0);
+    snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y "
+             "--term a=x1 --term b=x2 --term c=x3 --only a,b,c --holdout 0",
+             FE_TEST_CLI, dir, dir);
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, "entered with b: no candidate passed alone") != NULL
+                  || strstr(out, "entered with a: no candidate passed alone") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "  1. a (") != NULL || strstr(out, "  1. b (") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "  2. a (") != NULL || strstr(out, "  2. b (") != NULL, "%s", out);
+    ck_assert_msg(strstr(out, "  3. ") == NULL, "%s", out);
+    snprintf(cmd + strlen(cmd), sizeof cmd - strlen(cmd), " --json");
+    ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+    ck_assert_msg((strstr(out, "\"name\": \"a\"") != NULL && strstr(out, "\"entered_with\": \"b\"") != NULL
+                   && strstr(out, "\"name\": \"b\"") != NULL && strstr(out, "\"entered_with\": \"a\"") != NULL),
+                  "%s", out);
+    ck_assert_msg(strstr(out, "\"entered_with\": null") == NULL, "%s", out);
+    ck_assert_msg(strstr(out, "\"step\": 2, \"added\": ") != NULL, "%s", out);
+    fe_test_remove_dir(dir);
+}
+END_TEST
+
 /* The reader's options, which discover takes as every command does
    (cli.org).  --decimal-comma: the pair with tabs and decimal commas gives
    the JSON of the pair with points, byte for byte, and is refused without
@@ -1020,6 +1065,7 @@ Suite *fe_discover_cli_suite(void)
                         (int)(sizeof unit_cases / sizeof unit_cases[0]));
     tcase_add_test(t, report_lays_recordings_end_to_end);
     tcase_add_test(t, report_keeps_an_epoch_clock);
+    tcase_add_test(t, a_pair_that_explains_only_together_is_reported_as_one);
     tcase_add_test(t, free_fall_recordings_show_quadratic_drag);
     tcase_add_test(t, magnetometers_show_axis_gain_and_cross_axis);
     tcase_add_test(t, sphere_terms_that_fail_on_held_out_rows_are_not_explained);
