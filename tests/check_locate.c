@@ -746,6 +746,61 @@ START_TEST(residual_map_cells_equal_sums_over_the_rows)
 }
 END_TEST
 
+/* The most cells one row can join.  A range of no width is one band
+   (residual_map_refusals_at_their_edges): its four bands are one and the
+   same interval, and a row lies in each of them.  With the velocity's
+   range [0, 0] (rows that stood still) and a row moving at 0.25, outside
+   it (a value outside joins the band at the range's end), and a constant
+   temperature, the row lies in the velocity's positive half, in all four
+   speed bands, in the position's positive half and in all four
+   temperature bands: ten regions of thirteen (one of the velocity's
+   three, one of the position's two, every band), and with its time block
+   and its three bins, fourteen cells, each holding it once. */
+START_TEST(a_row_joins_every_region_it_lies_in)
+{
+    fe_residual_map m;
+    fe_sample s = {0};
+    const double lo[3] = {-1.0, 0.0, 10.0}, hi[3] = {1.0, 0.0, 10.0};
+    double regions = 0.0, bins = 0.0, blocks = 0.0;
+    ck_assert_int_eq(fe_residual_map_init(&m, 4, 40, 0, map_roles, lo, hi), FE_OK);
+    ck_assert_uint_eq(m.nregions, FE_RESIDUAL_REGIONS);
+    s.t = 3.0;
+    s.position = 0.5;
+    s.velocity = 0.25;
+    s.temperature = 10.0;
+    ck_assert_int_eq(fe_residual_map_add(&m, &s, 0.75, -0.5), FE_OK);
+    for (size_t g = 0; g < m.nregions; g++) {
+        int in = m.region[g] == FE_REGION_VELOCITY_POSITIVE || m.region[g] == FE_REGION_SPEED
+                 || m.region[g] == FE_REGION_POSITION_POSITIVE
+                 || m.region[g] == FE_REGION_TEMPERATURE;
+        ck_assert_double_eq(m.cell[g].n, in ? 1.0 : 0.0);
+        if (in) {
+            ck_assert_double_eq(m.cell[g].sum0, 0.75);
+            ck_assert_double_eq(m.cell[g].sq1, 0.25);
+            ck_assert_double_eq(m.cell[g].t0, 3.0);
+        }
+        regions += m.cell[g].n;
+    }
+    ck_assert_double_eq(regions, 10.0);
+    ck_assert_double_eq(m.block[0].n, 1.0);
+    ck_assert_double_eq(m.block[0].sum1, -0.5);
+    for (size_t k = 0; k <= m.blocks; k++)
+        blocks += m.block[k].n;
+    ck_assert_double_eq(blocks, 1.0);
+    ck_assert_double_eq(m.bin[0][30].n, 1.0);      /* (0.5 + 1) / 2 of 40 bins */
+    ck_assert_double_eq(m.bin[0][30].sum_at, 0.5);
+    ck_assert_double_eq(m.bin[1][0].n, 1.0);       /* the range's one band: its first */
+    ck_assert_double_eq(m.bin[1][0].sum_at, 0.25);
+    ck_assert_double_eq(m.bin[2][0].n, 1.0);
+    ck_assert_double_eq(m.bin[2][0].sum_at, 10.0);
+    for (int v = 0; v < 3; v++)
+        for (int j = 0; j < FE_RESIDUAL_BINS; j++)
+            bins += m.bin[v][j].n;
+    ck_assert_double_eq(bins, 3.0);
+    ck_assert_uint_eq(m.n, 1);
+}
+END_TEST
+
 START_TEST(a_part_numbers_its_recordings_from_zero)
 {
     /* Seed 10117's locate:764 and its neighbours: the recordings of a part
@@ -1533,6 +1588,7 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, the_largest_statistic_after_the_terms_looks_at_the_regions);
     tcase_add_test(t, cells_of_two_rows_are_tested_and_of_one_not);
     tcase_add_test(t, merge_of_consecutive_parts_equals_whole);
+    tcase_add_test(t, a_row_joins_every_region_it_lies_in);
     tcase_add_test(t, the_lag_one_statistic_is_a_mean_product_over_a_mean_square);
     tcase_add_test(t, a_window_without_pairs_has_no_autocorrelation_figure);
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);

@@ -305,6 +305,49 @@ START_TEST(precision_at_large_offset)
 }
 END_TEST
 
+/* The block's correction, where the provisional mean is far off: 64
+   values 2^52 + k, k = 7i mod 5 in 0 .. 4, whose sums (to 2^58) round to
+   multiples of up to 64, so that the first pass's mean can miss by a
+   whole unit where the spread is about 1.4.  The deviations from any
+   double near 2^52 are exact integers, and so are their squares' sum,
+   their sum c and c^2 / 64: the corrected two-pass sum of squares,
+   sum d^2 - c^2 / 64, is exactly that of the k about their mean, worked
+   here from the k alone (127 / 64 their mean).  Every kernel must give
+   it to the bit; the uncorrected sum about a mean summed in order is
+   off by more than a third of it (191 against 8255 / 64), so the
+   correction is what is tested. */
+START_TEST(correction_takes_out_a_provisional_mean_far_off)
+{
+    enum { M = 64 };
+    const double big = 4503599627370496.0;      /* 2^52 */
+    double x[M], kmean = 0.0, exact = 0.0, seq = 0.0, naive = 0.0;
+    fe_meanvar fast = FE_MEANVAR_EMPTY, loops = FE_MEANVAR_EMPTY, sse2 = FE_MEANVAR_EMPTY;
+    for (int i = 0; i < M; i++) {
+        x[i] = big + (double)(7 * i % 5);
+        kmean += (double)(7 * i % 5);
+        seq += x[i];
+    }
+    kmean /= M;
+    for (int i = 0; i < M; i++)
+        exact += ((double)(7 * i % 5) - kmean) * ((double)(7 * i % 5) - kmean);
+    for (int i = 0; i < M; i++)
+        naive += (x[i] - seq / M) * (x[i] - seq / M);
+    ck_assert_double_eq(kmean, 127.0 / 64.0);
+    ck_assert_msg(fabs(naive - exact) > exact / 3.0,
+                  "the provisional mean is not far off: %.17g vs %.17g", naive, exact);
+    ck_assert_int_eq(fe_meanvar_add_many(&fast, x, M, NULL), FE_OK);
+    ck_assert_int_eq(fe__meanvar_block_portable(x, M, &loops), FE_OK);
+    ck_assert_int_eq(fe__meanvar_block_sse2(x, M, &sse2), FE_OK);
+    ck_assert_double_eq(fast.m2, exact);
+    ck_assert_double_eq(loops.m2, exact);
+    ck_assert_double_eq(sse2.m2, exact);
+    /* The mean, 2^52 + 127/64, to the nearest integer, the spacing there. */
+    ck_assert_double_eq(fast.mean, big + 2.0);
+    ck_assert_double_eq(loops.mean, big + 2.0);
+    ck_assert_double_eq(sse2.mean, big + 2.0);
+}
+END_TEST
+
 START_TEST(small_values_far_from_one)
 {
     /* Values of 1e-6 + 1e-9 u (u uniform): the bulk path's mean and
@@ -364,6 +407,7 @@ Suite *fe_meanvar_suite(void)
     tcase_add_test(t, every_kernel_gives_the_loops_bits);
     tcase_add_test(t, precision_at_large_offset);
     tcase_add_test(t, small_values_far_from_one);
+    tcase_add_test(t, correction_takes_out_a_provisional_mean_far_off);
     tcase_add_test(t, merge_overflow_at_its_edge);
     suite_add_tcase(s, t);
     return s;

@@ -31,6 +31,13 @@ static int rig_jacobian(const fe_sample *s, const double *th, double *jac, void 
     return 0;
 }
 
+/* A user term: the sample's time, scaled by *user. */
+static double time_term(const fe_sample *s, const fe_catalog_scale *scale, void *user)
+{
+    (void)scale;
+    return *(const double *)user * s->t;
+}
+
 static int calls;
 static int counting_predict(const fe_sample *s, const double *th, double *y, void *user)
 {
@@ -569,6 +576,33 @@ START_TEST(arguments_and_failing_callbacks)
     bad.names = NULL;
     ck_assert_int_eq(fe_model_acc_init(&a, &bad, &c, 4, 100, st, nst), FE_OK);
     ck_assert_str_eq(fe_model_group_name(&a, 1), "theta2");
+    /* The widest model, p + terms = FE_DISCOVER_MAX_GROUPS groups (the
+       position terms and user terms up to it): the last group is named,
+       and the one after it, where groups[] has no entry, is out of range:
+       NULL, as model.h says. */
+    {
+        fe_catalog wide;
+        double one = 1.0, *stw;
+        size_t nw;
+        char tn[FE_DISCOVER_MAX_GROUPS][16];
+        ck_assert_int_eq(fe_catalog_init(&wide, FE_ROLE_POSITION, &sc), FE_OK);
+        for (size_t j = wide.count; 3 + j < FE_DISCOVER_MAX_GROUPS; j++) {
+            snprintf(tn[j], sizeof tn[j], "w%zu", j);
+            ck_assert_int_eq(fe_catalog_add(&wide, tn[j], "", time_term, &one), FE_OK);
+        }
+        ck_assert_uint_eq(3 + wide.count, FE_DISCOVER_MAX_GROUPS);
+        nw = fe_model_acc_doubles(3, wide.count, 4);
+        ck_assert_uint_gt(nw, 0);
+        stw = malloc(nw * sizeof *stw);
+        ck_assert_ptr_nonnull(stw);
+        ck_assert_int_eq(fe_model_acc_init(&a, &m, &wide, 4, 100, stw, nw), FE_OK);
+        ck_assert_uint_eq(a.ngroups, FE_DISCOVER_MAX_GROUPS);
+        ck_assert_str_eq(fe_model_group_name(&a, FE_DISCOVER_MAX_GROUPS - 1),
+                         tn[FE_DISCOVER_MAX_GROUPS - 4]);
+        ck_assert_ptr_null(fe_model_group_name(&a, FE_DISCOVER_MAX_GROUPS));
+        ck_assert_ptr_null(fe_model_group_name(&a, FE_DISCOVER_MAX_GROUPS + 1));
+        free(stw);
+    }
     /* Rows: failing and non-finite Jacobians, failing finite differences,
        NULL arguments; every refusal leaves the accumulation as it was. */
     ck_assert_int_eq(fe_model_acc_init(&a, &m, &c, 4, 100, st, nst), FE_OK);

@@ -46,6 +46,11 @@ START_TEST(empty_and_one_sample)
     fe_quadric q = FE_QUADRIC_EMPTY, e = FE_QUADRIC_EMPTY;
     ck_assert_uint_eq(fe_quadric_count(&q), 0);
     ck_assert_int_eq(fe_quadric_regions(&q), 0);
+    ck_assert_double_eq(fe_quadric_coverage(&q), 0.0);
+    /* A NULL accumulation reads as an empty one (quadric.h). */
+    ck_assert_uint_eq(fe_quadric_count(NULL), 0);
+    ck_assert_int_eq(fe_quadric_regions(NULL), 0);
+    ck_assert_double_eq(fe_quadric_coverage(NULL), 0.0);
     ck_assert_int_eq(fe_quadric_add_many(&q, x, 0, NULL), FE_OK);
     ck_assert_mem_eq(&q, &e, sizeof q);
     ck_assert_int_eq(fe_quadric_add(&q, x), FE_OK);
@@ -489,6 +494,37 @@ START_TEST(coverage_counts_a_region_seen_at_exactly_half_the_size)
        2, and the regions seen at 1 no longer count. */
     ck_assert_int_eq(fe_quadric_add(&q, s[4]), FE_OK);
     ck_assert_int_eq(fe_quadric_regions(&q), 1);
+}
+END_TEST
+
+/* The regions are counted from the box and the marks, whatever the
+   moments hold: a stream whose first coordinates add up to the first
+   sample's (its first moment about that reference, the first sample, is
+   0) counts its regions like any other.  (0, 0, 0): no extent.  (2, 0, 0):
+   x in [0, 2], half-width 1, centre (1, 0, 0), +x seen at 1.  (-2, 0, 0):
+   x in [-2, 2], half-width 2, centre 0, -x seen at 2.  (0, 0, 2): z in
+   [0, 2], still 2, centre (0, 0, 1), +z seen at 2.  Half the final size
+   is 1: all three count; with the centre given as (0, 0, 0) the same. */
+START_TEST(coverage_does_not_depend_on_the_first_moment)
+{
+    const double s[4][3] = {{0, 0, 0}, {2, 0, 0}, {-2, 0, 0}, {0, 0, 2}};
+    const double px[3] = {1, 0, 0}, mx[3] = {-1, 0, 0}, pz[3] = {0, 0, 1};
+    const double origin[3] = {0, 0, 0};
+    fe_quadric q = FE_QUADRIC_EMPTY, c;
+    ck_assert_int_ne(fe_quadric_region(px), fe_quadric_region(mx));
+    ck_assert_int_ne(fe_quadric_region(px), fe_quadric_region(pz));
+    ck_assert_int_ne(fe_quadric_region(mx), fe_quadric_region(pz));
+    ck_assert_int_eq(fe_quadric_init(&c, origin), FE_OK);
+    for (int i = 0; i < 4; i++) {
+        ck_assert_int_eq(fe_quadric_add(&q, s[i]), FE_OK);
+        ck_assert_int_eq(fe_quadric_add(&c, s[i]), FE_OK);
+    }
+    ck_assert_double_eq(q.m[1], 0.0);       /* x's first moment about (0, 0, 0) */
+    ck_assert_double_eq(c.m[1], 0.0);
+    ck_assert_uint_eq(fe_quadric_count(&q), 4);
+    ck_assert_int_eq(fe_quadric_regions(&q), 3);
+    ck_assert_int_eq(fe_quadric_regions(&c), 3);
+    FE_ASSERT_REL(fe_quadric_coverage(&q), 0.03, 0.0);
 }
 END_TEST
 
@@ -961,6 +997,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, block_extremes_in_the_tail_of_a_block);
     tcase_add_test(t, block_coverage_of_a_hemisphere_inside_the_box);
     tcase_add_test(t, coverage_counts_a_region_seen_at_exactly_half_the_size);
+    tcase_add_test(t, coverage_does_not_depend_on_the_first_moment);
     tcase_add_test(t, compare_a_box_of_one_point_absolutely);
     tcase_add_test(t, compare_is_the_largest_scaled_difference);
     tcase_add_test(t, state_size);

@@ -82,7 +82,8 @@ int fe_quadric_compare(const fe_quadric *a, const fe_quadric *b, double *apart);
 
 /* fe_quadric_count: N.  fe_quadric_regions: the number of regions
    visited while the box was at least half its final size (its largest
-   half-width).  fe_quadric_coverage: their fraction of 100, in [0, 1]. */
+   half-width).  fe_quadric_coverage: their fraction of 100, in [0, 1].
+   Each reads a NULL q, as an empty one, as 0. */
 uint64_t fe_quadric_count(const fe_quadric *q);
 double fe_quadric_coverage(const fe_quadric *q);
 int fe_quadric_regions(const fe_quadric *q);
