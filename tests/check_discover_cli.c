@@ -25,6 +25,17 @@ static void make_dir(void)
     ck_assert_ptr_nonnull(mkdtemp(dir));
 }
 
+/* Open dir/real and dir/sim for writing: a recording and its simulation. */
+static void open_pair(const char *real, const char *sim, FILE **fr, FILE **fs)
+{
+    char path[128];
+    snprintf(path, sizeof path, "%s/%s", dir, real);
+    *fr = fopen(path, "w");
+    snprintf(path, sizeof path, "%s/%s", dir, sim);
+    *fs = fopen(path, "w");
+    ck_assert(*fr != NULL && *fs != NULL);
+}
+
 
 
 START_TEST(concealed_drag_is_named_and_the_null_is_not)
@@ -101,15 +112,11 @@ END_TEST
 START_TEST(a_pair_that_explains_only_together_is_reported_as_one)
 {
     static char out[65536];
-    char cmd[2048], path[128];
+    char cmd[2048];
     FILE *r, *sm;
     fe_rng g = fe_rng_seed(23);
     make_dir();
-    snprintf(path, sizeof path, "%s/r.csv", dir);
-    r = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/s.csv", dir);
-    sm = fopen(path, "w");
-    ck_assert(r != NULL && sm != NULL);
+    open_pair("r.csv", "s.csv", &r, &sm);
     fprintf(r, "time,y\n");
     fprintf(sm, "time,y,x1,x2,x3\n");
     for (int t = 0; t < 2000; t++) {
@@ -275,7 +282,6 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     fe_synth_spec spec = fe_synth_default_spec("viscous_friction", 5);
     fe_sample smp;
     FILE *fr, *fs;
-    char path[256];
     make_dir();
     snprintf(cmd, sizeof cmd, "%s synth --effect viscous_friction --order 2 --seed 3 --rows 6000 "
              "--real %s/r.csv --sim %s/s.csv", FE_TEST_CLI, dir, dir);
@@ -317,11 +323,7 @@ START_TEST(output_error_is_named_in_the_derivative_it_enters)
     spec.rows = 6000;
     spec.parting = 100.0;
     ck_assert_int_eq(fe_synth_init(&g, &spec), FE_OK);
-    snprintf(path, sizeof path, "%s/wr.csv", dir);
-    fr = fopen(path, "w");
-    snprintf(path, sizeof path, "%s/ws.csv", dir);
-    fs = fopen(path, "w");
-    ck_assert(fr != NULL && fs != NULL);
+    open_pair("wr.csv", "ws.csv", &fr, &fs);
     fprintf(fr, "time,position\n");
     fprintf(fs, "time,position,velocity,input\n");
     while (fe_synth_next(&g, &smp) == FE_OK) {
@@ -359,14 +361,11 @@ START_TEST(a_function_of_the_state_left_is_not_explained)
        drift is named, the probes of the velocity find the bump, and the
        verdict is not "explained", in the story and in the JSON. */
     static char out[65536];
-    char cmd[2048], path[256];
+    char cmd[2048];
     fe_rng g = fe_rng_seed(11);
     FILE *fr, *fs;
     make_dir();
-    snprintf(path, sizeof path, "%s/r.csv", dir);
-    ck_assert_ptr_nonnull(fr = fopen(path, "w"));
-    snprintf(path, sizeof path, "%s/s.csv", dir);
-    ck_assert_ptr_nonnull(fs = fopen(path, "w"));
+    open_pair("r.csv", "s.csv", &fr, &fs);
     fprintf(fr, "t,y\n");
     fprintf(fs, "t,y,v\n");
     for (int i = 0; i < 5000; i++) {
