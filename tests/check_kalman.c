@@ -1821,6 +1821,69 @@ START_TEST(a_merge_that_overflows_in_any_one_sum_is_refused)
 }
 END_TEST
 
+/* Issue 20: the information prior's covariance P0 is refused when any of
+   its n^2 entries is not finite (FE_ENONFINITE, the accumulation as it
+   was), even an entry of the lower triangle, which the Cholesky solve
+   ('U') never reads and would otherwise pass over silently. */
+START_TEST(an_information_prior_not_finite_in_any_entry_is_refused)
+{
+    enum { N = 3 };
+    const double P0[N * N] = {4, 1, 0, 1, 3, 1, 0, 1, 2}, x0[N] = {1, -2, 3};
+    const double bad[2] = {NAN, INFINITY};
+    for (size_t pos = 0; pos < N * N; pos++)
+        for (int b = 0; b < 2; b++) {
+            kinfo s;
+            double P[N * N], snap_L[N * N], snap_e[N];
+            kinfo_make(&s, N, 1);
+            ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, x0, 2.0), FE_OK);
+            memcpy(snap_L, s.s.Lambda, sizeof snap_L);
+            memcpy(snap_e, s.s.eta, sizeof snap_e);
+            memcpy(P, P0, sizeof P);
+            P[pos] = bad[b];
+            ck_assert_msg(fe_kalman_info_set_prior(&s.s, x0, P) == FE_ENONFINITE,
+                          "P0[%zu] = %g taken", pos, bad[b]);
+            ck_assert_mem_eq(s.s.Lambda, snap_L, sizeof snap_L);
+            ck_assert_mem_eq(s.s.eta, snap_e, sizeof snap_e);
+            free(s.mem);
+        }
+}
+END_TEST
+
+/* Issue 20: the covariance form of an information accumulation whose
+   state is not a double is refused, the filter unchanged.  Lambda =
+   1e-300 I (a prior variance of 1e300) and eta = (1e10, 1): P = 1e300 I
+   is finite, but x = P eta = (1e310, 1e300), its first entry past
+   DBL_MAX. */
+START_TEST(a_covariance_form_whose_state_overflows_is_refused)
+{
+    kinfo s;
+    kf f;
+    fe_kalman desc;
+    double snap[2 + 4];
+    const double x1[2] = {3.0, -1.0};
+    kinfo_make(&s, 2, 1);
+    kf_make(&f, 2, 1);
+    ck_assert_int_eq(fe_kalman_set_prior_scaled(&f.k, x1, 5.0), FE_OK);
+    memcpy(snap, f.mem, sizeof snap);
+    desc = f.k;
+    ck_assert_int_eq(fe_kalman_info_set_prior_scaled(&s.s, NULL, 1e300), FE_OK);
+    ck_assert_double_eq(s.s.Lambda[0], 1e-300);
+    s.s.eta[0] = 1e10;
+    s.s.eta[1] = 1.0;
+    ck_assert(!isfinite(1e300 * 1e10));
+    ck_assert_int_eq(fe_kalman_info_to_kalman(&s.s, &f.k), FE_ENONFINITE);
+    ASSERT_UNCHANGED(f, snap, desc);
+    /* With eta = (1e-10, 1) the state (1e290, 1e300) is a double, taken. */
+    s.s.eta[0] = 1e-10;
+    ck_assert_int_eq(fe_kalman_info_to_kalman(&s.s, &f.k), FE_OK);
+    ck_assert_double_eq_tol(f.k.x[0], 1e290, 1e276);
+    ck_assert_double_eq_tol(f.k.x[1], 1e300, 1e286);
+    ck_assert_double_eq_tol(f.k.P[0], 1e300, 1e286);
+    free(s.mem);
+    kf_free(&f);
+}
+END_TEST
+
 START_TEST(prior_variances_are_refused_just_below_their_edges)
 {
     kf f;
@@ -1960,6 +2023,8 @@ Suite *fe_kalman_suite(void)
     tcase_add_test(t, a_packet_of_bmax_is_folded_and_one_more_refused_by_every_step);
     tcase_add_test(t, prior_variances_are_refused_just_below_their_edges);
     tcase_add_test(t, a_merge_that_overflows_in_any_one_sum_is_refused);
+    tcase_add_test(t, an_information_prior_not_finite_in_any_entry_is_refused);
+    tcase_add_test(t, a_covariance_form_whose_state_overflows_is_refused);
     tcase_add_test(t, monitor_ranges_are_refused_at_their_bounds_and_taken_just_inside);
     suite_add_tcase(s, t);
     return s;

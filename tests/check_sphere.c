@@ -731,6 +731,83 @@ START_TEST(damping_when_a_step_fails)
 }
 END_TEST
 
+/* The damping and step of each row of a trace, and the parameters
+   after it (frame of the solve). */
+struct sphere_steps { int n; double lambda[64], step[64], beta[64][4]; };
+
+static int keep_sphere_steps(const fe_sphere_iteration *it, void *ctx)
+{
+    struct sphere_steps *t = ctx;
+    if (t->n < 64) {
+        t->lambda[t->n] = it->lambda;
+        t->step[t->n] = it->step;
+        memcpy(t->beta[t->n], it->params, 4 * sizeof *it->params);
+    }
+    t->n++;
+    return 0;
+}
+
+START_TEST(a_short_step_ends_the_fit_only_when_hardly_damped)
+{
+    /* The stop rule of literate/sphere.org: a step of at most xtol (1 +
+       max |beta|) ends the fit only with lambda <= 1e-2; a step that is
+       short because it is damped does not.  The half sphere of
+       damping_when_a_step_fails, whose first steps are refused and damped
+       up to lambda = 0.1, fitted with xtol from 0.5 down to 0.007 (factors
+       of 0.9): in every fit each row before the last whose damping is at
+       most 1e-2 has a step over the bound (beta before the row: the box
+       guess d = 0, s = 1, then the trace's), and the last row's damping
+       is at most 1e-2.  Over the sweep some row with lambda above 1e-2
+       has a step within the bound, so the rule's second half is tried. */
+    enum { N = 5000 };
+    static double x[3 * N];
+    fe_quadric q = FE_QUADRIC_EMPTY;
+    fe_rng g = fe_rng_seed(3);
+    int damped_short = 0;
+    for (size_t i = 0; i < N; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(&g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        v[0] = fabs(v[0]);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(&g);
+    }
+    ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
+    for (int k = 0; k <= 40; k++) {
+        fe_sphere_options o = fe_sphere_default_options();
+        fe_sphere_fit f;
+        static struct sphere_steps t;
+        double before[4] = {0, 0, 0, 1};
+        o.min_extent = 0.0;
+        o.xtol = 0.5 * pow(0.9, k);
+        o.trace = keep_sphere_steps;
+        o.trace_ctx = &t;
+        t.n = 0;
+        ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
+        ck_assert_int_eq(t.n, f.iterations);
+        ck_assert_int_le(t.n, 64);
+        for (int r = 0; r < t.n; r++) {
+            double bmax = 0.0;
+            for (int a = 0; a < 4; a++)
+                bmax = fmax(bmax, fabs(before[a]));
+            if (t.lambda[r] > 1e-2)
+                damped_short += t.step[r] <= o.xtol * (1.0 + bmax);
+            else if (r + 1 < t.n)
+                ck_assert_msg(t.step[r] > o.xtol * (1.0 + bmax),
+                              "xtol %g, row %d: step %g within the bound, not the last",
+                              o.xtol, r + 1, t.step[r]);
+            memcpy(before, t.beta[r], sizeof before);
+        }
+        ck_assert_msg(t.lambda[t.n - 1] <= 1e-2, "xtol %g: the fit ended at lambda %g",
+                      o.xtol, t.lambda[t.n - 1]);
+    }
+    ck_assert_int_gt(damped_short, 0);
+}
+END_TEST
+
 START_TEST(refuse_too_few_and_bad_arguments)
 {
     double x[3 * 6];
@@ -2041,6 +2118,7 @@ Suite *fe_sphere_suite(void)
     tcase_add_test(t, params_are_the_fitted_shape);
     tcase_add_test(t, sphere_stops_where_the_predicted_decrease_is_rounding);
     tcase_add_test(t, trace_and_stop);
+    tcase_add_test(t, a_short_step_ends_the_fit_only_when_hardly_damped);
     tcase_add_test(t, damping_when_a_step_fails);
     tcase_add_test(t, refuse_too_few_and_bad_arguments);
     tcase_add_test(t, refuse_planar_data);
