@@ -521,15 +521,16 @@ START_TEST(algebraic_covariance_is_the_linear_estimators)
 }
 END_TEST
 
-/* The rows of a fit's trace: damping, acceptance, and the parameters
-   after each iteration (frame of the solve). */
-struct sphere_rows { int n; double lambda[64]; int accepted[64]; double beta[64][4]; };
+/* The rows of a fit's trace: damping, acceptance, step, and the
+   parameters after each iteration (frame of the solve). */
+struct sphere_rows { int n; double lambda[64], step[64]; int accepted[64]; double beta[64][4]; };
 
 static int keep_sphere_rows(const fe_sphere_iteration *it, void *ctx)
 {
     struct sphere_rows *t = ctx;
     if (t->n < 64) {
         t->lambda[t->n] = it->lambda;
+        t->step[t->n] = it->step;
         t->accepted[t->n] = it->accepted;
         memcpy(t->beta[t->n], it->params, 4 * sizeof *it->params);
     }
@@ -697,6 +698,23 @@ static int watch_damping(const fe_sphere_iteration *it, void *ctx)
     return 0;
 }
 
+/* n samples of the half (x > centre) of the ellipsoid C0, R0, with noise
+   of 20 on each axis. */
+static void half_sphere(fe_rng *g, double *x, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        double v[3], s = 0.0;
+        for (int j = 0; j < 3; j++) {
+            v[j] = fe_rng_normal(g);
+            s += v[j] * v[j];
+        }
+        s = sqrt(s);
+        v[0] = fabs(v[0]);
+        for (int j = 0; j < 3; j++)
+            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(g);
+    }
+}
+
 START_TEST(damping_when_a_step_fails)
 {
     /* Half a sphere (x > centre), fitted with the hemisphere check off:
@@ -709,17 +727,7 @@ START_TEST(damping_when_a_step_fails)
     fe_sphere_fit f;
     struct damping d = {0, 0, 0, 0.0};
     fe_rng g = fe_rng_seed(3);
-    for (size_t i = 0; i < N; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = sqrt(s);
-        v[0] = fabs(v[0]);
-        for (int j = 0; j < 3; j++)
-            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(&g);
-    }
+    half_sphere(&g, x, N);
     fe_quadric_add_many(&q, x, N, NULL);
     o.min_extent = 0.0;
     o.trace = watch_damping;
@@ -730,22 +738,6 @@ START_TEST(damping_when_a_step_fails)
     ck_assert_double_eq_tol(f.radius, 400, 20);
 }
 END_TEST
-
-/* The damping and step of each row of a trace, and the parameters
-   after it (frame of the solve). */
-struct sphere_steps { int n; double lambda[64], step[64], beta[64][4]; };
-
-static int keep_sphere_steps(const fe_sphere_iteration *it, void *ctx)
-{
-    struct sphere_steps *t = ctx;
-    if (t->n < 64) {
-        t->lambda[t->n] = it->lambda;
-        t->step[t->n] = it->step;
-        memcpy(t->beta[t->n], it->params, 4 * sizeof *it->params);
-    }
-    t->n++;
-    return 0;
-}
 
 START_TEST(a_short_step_ends_the_fit_only_when_hardly_damped)
 {
@@ -764,26 +756,16 @@ START_TEST(a_short_step_ends_the_fit_only_when_hardly_damped)
     fe_quadric q = FE_QUADRIC_EMPTY;
     fe_rng g = fe_rng_seed(3);
     int damped_short = 0;
-    for (size_t i = 0; i < N; i++) {
-        double v[3], s = 0.0;
-        for (int j = 0; j < 3; j++) {
-            v[j] = fe_rng_normal(&g);
-            s += v[j] * v[j];
-        }
-        s = sqrt(s);
-        v[0] = fabs(v[0]);
-        for (int j = 0; j < 3; j++)
-            x[3 * i + j] = C0[j] + R0[j] * v[j] / s + 20.0 * fe_rng_normal(&g);
-    }
+    half_sphere(&g, x, N);
     ck_assert_int_eq(fe_quadric_add_many(&q, x, N, NULL), FE_OK);
     for (int k = 0; k <= 40; k++) {
         fe_sphere_options o = fe_sphere_default_options();
         fe_sphere_fit f;
-        static struct sphere_steps t;
+        static struct sphere_rows t;
         double before[4] = {0, 0, 0, 1};
         o.min_extent = 0.0;
         o.xtol = 0.5 * pow(0.9, k);
-        o.trace = keep_sphere_steps;
+        o.trace = keep_sphere_rows;
         o.trace_ctx = &t;
         t.n = 0;
         ck_assert_int_eq(fe_sphere_fit_moments(&q, FE_FIT_SPHERE, &o, &f), FE_OK);
