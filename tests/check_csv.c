@@ -371,6 +371,59 @@ START_TEST(too_long_line_at_the_end_and_a_read_error_while_skipping)
 }
 END_TEST
 
+/* A read error while a line is being completed (not while a long line is
+   skipped) is FE_EIO, not a line too long nor the end of the input; and a
+   line holding only a carriage return is an empty line, at the end of the
+   input too. */
+START_TEST(a_read_error_inside_a_line_and_a_lone_carriage_return)
+{
+    char *line, buf[16];
+    size_t len = 99;
+    fe_csv_reader r;
+    struct failing f = {"1,2\n3,", 0};
+    struct chunks c = {"a\n\r\nb\n\r", 0, 64};
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_then_fail, &f, buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "1,2");
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_EIO);
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, buf, sizeof buf), FE_OK);
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+    ck_assert_str_eq(line, "a");
+    for (int i = 0; i < 3; i++) {
+        const char *want = i == 1 ? "b" : "";
+        len = 99;
+        ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+        ck_assert_str_eq(line, want);
+        ck_assert_uint_eq(len, strlen(want));
+    }
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+}
+END_TEST
+
+/* The reader reads and writes nothing before its buffer: an empty line at
+   the buffer's start, first and again after a refill moved the rest to
+   the front, is empty though the byte before the buffer is a carriage
+   return, and that byte is left as it was. */
+START_TEST(an_empty_line_at_the_buffer_start_looks_at_nothing_before_it)
+{
+    char store[1 + 8], *line;
+    size_t len = 99;
+    fe_csv_reader r;
+    struct chunks c = {"\n1,2\n3\n\n4\n", 0, 64};   /* 7 bytes, then the rest */
+    store[0] = '\r';
+    ck_assert_int_eq(fe_csv_reader_init_read(&r, read_chunks, &c, store + 1, 8), FE_OK);
+    for (int i = 0; i < 5; i++) {
+        const char *want[] = {"", "1,2", "3", "", "4"};
+        len = 99;
+        ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_OK);
+        ck_assert_str_eq(line, want[i]);
+        ck_assert_uint_eq(len, strlen(want[i]));
+    }
+    ck_assert_int_eq(fe_csv_next_line(&r, &line, &len), FE_END);
+    ck_assert_int_eq(store[0], '\r');
+}
+END_TEST
+
 /* Each missing argument of the two number parsers alone. */
 START_TEST(number_parsers_refuse_each_missing_argument)
 {
@@ -849,6 +902,8 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, byte_order_mark_at_its_edges);
     tcase_add_test(t, strtod_extensions_are_not_numbers);
     tcase_add_test(t, too_long_line_at_the_end_and_a_read_error_while_skipping);
+    tcase_add_test(t, a_read_error_inside_a_line_and_a_lone_carriage_return);
+    tcase_add_test(t, an_empty_line_at_the_buffer_start_looks_at_nothing_before_it);
     tcase_add_test(t, number_parsers_refuse_each_missing_argument);
     tcase_add_test(t, a_double_is_written_in_the_fewest_of_15_16_and_17_digits);
     tcase_add_test(t, numbers_read_and_written_alike_in_any_locale);
