@@ -366,11 +366,12 @@ static const char *fe__csv_digits(const char *s, uint64_t *w)
     return s;
 }
 
-/* A whole field that is a plain decimal with w <= 2^53 and |q| <= 22 (see
-   the text): *value, and 1.  Otherwise 0, and strtod decides.  At most 19
-   digits in all keep w below 10^19 < 2^64, so the digits are read
-   without a test for overflow; w <= 2^53 is asked once, at the end. */
-static int fe__csv_fast_number(const char *s, double *value)
+/* The plain decimal at s with w <= 2^53 and |q| <= 22 (see the text),
+   ended by the NUL or by `end`: *value, and the byte that ends it.
+   Otherwise NULL, and strtod decides.  At most 19 digits in all keep w
+   below 10^19 < 2^64, so the digits are read without a test for
+   overflow; w <= 2^53 is asked once, at the end. */
+static inline const char *fe__csv_fast_span(const char *s, char end, double *value)
 {
     static const double sign[2] = {1.0, -1.0};
     uint64_t w = 0;
@@ -385,35 +386,41 @@ static int fe__csv_fast_number(const char *s, double *value)
         q = -(int)(s - point - 1);
     }
     if ((size_t)(s - first) - (*point == '.') - 1 > 18)
-        return 0;                               /* no digit, or over 19 */
-    if (*s != '\0') {
+        return NULL;                            /* no digit, or over 19 */
+    if (*s != '\0' && *s != end) {
         int e = 0, eneg = 0;
         if (*s != 'e' && *s != 'E')
-            return 0;
+            return NULL;
         s++;
         if (*s == '+' || *s == '-')
             eneg = *s++ == '-';
         if ((unsigned)(*s - '0') >= 10u)
-            return 0;
+            return NULL;
         for (; (unsigned)(*s - '0') < 10u; s++)
             if (e < 10000)
                 e = 10 * e + (*s - '0');
-        if (*s != '\0')
-            return 0;
+        if (*s != '\0' && *s != end)
+            return NULL;
         q += eneg ? -e : e;
     }
     if (w > (UINT64_C(1) << 53))
-        return 0;
+        return NULL;
     if (w == 0) {
         *value = sign[neg] * 0.0;
-        return 1;
+        return s;
     }
     if (q < -22 || q > 22)
-        return 0;
+        return NULL;
     v = (double)(int64_t)w;                     /* w <= 2^53: exact */
     v = q < 0 ? v / fe__csv_pow10[-q] : v * fe__csv_pow10[q];
     *value = sign[neg] * v;
-    return 1;
+    return s;
+}
+
+/* A whole field that the fast path takes: *value, and 1; otherwise 0. */
+static int fe__csv_fast_number(const char *s, double *value)
+{
+    return fe__csv_fast_span(s, '\0', value) != NULL;
 }
 
 /* Is s entirely a plain decimal with `point` as its decimal mark? */
@@ -574,3 +581,33 @@ int fe_csv_number_comma(const fe_csv_field *field, double *value)
     return fe_csv_number(&f, value);
 }
 /* Parse a field as a number ends here */
+/* [[file:../literate/csv.org::Read a line of plain numbers in one pass][Read a line of plain numbers in one pass]] */
+int fe_csv_numbers(const char *line, char delimiter, double *values, size_t max,
+                   size_t *count)
+{
+    size_t k = 0;
+    if (line == NULL || values == NULL || count == NULL)
+        return FE_EINVAL;
+    if (delimiter == FE_CSV_WHITESPACE || delimiter == '\0'
+        || strchr("0123456789+-.eE", delimiter) != NULL)
+        return FE_EINVAL;
+    for (;;) {
+        double v;
+        const char *end = fe__csv_fast_span(line, delimiter, &v);
+        if (end == NULL) {
+            *count = k;
+            return FE_EPARSE;
+        }
+        if (k == max) {
+            *count = max + 1;
+            return FE_ESIZE;
+        }
+        values[k++] = v;
+        if (*end == '\0')
+            break;
+        line = end + 1;
+    }
+    *count = k;
+    return FE_OK;
+}
+/* Read a line of plain numbers in one pass ends here */

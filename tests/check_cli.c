@@ -80,6 +80,8 @@ static const struct cli_case cases[] = {
     {"infinity word", "stats", "a\n1\nInfinity\n", 3, "'Infinity' in column 'a' is not a finite number"},
     {"nan with a payload", "stats", "a\n1\nnan(0x7)\n", 3, "'nan(0x7)' in column 'a' is not a number"},
     {"empty cell", "stats", "a,b\n1,2\n3,\n", 3, "%s:3:3: empty cell in column 'b'"},
+    {"more fields than the header", "stats", "a,b\n1,2\n3,4,5\n", 3,
+     "%s:3:1: expected 2 fields, found 3"},
     {"empty cell first", "stats", "a,b\n1,2\n,4\n", 3, "%s:3:1: empty cell in column 'a'"},
     {"--skip-bad-rows counts by reason", "stats --skip-bad-rows --json",
      "a,b\n1,2\n,3\nNaN,4\nx,5\n7\n3,6\n", 0,
@@ -149,6 +151,41 @@ START_TEST(stats_over_runs_of_rows)
         FE_ASSERT_REL(sd, sqrt((double)(ss[j] / (N - 1))), 1e-14);
         ck_assert_double_eq(lo, j == 0 ? 1 : -5000);
         ck_assert_double_eq(hi, j == 0 ? 5000 : -1);
+    }
+    snprintf(want, sizeof want, "\"rows\": %d,", N);
+    ck_assert_ptr_nonnull(strstr(out, want));
+}
+END_TEST
+
+/* Rows that the one pass reads and rows it declines give the numbers a
+   long-double sum of the values written gives: 100 rows of numbers,
+   every seventh with a padded, quoted or exponent field among them, then
+   200 rows whose unused first column is text (the one pass declines 64
+   of them in a row and stops asking), and the rows' count. */
+START_TEST(rows_the_one_pass_declines_read_as_before)
+{
+    enum { N = 300 };
+    static char text[N * 48 + 16];
+    char out[4096], path[64], want[64];
+    size_t len = (size_t)sprintf(text, "label,x,y\n");
+    long double sum[2] = {0, 0};
+    for (int i = 0; i < N; i++) {
+        double x = 0.001 * (double)((i * 7919) % 1000) - 0.5, y = 25.0 + 0.25 * (i % 37);
+        const char *form = i >= 100 ? "r%d,%.3f,%.2f\n" : i % 21 == 0 ? "%d, %.3f,%.2f\n"
+                           : i % 21 == 7 ? "%d,%.3f,\"%.2f\"\n" : i % 21 == 14 ? "%d,%.3f,%.2fe0\n"
+                           : "%d,%.3f,%.2f\n";
+        len += (size_t)sprintf(text + len, form, i, x, y);
+        sum[0] += x;
+        sum[1] += y;
+    }
+    ck_assert_int_eq(run_on("stats --columns x,y --json", text, len, out, sizeof out, path,
+                            sizeof path), 0);
+    for (int j = 0; j < 2; j++) {
+        const char *at = strstr(out, j == 0 ? "\"name\": \"x\"" : "\"name\": \"y\"");
+        double mean;
+        ck_assert_ptr_nonnull(at);
+        ck_assert_int_eq(sscanf(at + 11, ", \"mean\": %lg", &mean), 1);
+        FE_ASSERT_REL(mean, (double)(sum[j] / N), 1e-13);
     }
     snprintf(want, sizeof want, "\"rows\": %d,", N);
     ck_assert_ptr_nonnull(strstr(out, want));
@@ -679,6 +716,7 @@ Suite *fe_cli_suite(void)
     tcase_set_timeout(t, 60);
     tcase_add_loop_test(t, table_driven, 0, (int)(sizeof cases / sizeof cases[0]));
     tcase_add_test(t, stats_over_runs_of_rows);
+    tcase_add_test(t, rows_the_one_pass_declines_read_as_before);
     tcase_add_test(t, binary_and_long_lines);
     tcase_add_test(t, json_outputs_follow_their_schemas);
     tcase_add_test(t, schema_validator_refuses);

@@ -832,44 +832,52 @@ static int ref_plain(const char *s)
 
 /* Text over "0123456789.eE+-" and a stray byte or two, most of it shaped
    like a decimal (sign, 0 to 22 digits, a point, 0 to 22 digits, an
-   exponent): fe_csv_number says what the grammar and strtod say, to the
-   bit, and leaves the value alone when it refuses. */
-START_TEST(numbers_match_the_grammar_and_strtod_on_random_text)
+   exponent), NUL-terminated in text (at least 64 bytes); its length. */
+static size_t random_decimal(fe_rng *g, char *text)
 {
     static const char alphabet[] = "0123456789.eE+-";
+    size_t n = 0;
+    if (fe_rng_next(g) % 4 == 0) {
+        size_t len = fe_rng_next(g) % 24;
+        for (; n < len; n++)
+            text[n] = alphabet[fe_rng_next(g) % (sizeof alphabet - 1)];
+    } else {
+        size_t a = fe_rng_next(g) % 23, b = fe_rng_next(g) % 23;
+        if (fe_rng_next(g) % 2)
+            text[n++] = "+-"[fe_rng_next(g) % 2];
+        for (size_t i = 0; i < a; i++)
+            text[n++] = (char)('0' + fe_rng_next(g) % 10);
+        if (fe_rng_next(g) % 4 != 0)
+            text[n++] = '.';
+        for (size_t i = 0; i < b; i++)
+            text[n++] = (char)('0' + fe_rng_next(g) % 10);
+        if (fe_rng_next(g) % 4 == 0) {
+            text[n++] = "eE"[fe_rng_next(g) % 2];
+            if (fe_rng_next(g) % 2)
+                text[n++] = "+-"[fe_rng_next(g) % 2];
+            for (size_t i = fe_rng_next(g) % 4; i > 0; i--)
+                text[n++] = (char)('0' + fe_rng_next(g) % 10);
+        }
+        if (fe_rng_next(g) % 16 == 0)
+            text[n++] = "x. e1"[fe_rng_next(g) % 5];
+    }
+    text[n] = '\0';
+    return n;
+}
+
+/* Random decimals (random_decimal): fe_csv_number says what the grammar
+   and strtod say, to the bit, and leaves the value alone when it
+   refuses. */
+START_TEST(numbers_match_the_grammar_and_strtod_on_random_text)
+{
     fe_rng g = fe_rng_seed(17);
     int cases = fe_test_quick() ? 10000 : 300000;
     char text[80];
     for (int t = 0; t < cases; t++) {
-        size_t n = 0;
         fe_csv_field f = {text, 1};
         double v = -7.0, want = -7.0;
         int rc, rwant;
-        if (fe_rng_next(&g) % 4 == 0) {
-            size_t len = fe_rng_next(&g) % 24;
-            for (; n < len; n++)
-                text[n] = alphabet[fe_rng_next(&g) % (sizeof alphabet - 1)];
-        } else {
-            size_t a = fe_rng_next(&g) % 23, b = fe_rng_next(&g) % 23;
-            if (fe_rng_next(&g) % 2)
-                text[n++] = "+-"[fe_rng_next(&g) % 2];
-            for (size_t i = 0; i < a; i++)
-                text[n++] = (char)('0' + fe_rng_next(&g) % 10);
-            if (fe_rng_next(&g) % 4 != 0)
-                text[n++] = '.';
-            for (size_t i = 0; i < b; i++)
-                text[n++] = (char)('0' + fe_rng_next(&g) % 10);
-            if (fe_rng_next(&g) % 4 == 0) {
-                text[n++] = "eE"[fe_rng_next(&g) % 2];
-                if (fe_rng_next(&g) % 2)
-                    text[n++] = "+-"[fe_rng_next(&g) % 2];
-                for (size_t i = fe_rng_next(&g) % 4; i > 0; i--)
-                    text[n++] = (char)('0' + fe_rng_next(&g) % 10);
-            }
-            if (fe_rng_next(&g) % 16 == 0)
-                text[n++] = "x. e1"[fe_rng_next(&g) % 5];
-        }
-        text[n] = '\0';
+        random_decimal(&g, text);
         rc = fe_csv_number(&f, &v);
         if (!ref_plain(text)) {
             rwant = FE_EPARSE;
@@ -883,6 +891,129 @@ START_TEST(numbers_match_the_grammar_and_strtod_on_random_text)
         if (rc != rwant || memcmp(&v, &want, sizeof v) != 0)
             ck_abort_msg("'%s': %d %.17g, want %d %.17g", text, rc, v, rwant, want);
     }
+}
+END_TEST
+
+/* Does the fast path take this field, by the chapter's rule, worked out
+   here on its own: a plain decimal of 1 to 19 digits whose integer w is
+   at most 2^53, and zero or within 10^22 after its exponent. */
+static int ref_fast(const char *s)
+{
+    uint64_t w = 0;
+    long q = 0, e = 0;
+    int digits = 0, eneg = 0;
+    if (!ref_plain(s))
+        return 0;
+    if (*s == '+' || *s == '-')
+        s++;
+    for (; *s >= '0' && *s <= '9'; s++, digits++)
+        w = digits < 19 ? 10 * w + (uint64_t)(*s - '0') : w;
+    if (*s == '.')
+        for (s++; *s >= '0' && *s <= '9'; s++, digits++, q--)
+            w = digits < 19 ? 10 * w + (uint64_t)(*s - '0') : w;
+    if (*s == 'e' || *s == 'E') {
+        s++;
+        if (*s == '+' || *s == '-')
+            eneg = *s++ == '-';
+        for (; *s >= '0' && *s <= '9'; s++)
+            e = e < 100000 ? 10 * e + (*s - '0') : e;
+    }
+    q += eneg ? -e : e;
+    return digits <= 19 && w <= (UINT64_C(1) << 53) && (w == 0 || (q >= -22 && q <= 22));
+}
+
+/* Lines of random fields (random_decimal, now and then an empty field, a
+   padded or quoted number or a word) joined by one of four delimiters,
+   read by the one pass with a field limit that is often reached: it
+   reads the fields up to the first one the fast path does not take, each
+   to the bit of strtod's value, says FE_EPARSE there or FE_ESIZE past the
+   limit, and leaves the line as it was. */
+START_TEST(one_pass_reads_what_the_fast_path_takes_and_stops_at_the_rest)
+{
+    static const char delims[] = {',', ';', '\t', '|'};
+    static const char *const odd[] = {"", " 1.5", "\"2\"", "nan", "abc", "1.5 "};
+    fe_rng g = fe_rng_seed(18);
+    int cases = fe_test_quick() ? 3000 : 100000;
+    for (int t = 0; t < cases; t++) {
+        char line[16 * 80], copy[sizeof line], field[16][80];
+        double v[16], want;
+        size_t nf = 1 + fe_rng_next(&g) % 12, max = fe_rng_next(&g) % 3 == 0
+                                                       ? fe_rng_next(&g) % 12 : 16;
+        size_t n = 0, count = 99, first_other = nf, expect_count;
+        char d = delims[fe_rng_next(&g) % 4];
+        int rc, expect;
+        for (size_t i = 0; i < nf; i++) {
+            if (fe_rng_next(&g) % 8 == 0)
+                strcpy(field[i], odd[fe_rng_next(&g) % 6]);
+            else if (fe_rng_next(&g) % 2 == 0)
+                snprintf(field[i], sizeof field[i], "%.*f", (int)(fe_rng_next(&g) % 8),
+                         (fe_rng_uniform(&g) - 0.5) * 2e4);
+            else
+                random_decimal(&g, field[i]);
+            if (first_other == nf && !ref_fast(field[i]))
+                first_other = i;
+            if (i > 0)
+                line[n++] = d;
+            memcpy(line + n, field[i], strlen(field[i]) + 1);
+            n += strlen(field[i]);
+        }
+        memcpy(copy, line, n + 1);
+        rc = fe_csv_numbers(line, d, v, max, &count);
+        if (first_other <= max && first_other < nf) {
+            expect = FE_EPARSE;
+            expect_count = first_other;
+        } else if (nf > max) {
+            expect = FE_ESIZE;
+            expect_count = max + 1;
+        } else {
+            expect = FE_OK;
+            expect_count = nf;
+        }
+        ck_assert_msg(rc == expect && count == expect_count, "'%s' (max %zu): %d, %zu fields;"
+                      " want %d, %zu", copy, max, rc, count, expect, expect_count);
+        ck_assert_msg(memcmp(line, copy, n + 1) == 0, "'%s' changed to '%s'", copy, line);
+        for (size_t i = 0; i < expect_count && i < max && i < first_other; i++) {
+            want = strtod(field[i], NULL);
+            ck_assert_msg(memcmp(&v[i], &want, sizeof want) == 0, "'%s' field %zu: %.17g,"
+                          " want %.17g", copy, i, v[i], want);
+        }
+    }
+}
+END_TEST
+
+/* The one pass at its edges: the field limit equal to the count and one
+   under it (the first fault in the line decides), an empty line, a delimiter at the end, each delimiter it must
+   refuse and one it may take, each missing argument. */
+START_TEST(one_pass_at_its_edges)
+{
+    double v[4] = {0};
+    size_t count = 99;
+    const char *refused = "0123456789+-.eE";
+    ck_assert_int_eq(fe_csv_numbers("1,-2.5,3e2", ',', v, 3, &count), FE_OK);
+    ck_assert_uint_eq(count, 3);
+    ck_assert(v[0] == 1.0 && v[1] == -2.5 && v[2] == 300.0);
+    ck_assert_int_eq(fe_csv_numbers("1,-2.5,3e2", ',', v, 2, &count), FE_ESIZE);
+    ck_assert_uint_eq(count, 3);
+    ck_assert_int_eq(fe_csv_numbers("1,2,x", ',', v, 2, &count), FE_EPARSE);
+    ck_assert_uint_eq(count, 2);
+    ck_assert_int_eq(fe_csv_numbers("1,x,3", ',', v, 1, &count), FE_EPARSE);
+    ck_assert_uint_eq(count, 1);
+    ck_assert_int_eq(fe_csv_numbers("", ',', v, 3, &count), FE_EPARSE);
+    ck_assert_uint_eq(count, 0);
+    ck_assert_int_eq(fe_csv_numbers("1,2,", ',', v, 3, &count), FE_EPARSE);
+    ck_assert_uint_eq(count, 2);
+    ck_assert_int_eq(fe_csv_numbers("7", ',', v, 0, &count), FE_ESIZE);
+    ck_assert_uint_eq(count, 1);
+    ck_assert_int_eq(fe_csv_numbers("1:2", ':', v, 3, &count), FE_OK);
+    ck_assert_uint_eq(count, 2);
+    ck_assert(v[0] == 1.0 && v[1] == 2.0);
+    for (const char *c = refused; *c != '\0'; c++)
+        ck_assert_msg(fe_csv_numbers("1,2", *c, v, 3, &count) == FE_EINVAL, "'%c'", *c);
+    ck_assert_int_eq(fe_csv_numbers("1,2", '\0', v, 3, &count), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_numbers("1 2", FE_CSV_WHITESPACE, v, 3, &count), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_numbers(NULL, ',', v, 3, &count), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_numbers("1", ',', NULL, 3, &count), FE_EINVAL);
+    ck_assert_int_eq(fe_csv_numbers("1", ',', v, 3, NULL), FE_EINVAL);
 }
 END_TEST
 
@@ -912,6 +1043,8 @@ Suite *fe_csv_suite(void)
     tcase_add_test(t, split_fast_path_matches_the_oracle_at_every_offset);
     tcase_add_test(t, split_fast_path_matches_the_oracle_on_random_lines);
     tcase_add_test(t, numbers_match_the_grammar_and_strtod_on_random_text);
+    tcase_add_test(t, one_pass_reads_what_the_fast_path_takes_and_stops_at_the_rest);
+    tcase_add_test(t, one_pass_at_its_edges);
     suite_add_tcase(s, t);
     return s;
 }

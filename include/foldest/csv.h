@@ -79,6 +79,22 @@ int fe_csv_number(const fe_csv_field *field, double *value);
    point is not accepted.  A field of more than 255 bytes is FE_EPARSE. */
 int fe_csv_number_comma(const fe_csv_field *field, double *value);
 
+/* fe_csv_numbers: a line that holds nothing but plain decimals, as
+   fe_csv_number's fast path reads them (at most 19 digits, an exponent
+   within 10^22), separated by `delimiter`, read in one pass: values[0 ..
+   *count - 1], the line unchanged.  FE_EPARSE as soon as a field is
+   anything else (empty, quoted, padded with spaces, a word, more digits):
+   *count is then the number of fields read before it, and the caller
+   splits the line and reads it field by field (fe_csv_split,
+   fe_csv_number), which gives the same values where both succeed, and
+   says what is wrong.  FE_ESIZE when a number follows the max-th field
+   (*count is then max + 1): the first fault in the line decides.
+   FE_EINVAL for a NULL argument, or a delimiter
+   that is FE_CSV_WHITESPACE, the NUL, or a byte a number may hold (a
+   digit, a sign, the point, 'e' or 'E'). */
+int fe_csv_numbers(const char *line, char delimiter, double *values, size_t max,
+                   size_t *count);
+
 /* Both read the same numbers whatever locale the calling program set
    (setlocale's LC_NUMERIC): a recording's decimal mark is the file's, not
    the reader's.  In a locale whose decimal mark is not '.', a decimal

@@ -53,6 +53,7 @@ typedef struct fe_cli_table {
     int progress;               /* show progress on stderr */
     void *gz;                   /* the zlib stream everything is read through */
     int decimal_comma;          /* 1: forced; 2: a semicolon table */
+    unsigned declined;          /* lines in a row that the one pass declined */
     size_t bad[4];              /* rows skipped in this pass, by reason */
     int reread;                 /* fe_cli_table_reread: they are counted */
     int view;                   /* a batch's reader on a worker thread
