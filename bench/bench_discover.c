@@ -14,8 +14,9 @@
    row by row with libm for the row paths.
    Also timed, for reference: the full accumulation of all 53 terms, which
    forward selection needs after the first step.
-   Then the same two folds from CSV files of the same records, as a
-   recording is read (fe_csv_*): with the 6 significant digits of a sensor
+   Then the same two folds from CSV files of the same records, as the
+   command reads a recording (fe_csv_numbers, the split where it
+   declines): with the 6 significant digits of a sensor
    recording, and with the 17 of an exact round trip.
    Prints ns per record; the ratios of issue 16 (ranking from a file at
    most 1.25 times the base fold; in memory, the screen's fold within 2
@@ -282,7 +283,8 @@ static double fold_panels(const double *state, const double *r, size_t n, size_t
 }
 
 /* The same records from a CSV file, as a recording is read: each line
-   split and parsed (fe_csv_*), the records of a panel evaluated by columns
+   read in one pass (fe_csv_numbers), or split and parsed field by field
+   when it declines, as the command does, the records of a panel evaluated by columns
    and folded.  Returns the best time, or -1 when the file cannot be read. */
 static double fold_file(const char *path, size_t n, size_t m, size_t base_cols,
                         double *storage, size_t nst, fe_discover_acc *a, double *panel)
@@ -304,11 +306,18 @@ static double fold_file(const char *path, size_t n, size_t m, size_t base_cols,
                 int end = fe_csv_next_line(&rd, &line, &len) != FE_OK;
                 if (!end) {
                     fe_csv_field f[NS + 1];
+                    double v[NS + 1];
                     size_t nf;
-                    bad |= fe_csv_split(line, ',', f, NS + 1, &nf, NULL) != FE_OK || nf != NS + 1;
-                    for (size_t c = 0; c < NS && !bad; c++)
-                        bad |= fe_csv_number(&f[c], &st[NS * q + c]) != FE_OK;
-                    bad |= bad || fe_csv_number(&f[NS], &r[q]) != FE_OK;
+                    if (fe_csv_numbers(line, ',', v, NS + 1, &nf) == FE_OK && nf == NS + 1) {
+                        memcpy(&st[NS * q], v, NS * sizeof *v);
+                        r[q] = v[NS];
+                    } else {
+                        bad |= fe_csv_split(line, ',', f, NS + 1, &nf, NULL) != FE_OK
+                               || nf != NS + 1;
+                        for (size_t c = 0; c < NS && !bad; c++)
+                            bad |= fe_csv_number(&f[c], &st[NS * q + c]) != FE_OK;
+                        bad |= bad || fe_csv_number(&f[NS], &r[q]) != FE_OK;
+                    }
                     q++;
                 }
                 if (q == PCOL || (end && q > 0)) {
@@ -523,8 +532,8 @@ int main(int argc, char **argv)
     }
     for (int d = 0; d < 2; d++) {
         if (t_file_base[d] > 0 && t_file_screen[d] > 0) {
-            printf("from a CSV file of the same records, %d significant digits (8 columns, read,"
-                   " split and parsed):\n", file_digits[d]);
+            printf("from a CSV file of the same records, %d significant digits (8 columns, read"
+                   " as the command reads them):\n", file_digits[d]);
             printf("    base model alone                               %8.1f\n",
                    1e9 * t_file_base[d] / (double)n);
             printf("    screen of the %d candidates                    %8.1f\n", CAND,
