@@ -421,8 +421,8 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
     while (k < n) {
         size_t m = n - k < FE__QUADRIC_BLOCK ? n - k : FE__QUADRIC_BLOCK;
         const double *b = x + 3 * k;
-        double lo[3], hi[3], rlo[3], rhi[3], sums[35], next[35];
-        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1, full = 0;
+        double rlo[3], rhi[3], sums[35], next[35];
+        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, grows = 0;
 
         if (fast) {             /* a non-finite sample makes a sum non-finite */
             size_t rest = n - k - m;
@@ -435,30 +435,46 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
             }
         }
         if (fast) {
-            for (int j = 0; j < 3; j++) {
-                lo[j] = rlo[j] < q->lo[j] ? rlo[j] : q->lo[j];
-                hi[j] = rhi[j] > q->hi[j] ? rhi[j] : q->hi[j];
-                inside = inside && rlo[j] > q->lo[j] && rhi[j] < q->hi[j];
-            }
-            full = fe__quadric_full(q);
-            if (!full)
-                for (int j = 0; j < 3; j++)
-                    fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
-        }
-        if (fast) {
             for (int j = 0; j < FE_QUADRIC_MOMENTS; j++)
                 q->m[j] = next[j];
-            for (int j = 0; j < 3; j++) {
-                q->lo[j] = lo[j];
-                q->hi[j] = hi[j];
-            }
-            if (!(full && inside) && !fe__quadric_full(q)) {
+            for (int j = 0; j < 3; j++)
+                grows = grows || rlo[j] < q->lo[j] || rhi[j] > q->hi[j];
+            if (!grows && !fe__quadric_full(q)) {
                 double c[3];
                 float size = fe__quadric_frame(q, c);
                 for (size_t i = 0; i < m; i++)
                     fe__quadric_mark(q, fe__quadric_region(
                         b[3 * i] - c[0], b[3 * i + 1] - c[1], b[3 * i + 2] - c[2]),
                         size);
+            }
+            if (grows) {
+                /* The box and the marks sample by sample, as the step
+                   does them; the frame and the test whether every region
+                   was visited only where the box moved. */
+                double c[3];
+                float size = fe__quadric_frame(q, c);
+                int full = fe__quadric_full(q);
+                for (size_t i = 0; i < m; i++) {
+                    const double *v = b + 3 * i;
+                    int moved = 0;
+                    for (int j = 0; j < 3; j++) {
+                        if (v[j] < q->lo[j]) {
+                            q->lo[j] = v[j];
+                            moved = 1;
+                        }
+                        if (v[j] > q->hi[j]) {
+                            q->hi[j] = v[j];
+                            moved = 1;
+                        }
+                    }
+                    if (moved) {
+                        size = fe__quadric_frame(q, c);
+                        full = fe__quadric_full(q);
+                    }
+                    if (!full)
+                        fe__quadric_mark(q, fe__quadric_region(
+                            v[0] - c[0], v[1] - c[1], v[2] - c[2]), size);
+                }
             }
             k += m;
             continue;
