@@ -4,6 +4,9 @@
 #include "foldest/error.h"
 #include "foldest/quadric.h"
 #include "lanes.h"
+#if defined(FE__LANES_X86)
+#include <immintrin.h>
+#endif
 
 enum { FE__QUADRIC_BLOCK = 512 };
 
@@ -153,20 +156,20 @@ static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
            r[8][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
     int i, l, k;
 
-    /* Copy relative to the reference; extremes of the relative
-       coordinates, in lanes. */
+    /* Copy relative to the reference; extremes of the samples
+       themselves, in lanes. */
     for (l = 0; l < FE__L; l++) {
-        lo[0][l] = hi[0][l] = b[0] - ref[0];
-        lo[1][l] = hi[1][l] = b[1] - ref[1];
-        lo[2][l] = hi[2][l] = b[2] - ref[2];
+        lo[0][l] = hi[0][l] = b[0];
+        lo[1][l] = hi[1][l] = b[1];
+        lo[2][l] = hi[2][l] = b[2];
     }
     for (i = 0; i + FE__L <= n; i += FE__L)
         for (l = 0; l < FE__L; l++) {
-            double x = b[3 * (i + l)] - ref[0], y = b[3 * (i + l) + 1] - ref[1],
-                   z = b[3 * (i + l) + 2] - ref[2];
-            X[i + l] = x;
-            Y[i + l] = y;
-            Z[i + l] = z;
+            double x = b[3 * (i + l)], y = b[3 * (i + l) + 1],
+                   z = b[3 * (i + l) + 2];
+            X[i + l] = x - ref[0];
+            Y[i + l] = y - ref[1];
+            Z[i + l] = z - ref[2];
             lo[0][l] = x < lo[0][l] ? x : lo[0][l];
             hi[0][l] = x > hi[0][l] ? x : hi[0][l];
             lo[1][l] = y < lo[1][l] ? y : lo[1][l];
@@ -175,15 +178,16 @@ static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
             hi[2][l] = z > hi[2][l] ? z : hi[2][l];
         }
     for (; i < n; i++) {
-        X[i] = b[3 * i] - ref[0];
-        Y[i] = b[3 * i + 1] - ref[1];
-        Z[i] = b[3 * i + 2] - ref[2];
-        lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
-        hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
-        lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
-        hi[1][0] = Y[i] > hi[1][0] ? Y[i] : hi[1][0];
-        lo[2][0] = Z[i] < lo[2][0] ? Z[i] : lo[2][0];
-        hi[2][0] = Z[i] > hi[2][0] ? Z[i] : hi[2][0];
+        double x = b[3 * i], y = b[3 * i + 1], z = b[3 * i + 2];
+        X[i] = x - ref[0];
+        Y[i] = y - ref[1];
+        Z[i] = z - ref[2];
+        lo[0][0] = x < lo[0][0] ? x : lo[0][0];
+        hi[0][0] = x > hi[0][0] ? x : hi[0][0];
+        lo[1][0] = y < lo[1][0] ? y : lo[1][0];
+        hi[1][0] = y > hi[1][0] ? y : hi[1][0];
+        lo[2][0] = z < lo[2][0] ? z : lo[2][0];
+        hi[2][0] = z > hi[2][0] ? z : hi[2][0];
     }
     for (int j = 0; j < 3; j++) {
         rlo[j] = lo[j][0];
@@ -267,134 +271,129 @@ static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
 #undef FE__QUADRIC_BLOCK_FN
 
 #if defined(FE__LANES_X86)
-#define FE__L 8
-#define FE__QUADRIC_BLOCK_FN fe__quadric_block8
 FE__LANES_WIDE
-static void FE__QUADRIC_BLOCK_FN(const double *b, int n, const double ref[3],
-                                 const double *next, int nnext,
-                                 double out[35], double rlo[3], double rhi[3])
+static void fe__quadric_block8(const double *b, int n, const double ref[3],
+                               const double *next, int nnext, double out[35],
+                               double rlo[3], double rhi[3])
 {
-    double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK], Z[FE__QUADRIC_BLOCK];
-    double a[9][FE__L] = {{0}}, c[9][FE__L] = {{0}}, q[8][FE__L] = {{0}},
-           r[8][FE__L] = {{0}}, lo[3][FE__L], hi[3][FE__L];
-    int i, l, k;
+    _Alignas(64) double X[FE__QUADRIC_BLOCK], Y[FE__QUADRIC_BLOCK],
+        Z[FE__QUADRIC_BLOCK];
+    /* Lane l of x gathers element 3 l of the 24 doubles v0 v1 v2: first
+       from v0 and v1 (table indices 0 to 15), then from v2 (8 to 15). */
+    const __m512i x01 = _mm512_set_epi64(0, 0, 15, 12, 9, 6, 3, 0),
+                  x2 = _mm512_set_epi64(13, 10, 5, 4, 3, 2, 1, 0),
+                  y01 = _mm512_set_epi64(0, 0, 0, 13, 10, 7, 4, 1),
+                  y2 = _mm512_set_epi64(14, 11, 8, 4, 3, 2, 1, 0),
+                  z01 = _mm512_set_epi64(0, 0, 0, 14, 11, 8, 5, 2),
+                  z2 = _mm512_set_epi64(15, 12, 9, 4, 3, 2, 1, 0);
+    const __m512d rx = _mm512_set1_pd(ref[0]), ry = _mm512_set1_pd(ref[1]),
+                  rz = _mm512_set1_pd(ref[2]);
+    __m512d lx = _mm512_set1_pd(b[0]), ly = _mm512_set1_pd(b[1]),
+            lz = _mm512_set1_pd(b[2]), hx = lx, hy = ly, hz = lz;
+    const __m512d zero = _mm512_setzero_pd();
+    __m512d s[34];                      /* the 34 sums, in the order of m[] */
+    int nl = n - n % 8, i, k;
 
-    /* Copy relative to the reference; extremes of the relative
-       coordinates, in lanes. */
-    for (l = 0; l < FE__L; l++) {
-        lo[0][l] = hi[0][l] = b[0] - ref[0];
-        lo[1][l] = hi[1][l] = b[1] - ref[1];
-        lo[2][l] = hi[2][l] = b[2] - ref[2];
-    }
-    for (i = 0; i + FE__L <= n; i += FE__L)
-        for (l = 0; l < FE__L; l++) {
-            double x = b[3 * (i + l)] - ref[0], y = b[3 * (i + l) + 1] - ref[1],
-                   z = b[3 * (i + l) + 2] - ref[2];
-            X[i + l] = x;
-            Y[i + l] = y;
-            Z[i + l] = z;
-            lo[0][l] = x < lo[0][l] ? x : lo[0][l];
-            hi[0][l] = x > hi[0][l] ? x : hi[0][l];
-            lo[1][l] = y < lo[1][l] ? y : lo[1][l];
-            hi[1][l] = y > hi[1][l] ? y : hi[1][l];
-            lo[2][l] = z < lo[2][l] ? z : lo[2][l];
-            hi[2][l] = z > hi[2][l] ? z : hi[2][l];
+    /* First pass: three loads hold eight samples; the permutations put
+       their x, y and z in lanes, relative to the reference, into X, Y, Z;
+       extremes, and the sums of degree one and two.  It asks for the
+       first of the three cache lines of the next block that these eight
+       samples' place covers, into the second-level cache. */
+    {
+        __m512d a0 = zero, a1 = zero, a2 = zero, a3 = zero, a4 = zero,
+                a5 = zero, a6 = zero, a7 = zero, a8 = zero;
+        for (i = 0; i < nl; i += 8) {
+            __m512d v0 = _mm512_loadu_pd(b + 3 * i),
+                    v1 = _mm512_loadu_pd(b + 3 * i + 8),
+                    v2 = _mm512_loadu_pd(b + 3 * i + 16);
+            __m512d ux = _mm512_permutex2var_pd(
+                        _mm512_permutex2var_pd(v0, x01, v1), x2, v2),
+                    uy = _mm512_permutex2var_pd(
+                        _mm512_permutex2var_pd(v0, y01, v1), y2, v2),
+                    uz = _mm512_permutex2var_pd(
+                        _mm512_permutex2var_pd(v0, z01, v1), z2, v2),
+                    x = _mm512_sub_pd(ux, rx), y = _mm512_sub_pd(uy, ry),
+                    z = _mm512_sub_pd(uz, rz);
+            if (3 * i < 3 * nnext)
+                _mm_prefetch((const char *)(next + 3 * i), _MM_HINT_T1);
+            _mm512_store_pd(X + i, x);
+            _mm512_store_pd(Y + i, y);
+            _mm512_store_pd(Z + i, z);
+            lx = _mm512_min_pd(ux, lx); hx = _mm512_max_pd(ux, hx);
+            ly = _mm512_min_pd(uy, ly); hy = _mm512_max_pd(uy, hy);
+            lz = _mm512_min_pd(uz, lz); hz = _mm512_max_pd(uz, hz);
+            a0 = _mm512_add_pd(a0, x); a1 = _mm512_add_pd(a1, y);
+            a2 = _mm512_add_pd(a2, z);
+            a3 = _mm512_fmadd_pd(x, x, a3); a4 = _mm512_fmadd_pd(x, y, a4);
+            a5 = _mm512_fmadd_pd(x, z, a5); a6 = _mm512_fmadd_pd(y, y, a6);
+            a7 = _mm512_fmadd_pd(y, z, a7); a8 = _mm512_fmadd_pd(z, z, a8);
         }
-    for (; i < n; i++) {
-        X[i] = b[3 * i] - ref[0];
-        Y[i] = b[3 * i + 1] - ref[1];
-        Z[i] = b[3 * i + 2] - ref[2];
-        lo[0][0] = X[i] < lo[0][0] ? X[i] : lo[0][0];
-        hi[0][0] = X[i] > hi[0][0] ? X[i] : hi[0][0];
-        lo[1][0] = Y[i] < lo[1][0] ? Y[i] : lo[1][0];
-        hi[1][0] = Y[i] > hi[1][0] ? Y[i] : hi[1][0];
-        lo[2][0] = Z[i] < lo[2][0] ? Z[i] : lo[2][0];
-        hi[2][0] = Z[i] > hi[2][0] ? Z[i] : hi[2][0];
+        s[0] = a0; s[1] = a1; s[2] = a2; s[3] = a3; s[4] = a4;
+        s[5] = a5; s[6] = a6; s[7] = a7; s[8] = a8;
     }
-    for (int j = 0; j < 3; j++) {
-        rlo[j] = lo[j][0];
-        rhi[j] = hi[j][0];
-        for (l = 1; l < FE__L; l++) {
-            rlo[j] = lo[j][l] < rlo[j] ? lo[j][l] : rlo[j];
-            rhi[j] = hi[j][l] > rhi[j] ? hi[j][l] : rhi[j];
+    /* Second pass: the six products of degree two, and from them the ten
+       sums of degree three and the fifteen of degree four (25 sums in
+       registers of the 32); the other two cache lines of the next block. */
+    {
+        __m512d c0 = zero, c1 = zero, c2 = zero, c3 = zero, c4 = zero,
+                c5 = zero, c6 = zero, c7 = zero, c8 = zero, c9 = zero,
+                q0 = zero, q1 = zero, q2 = zero, q3 = zero, q4 = zero,
+                q5 = zero, q6 = zero, q7 = zero, q8 = zero, q9 = zero,
+                q10 = zero, q11 = zero, q12 = zero, q13 = zero, q14 = zero;
+        for (i = 0; i < nl; i += 8) {
+            __m512d x = _mm512_load_pd(X + i), y = _mm512_load_pd(Y + i),
+                    z = _mm512_load_pd(Z + i), xx = _mm512_mul_pd(x, x),
+                    xy = _mm512_mul_pd(x, y), xz = _mm512_mul_pd(x, z),
+                    yy = _mm512_mul_pd(y, y), yz = _mm512_mul_pd(y, z),
+                    zz = _mm512_mul_pd(z, z);
+            if (3 * i + 8 < 3 * nnext)
+                _mm_prefetch((const char *)(next + 3 * i + 8), _MM_HINT_T1);
+            if (3 * i + 16 < 3 * nnext)
+                _mm_prefetch((const char *)(next + 3 * i + 16), _MM_HINT_T1);
+            c0 = _mm512_fmadd_pd(xx, x, c0); c1 = _mm512_fmadd_pd(xx, y, c1);
+            c2 = _mm512_fmadd_pd(xx, z, c2); c3 = _mm512_fmadd_pd(xy, y, c3);
+            c4 = _mm512_fmadd_pd(xy, z, c4); c5 = _mm512_fmadd_pd(xz, z, c5);
+            c6 = _mm512_fmadd_pd(yy, y, c6); c7 = _mm512_fmadd_pd(yy, z, c7);
+            c8 = _mm512_fmadd_pd(yz, z, c8); c9 = _mm512_fmadd_pd(zz, z, c9);
+            q0 = _mm512_fmadd_pd(xx, xx, q0); q1 = _mm512_fmadd_pd(xx, xy, q1);
+            q2 = _mm512_fmadd_pd(xx, xz, q2); q3 = _mm512_fmadd_pd(xx, yy, q3);
+            q4 = _mm512_fmadd_pd(xx, yz, q4); q5 = _mm512_fmadd_pd(xx, zz, q5);
+            q6 = _mm512_fmadd_pd(xy, yy, q6); q7 = _mm512_fmadd_pd(xy, yz, q7);
+            q8 = _mm512_fmadd_pd(xy, zz, q8); q9 = _mm512_fmadd_pd(xz, zz, q9);
+            q10 = _mm512_fmadd_pd(yy, yy, q10); q11 = _mm512_fmadd_pd(yy, yz, q11);
+            q12 = _mm512_fmadd_pd(yy, zz, q12); q13 = _mm512_fmadd_pd(yz, zz, q13);
+            q14 = _mm512_fmadd_pd(zz, zz, q14);
         }
+        s[9] = c0; s[10] = c1; s[11] = c2; s[12] = c3; s[13] = c4;
+        s[14] = c5; s[15] = c6; s[16] = c7; s[17] = c8; s[18] = c9;
+        s[19] = q0; s[20] = q1; s[21] = q2; s[22] = q3; s[23] = q4;
+        s[24] = q5; s[25] = q6; s[26] = q7; s[27] = q8; s[28] = q9;
+        s[29] = q10; s[30] = q11; s[31] = q12; s[32] = q13; s[33] = q14;
     }
-    /* The moments, in four groups of lanes; each group asks for every
-       fourth cache line of the next block (eight doubles a line). */
-#define FE__QUADRIC_AHEAD(g) \
-    if (8 * (4 * (i / FE__L) + (g)) < 3 * nnext) \
-        FE__PREFETCH(next + 8 * (4 * (i / FE__L) + (g)))
-    for (i = 0; i + FE__L <= n; i += FE__L) {
-        FE__QUADRIC_AHEAD(0);
-        for (l = 0; l < FE__L; l++) {
-            double x = X[i + l], y = Y[i + l], z = Z[i + l];
-            a[0][l] += x; a[1][l] += y; a[2][l] += z;
-            a[3][l] += x * x; a[4][l] += x * y; a[5][l] += x * z;
-            a[6][l] += y * y; a[7][l] += y * z; a[8][l] += z * z;
-        }
-    }
-    for (i = 0; i + FE__L <= n; i += FE__L) {
-        FE__QUADRIC_AHEAD(1);
-        for (l = 0; l < FE__L; l++) {
-            double x = X[i + l], y = Y[i + l], z = Z[i + l];
-            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
-                   yz = y * z;
-            c[0][l] += xx * x; c[1][l] += xx * y; c[2][l] += xx * z;
-            c[3][l] += xy * y; c[4][l] += xy * z; c[5][l] += xz * z;
-            c[6][l] += yy * y; c[7][l] += yy * z; c[8][l] += yz * z;
-        }
-    }
-    for (i = 0; i + FE__L <= n; i += FE__L) {
-        FE__QUADRIC_AHEAD(2);
-        for (l = 0; l < FE__L; l++) {
-            double x = X[i + l], y = Y[i + l], z = Z[i + l];
-            double xx = x * x, xy = x * y, xz = x * z, yy = y * y,
-                   yz = y * z, zz = z * z;
-            q[0][l] += xx * xx; q[1][l] += xx * xy; q[2][l] += xx * xz;
-            q[3][l] += xx * yy; q[4][l] += xx * yz; q[5][l] += xx * zz;
-            q[6][l] += xy * yy; q[7][l] += xy * yz;
-        }
-    }
-    for (i = 0; i + FE__L <= n; i += FE__L) {
-        FE__QUADRIC_AHEAD(3);
-        for (l = 0; l < FE__L; l++) {
-            double x = X[i + l], y = Y[i + l], z = Z[i + l];
-            double xy = x * y, xz = x * z, yy = y * y, yz = y * z,
-                   zz = z * z;
-            r[0][l] += xy * zz; r[1][l] += xz * zz; r[2][l] += yy * yy;
-            r[3][l] += yy * yz; r[4][l] += yy * zz; r[5][l] += yz * zz;
-            r[6][l] += zz * zz; r[7][l] += zz * z;
-        }
-    }
-#undef FE__QUADRIC_AHEAD
-    for (k = 0; k < 35; k++)
-        out[k] = 0.0;
+    rlo[0] = _mm512_reduce_min_pd(lx); rhi[0] = _mm512_reduce_max_pd(hx);
+    rlo[1] = _mm512_reduce_min_pd(ly); rhi[1] = _mm512_reduce_max_pd(hy);
+    rlo[2] = _mm512_reduce_min_pd(lz); rhi[2] = _mm512_reduce_max_pd(hz);
     out[0] = (double)n;
-    for (l = 0; l < FE__L; l++) {
-        for (k = 0; k < 9; k++)
-            out[1 + k] += a[k][l];
-        for (k = 0; k < 9; k++)
-            out[10 + k] += c[k][l];
-        out[19] += r[7][l];             /* the ninth of r is the tenth cubic */
-        for (k = 0; k < 8; k++)
-            out[20 + k] += q[k][l];
-        for (k = 0; k < 7; k++)
-            out[28 + k] += r[k][l];
-    }
+    for (k = 0; k < 34; k++)
+        out[1 + k] = _mm512_reduce_add_pd(s[k]);
     /* The tail that does not fill the lanes. */
-    for (; i < n; i++) {
-        double p[35];
-        fe__quadric_monomials(X[i], Y[i], Z[i], p);
+    for (i = nl; i < n; i++) {
+        double p[35], x = b[3 * i], y = b[3 * i + 1], z = b[3 * i + 2];
+        fe__quadric_monomials(x - ref[0], y - ref[1], z - ref[2], p);
         for (k = 1; k < 35; k++)
             out[k] += p[k];
+        rlo[0] = x < rlo[0] ? x : rlo[0];
+        rhi[0] = x > rhi[0] ? x : rhi[0];
+        rlo[1] = y < rlo[1] ? y : rlo[1];
+        rhi[1] = y > rhi[1] ? y : rhi[1];
+        rlo[2] = z < rlo[2] ? z : rlo[2];
+        rhi[2] = z > rhi[2] ? z : rhi[2];
     }
 }
-#undef FE__L
-#undef FE__QUADRIC_BLOCK_FN
 #endif
 
-/* The block's moment sums, extremes relative to ref; next (nnext
-   samples, or NULL and 0) is the block to prefetch. */
+/* The block's moment sums about ref and the extremes of its samples;
+   next (nnext samples, or NULL and 0) is the block to prefetch. */
 static void fe__quadric_block(const double *b, int n, const double ref[3],
                               const double *next, int nnext, double out[35],
                               double rlo[3], double rhi[3])
@@ -422,8 +421,8 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
     while (k < n) {
         size_t m = n - k < FE__QUADRIC_BLOCK ? n - k : FE__QUADRIC_BLOCK;
         const double *b = x + 3 * k;
-        double lo[3], hi[3], rlo[3], rhi[3], sums[35], next[35];
-        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, inside = 1, full = 0;
+        double rlo[3], rhi[3], sums[35], next[35];
+        int fast = (q->flags & FE_QUADRIC_HAS_REF) && q->m[0] > 0.0, grows = 0;
 
         if (fast) {             /* a non-finite sample makes a sum non-finite */
             size_t rest = n - k - m;
@@ -436,40 +435,46 @@ int fe_quadric_add_many(fe_quadric *q, const double *x, size_t n,
             }
         }
         if (fast) {
-            /* Inside the box for sure when strictly inside after rounding
-               (x - ref rounds monotonically); else find the extremes. */
-            for (int j = 0; j < 3; j++) {
-                lo[j] = q->lo[j];
-                hi[j] = q->hi[j];
-                inside = inside && rlo[j] > lo[j] - q->ref[j]
-                         && rhi[j] < hi[j] - q->ref[j];
-            }
-            if (!inside)
-                for (size_t i = 0; i < m; i++)
-                    for (int j = 0; j < 3; j++) {
-                        double v = b[3 * i + j];
-                        lo[j] = v < lo[j] ? v : lo[j];
-                        hi[j] = v > hi[j] ? v : hi[j];
-                    }
-            full = fe__quadric_full(q);
-            if (!full)
-                for (int j = 0; j < 3; j++)
-                    fast = fast && lo[j] == q->lo[j] && hi[j] == q->hi[j];
-        }
-        if (fast) {
             for (int j = 0; j < FE_QUADRIC_MOMENTS; j++)
                 q->m[j] = next[j];
-            for (int j = 0; j < 3; j++) {
-                q->lo[j] = lo[j];
-                q->hi[j] = hi[j];
-            }
-            if (!(full && inside) && !fe__quadric_full(q)) {
+            for (int j = 0; j < 3; j++)
+                grows = grows || rlo[j] < q->lo[j] || rhi[j] > q->hi[j];
+            if (!grows && !fe__quadric_full(q)) {
                 double c[3];
                 float size = fe__quadric_frame(q, c);
                 for (size_t i = 0; i < m; i++)
                     fe__quadric_mark(q, fe__quadric_region(
                         b[3 * i] - c[0], b[3 * i + 1] - c[1], b[3 * i + 2] - c[2]),
                         size);
+            }
+            if (grows) {
+                /* The box and the marks sample by sample, as the step
+                   does them; the frame and the test whether every region
+                   was visited only where the box moved. */
+                double c[3];
+                float size = fe__quadric_frame(q, c);
+                int full = fe__quadric_full(q);
+                for (size_t i = 0; i < m; i++) {
+                    const double *v = b + 3 * i;
+                    int moved = 0;
+                    for (int j = 0; j < 3; j++) {
+                        if (v[j] < q->lo[j]) {
+                            q->lo[j] = v[j];
+                            moved = 1;
+                        }
+                        if (v[j] > q->hi[j]) {
+                            q->hi[j] = v[j];
+                            moved = 1;
+                        }
+                    }
+                    if (moved) {
+                        size = fe__quadric_frame(q, c);
+                        full = fe__quadric_full(q);
+                    }
+                    if (!full)
+                        fe__quadric_mark(q, fe__quadric_region(
+                            v[0] - c[0], v[1] - c[1], v[2] - c[2]), size);
+                }
             }
             k += m;
             continue;

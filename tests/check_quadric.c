@@ -90,6 +90,41 @@ START_TEST(step_equals_block)
 }
 END_TEST
 
+/* Streams whose box keeps growing (Gaussian clouds, the first third
+   folded one step at a time): a block that grows the box must leave the
+   box and the recorded region sizes that one step at a time leaves, the
+   samples before the growth marked at the smaller size, not all of them
+   at the grown box's. */
+START_TEST(step_equals_block_when_the_box_grows)
+{
+    enum { N = 3000 };
+    static double x[3 * N];
+    fe_rng g = fe_rng_seed(7);
+    int differ = 0;
+    for (int t = 0; t < 40; t++) {
+        size_t n = 1 + (size_t)(fe_rng_uniform(&g) * (N - 1)), first = n / 3,
+               done = 0;
+        fe_quadric one = FE_QUADRIC_EMPTY, many = FE_QUADRIC_EMPTY;
+        int rc = FE_OK;
+        for (size_t i = 0; i < 3 * n; i++)
+            x[i] = 1000.0 + 50.0 * fe_rng_normal(&g);
+        for (size_t i = 0; i < n && rc == FE_OK; i++)
+            rc = fe_quadric_add(&one, x + 3 * i);
+        for (size_t i = 0; i < first && rc == FE_OK; i++)
+            rc = fe_quadric_add(&many, x + 3 * i);
+        ck_assert_int_eq(rc, FE_OK);
+        ck_assert_int_eq(fe_quadric_add_many(&many, x + 3 * first, n - first,
+                                             &done), FE_OK);
+        ck_assert_uint_eq(done, n - first);
+        ck_assert_double_le(moment_diff(&many, &one, 200.0), 1e-12);
+        ck_assert_mem_eq(many.lo, one.lo, sizeof one.lo);
+        ck_assert_mem_eq(many.hi, one.hi, sizeof one.hi);
+        differ += memcmp(many.seen, one.seen, sizeof one.seen) != 0;
+    }
+    ck_assert_int_eq(differ, 0);
+}
+END_TEST
+
 START_TEST(two_shards_equal_one)
 {
     enum { N = 20000 };
@@ -986,6 +1021,7 @@ Suite *fe_quadric_suite(void)
     tcase_add_test(t, index_and_exponents_are_inverse);
     tcase_add_test(t, empty_and_one_sample);
     tcase_add_test(t, step_equals_block);
+    tcase_add_test(t, step_equals_block_when_the_box_grows);
     tcase_add_test(t, two_shards_equal_one);
     tcase_add_test(t, blocks_partition_the_stream_and_merge_in_time);
     tcase_add_test(t, merge_every_split_and_associativity);
