@@ -2,7 +2,12 @@
 /* Discovery: the engine's algebra against brute force, merge, refusals, and
    the acceptance suite on concealed synthetic cases (every catalog term as
    the hidden effect, and null cases). */
+#define _POSIX_C_SOURCE 200809L  /* mmap, mprotect, sysconf: a page no one may read */
+
+#include <fcntl.h>
 #include <stdint.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "foldest.h"
 #include "testutil.h"
@@ -3448,6 +3453,96 @@ START_TEST(documented_refusals_at_their_edges)
 }
 END_TEST
 
+/* A row that starts a recording with a value not finite in any one of
+   its columns is refused before the break, the accumulation unchanged to
+   the byte (discover.h: "a is then unchanged"); the refusals test put its
+   NaN in column 1 of a row that did not start one.  The check before the
+   break copies the row's m values; with the copy starting at column 1
+   (seed 10223's discover:2325) or stopping after column 0 (2327, the
+   loop counting down) a NaN in a column not copied passed it, the break
+   was made, and only then was the row refused. */
+START_TEST(a_break_row_not_finite_in_any_column_is_refused_before_the_break)
+{
+    enum { M = 3, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K);
+    double *st = calloc(nst, sizeof *st), *copy = calloc(nst, sizeof *copy);
+    double phi[M] = {1.0, 2.0, 3.0};
+    const double bad[2] = {NAN, INFINITY};
+    fe_discover_acc a, before;
+    fe_discover_row row = {0, phi, 0.5, 0};
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    before = a;
+    memcpy(copy, st, nst * sizeof *st);
+    row.index = 1;
+    row.starts_recording = 1;
+    for (int c = 0; c < M; c++)
+        for (int v = 0; v < 2; v++) {
+            phi[c] = bad[v];
+            ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
+            ck_assert_mem_eq(&a, &before, sizeof a);
+            ck_assert_mem_eq(st, copy, nst * sizeof *st);
+            phi[c] = 1.0 + c;
+        }
+    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+    ck_assert_uint_eq(a.n, 2);
+    free(st);
+    free(copy);
+}
+END_TEST
+
+/* A row is read only up to its m term values (discover.h: "the m term
+   values").  They are placed at the end of a page whose next page may not
+   be read, so a read of phi[m] stops the test with a segmentation fault.
+   Seed 10223's discover:2326, the copy loop of the check before a break
+   (fe__discover_ok_after_break) run to i <= m, read phi[m] and then wrote
+   r over it: every result the same, so only such a page shows it.  The
+   rows fold, each path, to the accumulation of the same rows from an
+   ordinary array, to the byte. */
+START_TEST(a_row_is_read_only_up_to_its_m_terms)
+{
+    enum { M = 3, K = 4 };
+    size_t nst = fe_discover_acc_doubles(M, K), done = 0;
+    long pg = sysconf(_SC_PAGESIZE);
+    int fd = open("/dev/zero", O_RDWR);
+    double *st = calloc(nst, sizeof *st), *ref = calloc(nst, sizeof *ref);
+    double phi[M] = {1.0, -2.0, 3.0}, *edge;
+    unsigned char *map;
+    fe_discover_acc a, b;
+    fe_discover_row row = {0, NULL, 0.5, 0};
+    ck_assert_int_gt(pg, 0);
+    ck_assert_int_ge(fd, 0);
+    map = mmap(NULL, 2 * (size_t)pg, PROT_READ | PROT_WRITE, MAP_PRIVATE, fd, 0);
+    ck_assert_ptr_ne(map, MAP_FAILED);
+    close(fd);
+    ck_assert_int_eq(mprotect(map + pg, (size_t)pg, PROT_NONE), 0);
+    edge = (double *)(void *)(map + pg) - M;
+    memcpy(edge, phi, sizeof phi);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, FE_DISCOVER_ROW_UNKNOWN, st, nst), FE_OK);
+    ck_assert_int_eq(fe_discover_acc_init(&b, M, K, 100, FE_DISCOVER_ROW_UNKNOWN, ref, nst), FE_OK);
+    for (int i = 0; i < 6; i++) {
+        /* rows 0 to 5, rows 2 and 4 starting a recording */
+        row.index = (uint64_t)i;
+        row.starts_recording = i == 2 || i == 4;
+        row.phi = edge;
+        ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
+        row.phi = phi;
+        ck_assert_int_eq(fe_discover_add_row(&b, &row), FE_OK);
+    }
+    ck_assert_int_eq(fe_discover_add(&a, edge, 0.25), FE_OK);
+    ck_assert_int_eq(fe_discover_add(&b, phi, 0.25), FE_OK);
+    ck_assert_int_eq(fe_discover_add_rows(&a, edge, M, &row.r, 1, &done), FE_OK);
+    ck_assert_uint_eq(done, 1);
+    ck_assert_int_eq(fe_discover_add_rows(&b, phi, M, &row.r, 1, &done), FE_OK);
+    ck_assert_uint_eq(a.n, 8);
+    ck_assert_uint_eq(b.n, 8);
+    ck_assert_mem_eq(st, ref, fe_discover_acc_doubles(M, K) * sizeof *st);
+    ck_assert_int_eq(munmap(map, 2 * (size_t)pg), 0);
+    free(st);
+    free(ref);
+}
+END_TEST
+
 /* A row that starts a recording is checked before the break is made:
    1e154 squares to 1e308, so a second such row in the same block would
    take the sum of squares of column 0 past DBL_MAX (2e308).  It is
@@ -3798,6 +3893,8 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, shapes_counts_and_workspaces_at_their_edges);
     tcase_add_test(t, documented_refusals_at_their_edges);
     tcase_add_test(t, a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break);
+    tcase_add_test(t, a_row_is_read_only_up_to_its_m_terms);
+    tcase_add_test(t, a_break_row_not_finite_in_any_column_is_refused_before_the_break);
     tcase_add_test(t, sums_too_large_to_whiten_are_refused);
     tcase_add_test(t, a_residual_that_is_exactly_zero_is_white);
     tcase_set_timeout(acc, 900);

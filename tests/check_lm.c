@@ -4,8 +4,13 @@
    dense and Schur paths agreeing, the iteration report, failures of the
    model handled, multi-session magnetometer calibration on synthetic
    sessions with known truth and on real recordings split into sessions. */
+#define _POSIX_C_SOURCE 200809L  /* mmap, mprotect, sysconf: a page no one may read */
+
+#include <fcntl.h>
 #include <float.h>
 #include <stdint.h>
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "foldest.h"
 #include "testutil.h"
@@ -39,6 +44,47 @@ START_TEST(rosenbrock_dense_and_schur)
         ck_assert_double_eq_tol(x[1], 1.0, 1e-10);
         ck_assert_double_eq_tol(r.initial_cost, 0.5 * (4.4 * 4.4 + 2.2 * 2.2), 1e-12);
         ck_assert_int_gt(r.iterations, 1);
+        free(w);
+    }
+}
+END_TEST
+
+/* The workspace is read only up to its end: fe_lm_work(prob, method)
+   doubles placed at the end of a page whose next page may not be read, so
+   a read one past them stops the test with a segmentation fault.  Seed
+   10223's lm:586 (the loop that forms the last two steps, d = xt - xa,
+   run to k <= p) read one double past the workspace (xa is its last p
+   doubles) and wrote it over xa[0], which the next line sets: every
+   result the same, so only such a page shows it.  Rosenbrock from
+   (-1.2, 1) by both methods: the same point, bit for bit, and the same
+   counts as with a workspace from malloc. */
+START_TEST(the_workspace_is_read_only_up_to_its_end)
+{
+    fe_lm_problem p = {2, 0, 0, rosenbrock, NULL};
+    long pg = sysconf(_SC_PAGESIZE);
+    for (int method = FE_LM_DENSE; method <= FE_LM_SCHUR; method++) {
+        size_t n = fe_lm_work(&p, method), pages = (n * sizeof(double) + (size_t)pg - 1) / (size_t)pg;
+        double x[2] = {-1.2, 1.0}, y[2] = {-1.2, 1.0}, *w = lm_work(&p, method), *edge;
+        fe_lm_result r, q;
+        unsigned char *map;
+        int fd = open("/dev/zero", O_RDWR);
+        ck_assert_int_gt(pg, 0);
+        ck_assert_int_ge(fd, 0);
+        map = mmap(NULL, (pages + 1) * (size_t)pg, PROT_READ | PROT_WRITE, MAP_PRIVATE, fd, 0);
+        ck_assert_ptr_ne(map, MAP_FAILED);
+        close(fd);
+        ck_assert_int_eq(mprotect(map + pages * (size_t)pg, (size_t)pg, PROT_NONE), 0);
+        edge = (double *)(void *)(map + pages * (size_t)pg) - n;
+        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, x, edge, NULL, NULL, &r), FE_OK);
+        ck_assert_int_eq(fe_lm_solve(&p, method, NULL, y, w, NULL, NULL, &q), FE_OK);
+        ck_assert_int_gt(r.accepted, 2);
+        ck_assert_mem_eq(x, y, sizeof x);
+        ck_assert_int_eq(r.iterations, q.iterations);
+        ck_assert_int_eq(r.evaluations, q.evaluations);
+        ck_assert_int_eq(r.accelerated, q.accelerated);
+        ck_assert_double_eq_tol(x[0], 1.0, 1e-10);
+        ck_assert_double_eq_tol(x[1], 1.0, 1e-10);
+        ck_assert_int_eq(munmap(map, (pages + 1) * (size_t)pg), 0);
         free(w);
     }
 }
@@ -893,6 +939,172 @@ START_TEST(second_step_searches_along_the_last_two)
 }
 END_TEST
 
+/* Two residuals sigma (x0^2 - 4) and sigma (x1^2 - 9): the Jacobian is
+   diagonal, so (A + lambda diag A) h = b is solved entry by entry, h_i =
+   b_i / (A_ii (1 + lambda)), and the two parameters share only the
+   damping and the gain ratio. */
+static int two_squares_model(const double *x, fe_lm_sink *s, void *ctx)
+{
+    const double sg = *(const double *)ctx, a[2] = {4.0, 9.0};
+    for (int i = 0; i < 2; i++) {
+        double j[2] = {0.0, 0.0};
+        int rc;
+        j[i] = sg * 2.0 * x[i];
+        rc = fe_lm_emit(s, sg * (x[i] * x[i] - a[i]), 1.0, j, FE_SCHUR_NONE, NULL);
+        if (rc != FE_OK)
+            return rc;
+    }
+    return FE_OK;
+}
+
+static double two_sq_cost(double sg, const double *x)
+{
+    const double a[2] = {4.0, 9.0};
+    double c = 0.0;
+    for (int i = 0; i < 2; i++)
+        c += 0.5 * sg * sg * (x[i] * x[i] - a[i]) * (x[i] * x[i] - a[i]);
+    return c;
+}
+
+START_TEST(the_search_along_the_last_two_steps_moves_every_parameter)
+{
+    /* second_step_searches_along_the_last_two with two parameters, by
+       hand: the damped step, its gain ratio, the parabola along a step
+       whose ratio is more than 0.25 from 1, the damping's update, and
+       after the second accepted step the search along d = x2 - x0, every
+       entry of it: the slope b'd, the cost at x2 + d, the parabola's
+       minimum t* (64 when it opens downwards), and the move when it lowers
+       the cost.  From (3, 4.5) the second step lands short of (2, 3) and
+       the search moves it nearer.  Seed 10223's lm:587 (the loop that
+       forms d counting down from 0) formed only d's first entry and left
+       the second as the workspace held it; with one parameter that is the
+       whole of d. */
+    double sg = 0.01, x[2] = {3.0, 4.5}, y[2] = {3.0, 4.5}, ya[2] = {0.0, 0.0};
+    fe_lm_problem p = {2, 0, 0, two_squares_model, &sg};
+    double *w = lm_work(&p, FE_LM_DENSE), lambda = fe_lm_default_params().lambda0;
+    double rowcost[2] = {0.0, 0.0};
+    const double a[2] = {4.0, 9.0};
+    fe_lm_params par = fe_lm_default_params();
+    fe_lm_result r;
+    int have = 0, accelerated = 0, evals = 1, rc;
+    for (int it = 0; it < 2; it++) {
+        double b[2], A[2], h[2], yt[2], cost = two_sq_cost(sg, y), pred = 0.0, slope = 0.0;
+        double ct, rho;
+        for (int i = 0; i < 2; i++) {
+            double f = sg * (y[i] * y[i] - a[i]), J = sg * 2.0 * y[i];
+            A[i] = J * J;
+            b[i] = -J * f;
+            h[i] = b[i] / (A[i] * (1.0 + lambda));
+            pred += h[i] * (b[i] + lambda * A[i] * h[i]);
+            slope += h[i] * b[i];
+            yt[i] = y[i] + h[i];
+        }
+        pred *= 0.5;
+        ct = two_sq_cost(sg, yt);
+        rho = (cost - ct) / pred;
+        evals++;                                    /* the trial point */
+        ck_assert_double_gt(rho, 0.0);              /* both are taken */
+        if (fabs(rho - 1.0) > 0.25) {
+            double c = ct - cost + slope;
+            if (c > 0.0 && slope > 0.0) {
+                double ts = fmin(slope / (2.0 * c), 64.0), ye[2];
+                if (ts > 0.0 && ts != 1.0) {
+                    evals++;                        /* the point along the step */
+                    for (int i = 0; i < 2; i++)
+                        ye[i] = y[i] + ts * h[i];
+                    if (two_sq_cost(sg, ye) < ct) {
+                        memcpy(yt, ye, sizeof yt);
+                        ct = two_sq_cost(sg, yt);
+                    }
+                }
+            }
+        }
+        {
+            double d[2], tt = 2.0 * rho - 1.0;
+            for (int i = 0; i < 2; i++)
+                d[i] = yt[i] - ya[i];
+            memcpy(ya, y, sizeof ya);
+            memcpy(y, yt, sizeof y);
+            cost = ct;
+            evals++;                                /* the step taken, with its Jacobian */
+            if (have) {
+                double sl = 0.0, y1[2], c1, c, ta, cta;
+                for (int i = 0; i < 2; i++) {
+                    double f2 = sg * (y[i] * y[i] - a[i]);
+                    sl += -(sg * 2.0 * y[i]) * f2 * d[i];
+                    y1[i] = y[i] + d[i];
+                }
+                ck_assert_double_gt(sl, 0.0);       /* the premise: a search */
+                c1 = two_sq_cost(sg, y1);
+                evals++;                            /* x + d */
+                c = c1 - cost + sl;
+                ta = c > 0.0 ? fmin(sl / (2.0 * c), 64.0) : 64.0;
+                cta = c1;
+                ck_assert_double_ne(ta, 1.0);       /* the premise: x + t* d */
+                {
+                    double yt2[2];
+                    for (int i = 0; i < 2; i++)
+                        yt2[i] = y[i] + ta * d[i];
+                    cta = two_sq_cost(sg, yt2);
+                    evals++;                        /* x + t* d */
+                    if (!(cta < c1)) {
+                        ta = 1.0;
+                        cta = c1;
+                    }
+                }
+                ck_assert_double_lt(cta, cost);     /* the premise: the search moves */
+                for (int i = 0; i < 2; i++)
+                    y[i] += ta * d[i];
+                cost = two_sq_cost(sg, y);
+                accelerated++;
+                evals++;                            /* the move, with its Jacobian */
+            }
+            have = 1;
+            lambda = fmax(1e-10, lambda * fmax(1.0 / 3.0, 1.0 - tt * tt * tt));
+        }
+        rowcost[it] = cost;
+    }
+    ck_assert_int_eq(accelerated, 1);
+    par.max_iter = 2;
+    rc = fe_lm_solve(&p, FE_LM_DENSE, &par, x, w, NULL, NULL, &r);
+    ck_assert(rc == FE_ENOCONV || rc == FE_OK);
+    ck_assert_int_eq(r.iterations, 2);
+    ck_assert_int_eq(r.accelerated, 1);
+    ck_assert_int_eq(r.evaluations, evals);
+    FE_ASSERT_REL(r.cost, rowcost[1], 1e-12);
+    FE_ASSERT_REL(x[0], y[0], 1e-12);
+    FE_ASSERT_REL(x[1], y[1], 1e-12);
+    free(w);
+}
+END_TEST
+
+/* A method that is neither FE_LM_DENSE nor FE_LM_SCHUR, and a null
+   workspace, are refused (lm.h: FE_EINVAL for a bad method) on a problem
+   that would otherwise solve, x left as it was.  model_failures_are_handled
+   asks the same of a problem whose model emits a stray block, which is
+   refused in any case; seed 10223's lm:391 (the method's test joined to
+   the workspace's by && instead of ||) let the method through there. */
+START_TEST(a_bad_method_or_no_workspace_is_refused_on_a_good_problem)
+{
+    fe_lm_problem p = {1, 0, 0, sqrt_model, NULL};
+    double w[64], x = 100.0;
+    fe_lm_result r;
+    const int bad[3] = {-1, 2, 7};
+    ck_assert_uint_le(fe_lm_work(&p, FE_LM_DENSE), 64);
+    ck_assert_uint_le(fe_lm_work(&p, FE_LM_SCHUR), 64);
+    for (int i = 0; i < 3; i++) {
+        ck_assert_int_eq(fe_lm_solve(&p, bad[i], NULL, &x, w, NULL, NULL, &r), FE_EINVAL);
+        ck_assert_double_eq(x, 100.0);
+    }
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, NULL, NULL, NULL, &r), FE_EINVAL);
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_SCHUR, NULL, &x, NULL, NULL, NULL, &r), FE_EINVAL);
+    ck_assert_double_eq(x, 100.0);
+    /* The same problem with a good method and workspace solves: x = 2. */
+    ck_assert_int_eq(fe_lm_solve(&p, FE_LM_DENSE, NULL, &x, w, NULL, NULL, &r), FE_OK);
+    ck_assert_double_eq_tol(x, 2.0, 1e-9);
+}
+END_TEST
+
 /* Two parameters whose columns are S (1, 1) and S K (1 + d, 1 - d),
    K = 1000: the second diagonal entry is K times the off-diagonal one. */
 struct collinear { double d; };
@@ -1535,6 +1747,9 @@ Suite *fe_lm_suite(void)
     TCase *t = tcase_create("levenberg-marquardt");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, rosenbrock_dense_and_schur);
+    tcase_add_test(t, the_workspace_is_read_only_up_to_its_end);
+    tcase_add_test(t, the_search_along_the_last_two_steps_moves_every_parameter);
+    tcase_add_test(t, a_bad_method_or_no_workspace_is_refused_on_a_good_problem);
     tcase_add_test(t, linear_model_matches_normal_equations);
     tcase_add_test(t, wide_linear_model_dense_and_schur);
     tcase_add_test(t, wide_rows_with_blocks_dense_and_schur);

@@ -569,6 +569,36 @@ START_TEST(a_lag_one_sum_that_overflows_is_refused)
 }
 END_TEST
 
+START_TEST(a_block_sum_of_squares_that_overflows_is_refused)
+{
+    /* Two scalar reports in block 0 (rows 0, 1 of four in two blocks),
+       whitened w and w.  Each square is a double; for w = 1e154 the
+       block's sum of squares 1e308 + 1e308 is not (DBL_MAX = 1.80e308),
+       and the second report is refused, the accumulation unchanged, while
+       its lag-one product (1e308, the first row had none) and its NIS fit.
+       For w = 9e153 the sum 1.62e308 is a double and is taken.  Seed
+       10223's locate:86 tested bk->sq - sq, which cannot overflow. */
+    for (int big = 0; big <= 1; big++) {
+        fe_innovations inn, before;
+        double w = big ? 1e154 : 9e153;
+        fe_kalman_report r = {1, 1.0, 0, NULL, &w, NULL};
+        ck_assert_int_eq(fe_innovations_init(&inn, 2, 4, 0), FE_OK);
+        ck_assert_int_eq(fe_innovations_add(&inn, 0.0, &r), FE_OK);
+        ck_assert(inn.block[0].sq == w * w);
+        memcpy(&before, &inn, sizeof inn);
+        if (big) {
+            ck_assert_int_eq(fe_innovations_add(&inn, 1.0, &r), FE_ENONFINITE);
+            ck_assert_mem_eq(&inn, &before, sizeof inn);
+        } else {
+            ck_assert_int_eq(fe_innovations_add(&inn, 1.0, &r), FE_OK);
+            ck_assert(inn.block[0].sq == w * w + w * w);
+            ck_assert(inn.block[0].acf == w * w);
+            ck_assert(inn.block[0].n == 2.0);
+        }
+    }
+}
+END_TEST
+
 START_TEST(arguments_merges_that_do_not_fit_and_json)
 {
     fe_innovations a, b, before;
@@ -1127,6 +1157,33 @@ START_TEST(the_largest_statistic_after_the_terms_looks_at_the_regions)
 }
 END_TEST
 
+/* The four speed bands split 0 .. vmax in quarters, vmax the larger of
+   |lo| and |hi| of the velocity's range, at either end: [-4, 1] and
+   [-1, 4] both give vmax = 4 and the bands [0, 1], [1, 2], [2, 3],
+   [3, 4].  The position's and temperature's ranges given beside it (not
+   in the roles) play no part.  Seed 10223's locate:528 compared the
+   temperature's lo (0 then) with |hi[1]| and took vmax = 1 for [-4, 1];
+   the suite's velocity ranges were all symmetric. */
+START_TEST(the_speed_bands_reach_the_faster_end_of_either_sign)
+{
+    for (int neg = 0; neg <= 1; neg++) {
+        fe_residual_map m;
+        const double lo[3] = {-9.0, neg ? -4.0 : -1.0, 50.0};
+        const double hi[3] = {9.0, neg ? 1.0 : 4.0, 60.0};
+        int band = 0;
+        ck_assert_int_eq(fe_residual_map_init(&m, 4, 40, 0, FE_ROLE_VELOCITY, lo, hi), FE_OK);
+        ck_assert_double_eq(m.vmax, 4.0);
+        for (size_t g = 0; g < m.nregions; g++)
+            if (m.region[g] == FE_REGION_SPEED) {
+                ck_assert_double_eq(m.region_lo[g], (double)band);
+                ck_assert_double_eq(m.region_hi[g], (double)(band + 1));
+                band++;
+            }
+        ck_assert_int_eq(band, 4);
+    }
+}
+END_TEST
+
 /* A cell is tested from 2 rows: rows 0 .. 37 at v = +0.5 with residuals
    -1, +1, ... (mean 0) and rows 38, 39 at v = -0.5 with residual +1.
    All 40 rows: mean 0.05, mean square 1, so every z is 0; the region
@@ -1594,6 +1651,8 @@ Suite *fe_locate_suite(void)
     tcase_add_test(t, refusals_leave_the_accumulation_unchanged);
     tcase_add_test(t, huge_values_are_refused_and_nothing_infinite_escapes);
     tcase_add_test(t, a_lag_one_sum_that_overflows_is_refused);
+    tcase_add_test(t, a_block_sum_of_squares_that_overflows_is_refused);
+    tcase_add_test(t, the_speed_bands_reach_the_faster_end_of_either_sign);
     tcase_add_test(t, arguments_merges_that_do_not_fit_and_json);
     tcase_add_test(t, merge_into_an_empty_part_is_the_other_part);
     tcase_add_test(t, json_of_every_length_is_whole_or_refused);

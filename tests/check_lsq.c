@@ -684,6 +684,42 @@ START_TEST(blocked_rows_stop_exactly_at_the_bad_row)
 }
 END_TEST
 
+/* The residual's sum of squares at its edge in an unweighted block: with
+   every regressor 0 and residuals 2^510 (squares 2^1020, exact), three
+   rows sum to 3 2^1020 = 1.5 2^1021, under DBL_MAX / 4 = 2^1022 - 2^969;
+   a fourth would make 2^1022, past it (a finite double, but beyond the
+   bound of lsq.org).  In one call of four rows the block is refused and
+   the row-by-row fold takes three: FE_ENONFINITE, *done = 3, G_rr = 3
+   2^1020.  A fifth row passed alone to the same accumulation is refused
+   with nothing changed.  The suite's residual refusals in a block were a
+   NaN and 1e300, whose square is not finite, so a test that looked at
+   the wrong entry of G, or subtracted, still refused them; seed 10223's
+   neighbours of lsq:121 did that (lsq:118 to 120, and 122, which tied the
+   residual's test to the total weight's). */
+START_TEST(a_blocked_residual_sum_past_its_edge_is_refused)
+{
+    const double r = 0x1p510, J[4] = {0.0, 0.0, 0.0, 0.0}, rs[4] = {r, r, r, r};
+    double g[2 * 2], gbefore[2 * 2];
+    fe_lsq a, before;
+    size_t done = 99;
+    ck_assert_double_eq(r * r, 0x1p1020);
+    ck_assert(3.0 * 0x1p1020 <= DBL_MAX / 4);
+    ck_assert(!(4.0 * 0x1p1020 <= DBL_MAX / 4));
+    fe_lsq_init(&a, 1, g);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, 1, rs, NULL, 4, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(done, 3);
+    ck_assert_uint_eq(a.n, 3);
+    ck_assert_double_eq(a.wsum, 3.0);
+    ck_assert_double_eq(g[3], 3.0 * 0x1p1020);
+    before = a;
+    memcpy(gbefore, g, sizeof g);
+    ck_assert_int_eq(fe_lsq_add_rows(&a, J, 1, rs, NULL, 1, &done), FE_ENONFINITE);
+    ck_assert_uint_eq(done, 0);
+    ck_assert_mem_eq(&a, &before, sizeof a);
+    ck_assert_mem_eq(g, gbefore, sizeof g);
+}
+END_TEST
+
 /* fe_lsq_add_rows' refusals at their edges: one row needs no stride
    (ldj 0 and p - 1 are taken for m = 1), two rows need ldj >= p (p - 1
    refused, p taken); null arguments are refused with nothing folded, and
@@ -902,6 +938,7 @@ Suite *fe_lsq_suite(void)
     tcase_add_test(t, exact_fit_has_zero_rss);
     tcase_add_test(t, sparse_rows_equal_dense_rows);
     tcase_add_test(t, blocked_rows_stop_exactly_at_the_bad_row);
+    tcase_add_test(t, a_blocked_residual_sum_past_its_edge_is_refused);
     tcase_add_test(t, add_rows_arguments_at_their_edges);
     tcase_add_test(t, merge_overflow_at_its_edge);
     tcase_add_test(t, weights_indices_and_counts_at_their_edges);

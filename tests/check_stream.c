@@ -116,6 +116,110 @@ START_TEST(fd_source_reads_records_through_a_small_buffer)
 }
 END_TEST
 
+/* An accumulator that sums doubles and counts how it was called: steps,
+   calls of step_many, and the observations those were handed. */
+typedef struct { double sum; size_t steps, batches, batched, largest; } call_count;
+
+static int count_step(void *acc, const void *obs, void *ctx)
+{
+    call_count *c = acc;
+    (void)ctx;
+    c->sum += *(const double *)obs;
+    c->steps++;
+    return FE_OK;
+}
+
+static int count_step_many(void *acc, const void *obs, size_t n, size_t *done, void *ctx)
+{
+    call_count *c = acc;
+    (void)ctx;
+    for (size_t i = 0; i < n; i++)
+        c->sum += ((const double *)obs)[i];
+    c->batches++;
+    c->batched += n;
+    if (n > c->largest)
+        c->largest = n;
+    *done = n;
+    return FE_OK;
+}
+
+static int generate_index(void *obs, size_t index, void *ctx)
+{
+    if (index >= *(const size_t *)ctx)
+        return FE_END;
+    *(double *)obs = (double)index;
+    return FE_OK;
+}
+
+START_TEST(the_library_sources_in_memory_are_folded_through_step_many)
+{
+    /* stream.org: a fold without a visitor hands everything an array or
+       file source already holds in memory to step_many at once, and any
+       other source one observation at a time through step; with a visitor
+       every observation goes through step.  The values 0 .. 999 sum to
+       999 * 1000 / 2 = 499500 whichever way.  Array source: one batch of
+       1000.  A file through a buffer of 64 doubles: every observation is
+       folded, each batch at most 64.  A generator: 1000 steps.  Seed
+       10223's stream:16 (the array source not recognised) folded the
+       array by 1000 steps. */
+    enum { N = 1000 };
+    static double x[N];
+    double buf[64], slot;
+    size_t n = N, done = 0, visits = 0;
+    char path[] = "/tmp/foldest-test-XXXXXX";
+    fe_accumulator f = {"count", sizeof(call_count), sizeof(double), NULL, count_step,
+                        count_step_many, NULL, NULL, NULL};
+    fe_array_source as;
+    fe_fd_source fs;
+    fe_generator_source gs;
+    fe_source src;
+    call_count c;
+    int fd;
+    for (int i = 0; i < N; i++)
+        x[i] = (double)i;
+    ck_assert_int_eq(fe_source_from_array(&src, &as, x, N, sizeof(double)), FE_OK);
+    c = (call_count){0};
+    ck_assert_int_eq(fe_fold_source(&f, &c, &src, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    ck_assert_double_eq(c.sum, 499500.0);
+    ck_assert_uint_eq(c.batches, 1);
+    ck_assert_uint_eq(c.batched, N);
+    ck_assert_uint_eq(c.steps, 0);
+    /* With a visitor, one observation at a time. */
+    ck_assert_int_eq(fe_source_rewind(&src), FE_OK);
+    c = (call_count){0};
+    ck_assert_int_eq(fe_scan_source(&f, &c, &src, count_visits, &visits, &done), FE_OK);
+    ck_assert_uint_eq(visits, N);
+    ck_assert_double_eq(c.sum, 499500.0);
+    ck_assert_uint_eq(c.steps, N);
+    ck_assert_uint_eq(c.batches, 0);
+    /* A file through 64 doubles. */
+    fd = mkstemp(path);
+    ck_assert_int_ge(fd, 0);
+    unlink(path);
+    ck_assert_int_eq(write(fd, x, sizeof x), (ssize_t)sizeof x);
+    ck_assert_int_eq(lseek(fd, 0, SEEK_SET), 0);
+    ck_assert_int_eq(fe_source_from_fd(&src, &fs, fd, sizeof(double), buf, sizeof buf), FE_OK);
+    c = (call_count){0};
+    ck_assert_int_eq(fe_fold_source(&f, &c, &src, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    ck_assert_double_eq(c.sum, 499500.0);
+    ck_assert_uint_eq(c.batched + c.steps, N);
+    ck_assert_uint_ge(c.batches, N / 64);
+    ck_assert_uint_le(c.largest, 64);
+    close(fd);
+    /* A generator holds nothing in memory. */
+    ck_assert_int_eq(fe_source_from_generator(&src, &gs, generate_index, &n, &slot, sizeof slot),
+                     FE_OK);
+    c = (call_count){0};
+    ck_assert_int_eq(fe_fold_source(&f, &c, &src, &done), FE_OK);
+    ck_assert_uint_eq(done, N);
+    ck_assert_double_eq(c.sum, 499500.0);
+    ck_assert_uint_eq(c.steps, N);
+    ck_assert_uint_eq(c.batches, 0);
+}
+END_TEST
+
 START_TEST(batched_fold_stops_exactly_at_the_refused_observation)
 {
     /* The library's own sources are folded in batches through step_many;
@@ -414,6 +518,7 @@ Suite *fe_stream_suite(void)
     tcase_add_test(t, fd_source_reads_records_through_a_small_buffer);
     tcase_add_test(t, fd_source_on_a_pipe_cannot_rewind);
     tcase_add_test(t, batched_fold_stops_exactly_at_the_refused_observation);
+    tcase_add_test(t, the_library_sources_in_memory_are_folded_through_step_many);
     tcase_add_test(t, bad_arguments_and_mismatched_sizes);
     tcase_add_test(t, sources_at_their_edges);
     tcase_add_test(t, fd_source_read_error_is_an_io_error);

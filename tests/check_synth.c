@@ -53,6 +53,11 @@ START_TEST(spec_refusals_at_their_edges)
             {"viscous_friction", 2, FE_OK}, {"viscous_friction", 1, FE_EINVAL},
             {"viscous_friction", 0, FE_OK}, {"viscous_friction", 3, FE_EINVAL},
             {"input_gain", 1, FE_OK}, {"input_gain", 2, FE_OK},
+            /* gain and delay are not forcings (synth.h): refused at order
+               1 and 2, taken at order 0 (seed 10223's synth:300 let
+               order 1 through). */
+            {"gain", 1, FE_EINVAL}, {"gain", 2, FE_EINVAL}, {"gain", 0, FE_OK},
+            {"delay", 1, FE_EINVAL}, {"delay", 2, FE_EINVAL}, {"delay", 0, FE_OK},
         };
         for (size_t i = 0; i < sizeof rig / sizeof rig[0]; i++) {
             s = fe_synth_default_spec(rig[i].effect, 3);
