@@ -2736,6 +2736,113 @@ static void lr_check(uint64_t seed, double wave, int shows, double *slope, doubl
     free(w);
 }
 
+/* The long-range factor under a fitted AR(1) model: each level's share of
+   a coefficient's whitened energy carries the whitening filter's power at
+   the level's frequency, pi / m_t radians a row for levels of m_t = n
+   2^(t-1) / B rows a side, and (1 - phi)^2 for the scaling coefficient.
+   The record: lr_check's columns and slow wave (0.3), AR(1) noise of
+   phi 0.5, the order held at 1; the scale fit reads ratios a little
+   above 1 (a flat line at 1.003), so every share counts in f.  From the rows: the whitened Gram matrix
+   sum_{t>=1} (z_t - phi z_{t-1})(z_t - phi z_{t-1})^T, each column made
+   orthogonal to the others in it, the raw Haar energies of its
+   fine-block sums over its whitened energy (the whole convolution, with
+   the transient rows at both ends, which the lagged sums cannot take
+   out), and the factor f = (1 - sum lambda) + sum lambda
+   max(1, V_t) with the engine's ratios V_t (checked against the rows
+   under white noise above) and no short-lag factor.  Then se_c^2 /
+   (G~^-1)_cc / f_c is the same s^2 for every coefficient. */
+START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
+{
+    static double z[LR_N][LR_M + 1];
+    size_t nst = fe_discover_acc_doubles(LR_M, 20), nw = fe_discover_workspace_doubles(LR_M, 20);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), *x = malloc(LR_N * sizeof *x);
+    fe_discover_group groups[LR_M] = {{"bias", 0, 1}, {"drift", 1, 1}, {"wave", 2, 1},
+                                      {"ripple", 3, 1}};
+    size_t base[LR_M] = {0, 1, 2, 3}, J, B;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_discover_acc a;
+    fe_rng g = fe_rng_seed(7);
+    double G[LR_M][LR_M] = {{0}}, Gi[LR_M][LR_M], e = 0.0, phi, s2[LR_M], fmin = INFINITY,
+           fmax = 0.0;
+    ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, LR_N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < LR_N; t++) {
+        double u = (double)t / LR_N;
+        e = 0.5 * e + fe_rng_normal(&g);
+        z[t][0] = 1.0;
+        z[t][1] = u;
+        z[t][2] = sin(9.0 * u);
+        z[t][3] = sin(0.47 * (double)t);
+        z[t][4] = 0.5 + 0.3 * u + e + 0.3 * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);
+        ck_assert_int_eq(fe_discover_add(&a, z[t], z[t][4]), FE_OK);
+    }
+    o.base = base;
+    o.nbase = LR_M;
+    o.max_steps = 0;
+    o.max_order = 1;
+    ck_assert_int_eq(fe_discover_select(&a, groups, LR_M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->noise.order, 1);
+    ck_assert_int_eq(r->noise.long_run, 0);
+    phi = r->noise.phi[0];
+    J = r->noise.scales;
+    B = a.fine;
+    ck_assert_uint_gt(J, 2);
+    for (size_t t = 1; t < LR_N; t++)
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                G[i][j] += (z[t][i] - phi * z[t - 1][i]) * (z[t][j] - phi * z[t - 1][j]);
+    {
+        long double Gl[LR_M * LR_M], Il[LR_M * LR_M];
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                Gl[i * LR_M + j] = G[i][j];
+        fe_test_inverse(LR_M, Gl, Il);
+        for (size_t i = 0; i < LR_M; i++)
+            for (size_t j = 0; j < LR_M; j++)
+                Gi[i][j] = (double)Il[i * LR_M + j];
+    }
+    for (size_t c = 0; c < LR_M; c++) {
+        double lam[16], total = 0.0, F = 0.0, f, energy = 0.0;
+        for (size_t t = 0; t < LR_N; t++) {
+            x[t] = 0.0;
+            for (size_t k = 0; k < LR_M; k++)
+                x[t] += Gi[k][c] * z[t][k];
+        }
+        for (size_t t = 0; t <= LR_N; t++) {       /* the whole convolution */
+            double v = (t < LR_N ? x[t] : 0.0) - (t > 0 ? phi * x[t - 1] : 0.0);
+            energy += v * v;
+        }
+        lr_haar(x, LR_N, B, lam);
+        for (size_t t = 1; t <= J + 1; t++) {
+            double mt = (double)LR_N * (double)((size_t)1 << (t - 1)) / (double)B;
+            double wt = t <= J ? 3.14159265358979323846 / mt : 0.0;
+            double power = 1.0 + phi * phi - 2.0 * phi * cos(wt);   /* |1 - phi e^{iw}|^2 */
+            lam[t - 1] *= power / energy;
+            total += lam[t - 1];
+        }
+        for (size_t t = 0; t <= J; t++) {
+            if (total > 1.0)
+                lam[t] /= total;
+            F += lam[t] * (r->noise.scale_ratio[t] > 1.0 ? r->noise.scale_ratio[t] : 1.0);
+        }
+        f = (1.0 - (total > 1.0 ? 1.0 : total)) + F;
+        fmin = f < fmin ? f : fmin;
+        fmax = f > fmax ? f : fmax;
+        s2[c] = r->stderr_[c] * r->stderr_[c] / Gi[c][c] / f;
+    }
+    /* The shares count: the slow columns are widened, by the ratios above
+       1 that they weigh (1.003 here), and the ripple is not. */
+    ck_assert_double_gt(fmax, 1.001);
+    ck_assert_double_lt(fmin, 1.0001);
+    for (size_t c = 1; c < LR_M; c++)
+        FE_ASSERT_REL(s2[c], s2[0], 1e-8);
+    free(r);
+    free(st);
+    free(w);
+    free(x);
+}
+END_TEST
+
 START_TEST(long_range_factor_and_its_degrees_of_freedom_against_the_rows)
 {
     double slope, sw, sx;
@@ -2907,6 +3014,88 @@ START_TEST(look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms)
         }
     free(r);
     free(q);
+    free(st);
+    free(w);
+}
+END_TEST
+
+/* A candidate that shares part of the added term's effect is not its
+   look-alike.  x1 = a + b and x2 = a - b with a and b orthogonal to each
+   other, to the constant and to the noise in the sample, var b = var a / 3,
+   and y = c a + e: the two rank alike (the same drop, so the same BIC),
+   and once x1 is in, x2 keeps a third of its drop (0.25 c^2 of 0.75 c^2,
+   the part of a that x1 cannot carry), more than the tenth the rule
+   allows a look-alike; it enters next, and the first step names no
+   look-alike.  (The noise model is held white, so that the drops are the
+   sample's own.) */
+START_TEST(a_partly_shared_effect_is_not_a_look_alike)
+{
+    enum { N = 3000, K = 20, M = 3 };
+    static double col[4][N];                         /* 1, e, a, b */
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), c = 0.2;
+    fe_discover_acc a;
+    fe_discover_group groups[M] = {{"bias", 0, 1}, {"x1", 1, 1}, {"x2", 2, 1}};
+    size_t base[1] = {0}, first, other;
+    fe_discover_options o = fe_discover_default_options();
+    fe_discover_result *r = malloc(sizeof *r);
+    fe_rng g = fe_rng_seed(41);
+    double before = NAN, after = NAN, bic_first = NAN, bic_other = NAN;
+    for (size_t t = 0; t < N; t++) {
+        col[0][t] = 1.0;
+        for (int k = 1; k < 4; k++)
+            col[k][t] = fe_rng_normal(&g);
+    }
+    for (int k = 1; k < 4; k++) {       /* Gram-Schmidt, twice: e, a, b */
+        for (int pass = 0; pass < 2; pass++)
+            for (int j = 0; j < k; j++) {
+                double d = 0.0, nn = 0.0;
+                for (size_t t = 0; t < N; t++) {
+                    d += col[j][t] * col[k][t];
+                    nn += col[j][t] * col[j][t];
+                }
+                for (size_t t = 0; t < N; t++)
+                    col[k][t] -= d / nn * col[j][t];
+            }
+    }
+    {
+        double sa = 0.0, sb = 0.0;
+        for (size_t t = 0; t < N; t++) {
+            sa += col[2][t] * col[2][t];
+            sb += col[3][t] * col[3][t];
+        }
+        for (size_t t = 0; t < N; t++)
+            col[3][t] *= sqrt(sa / 3.0 / sb);       /* var b = var a / 3 */
+    }
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, N, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < N; t++) {
+        double phi[M] = {1.0, col[2][t] + col[3][t], col[2][t] - col[3][t]};
+        ck_assert_int_eq(fe_discover_add(&a, phi, c * col[2][t] + col[1][t]), FE_OK);
+    }
+    o.base = base;
+    o.nbase = 1;
+    o.max_order = 0;
+    ck_assert_int_eq(fe_discover_select(&a, groups, M, &o, r, w, nw), FE_OK);
+    ck_assert_uint_eq(r->steps, 2);
+    first = r->added[0];
+    other = first == 1 ? 2 : 1;
+    ck_assert_uint_eq(r->added[1], other);
+    for (size_t i = 0; i < r->nranked[0]; i++)
+        if (r->ranking[0][i].group == other) {
+            before = r->ranking[0][i].rss_drop;
+            bic_other = r->ranking[0][i].delta_bic;
+        } else if (r->ranking[0][i].group == first) {
+            bic_first = r->ranking[0][i].delta_bic;
+        }
+    for (size_t i = 0; i < r->nranked[1]; i++)
+        if (r->ranking[1][i].group == other)
+            after = r->ranking[1][i].rss_drop;
+    /* What the rule is asked: the two within 6 of BIC, and the drop after
+       a third of the drop before (exactly, but for rounding). */
+    ck_assert_double_lt(fabs(bic_other - bic_first), 1e-6 * fabs(bic_first));
+    FE_ASSERT_REL(after / before, 1.0 / 3.0, 1e-9);
+    ck_assert_uint_eq(r->nalike[0], 0);
+    free(r);
     free(st);
     free(w);
 }
@@ -3875,6 +4064,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_stand_in_is_set_aside_and_selection_runs_again);
     tcase_add_test(t, two_candidates_that_only_explain_together_enter_as_a_pair);
     tcase_add_test(t, long_range_factor_and_its_degrees_of_freedom_against_the_rows);
+    tcase_add_test(t, long_range_shares_carry_the_filter_power_at_each_level);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_near_zero);
     tcase_add_test(t, the_line_through_the_levels_at_a_slope_numerator_below_one);
     tcase_add_test(t, one_haar_level_is_its_own_ratio);
@@ -3886,6 +4076,7 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, a_wide_fold_by_columns_stops_at_a_bad_last_column);
     tcase_add_test(t, the_widest_fold_by_columns_equals_the_rows);
     tcase_add_test(t, look_alikes_anywhere_in_the_ranking_and_probes_after_two_terms);
+    tcase_add_test(t, a_partly_shared_effect_is_not_a_look_alike);
     tcase_add_test(t, statistics_do_not_depend_on_the_residual_unit);
     tcase_add_test(t, fit_columns_sandwich_errors_match_brute_force);
     tcase_add_test(t, the_widest_accumulation_folds_and_fits);
