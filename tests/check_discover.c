@@ -2525,6 +2525,19 @@ END_TEST
    log ratios, and Satterthwaite's degrees of freedom. */
 enum { LR_N = 4096, LR_M = 4 };
 
+/* Gi = G^-1, through long double. */
+static void lr_inverse(double G[LR_M][LR_M], double Gi[LR_M][LR_M])
+{
+    long double Gl[LR_M * LR_M], Il[LR_M * LR_M];
+    for (size_t i = 0; i < LR_M; i++)
+        for (size_t j = 0; j < LR_M; j++)
+            Gl[i * LR_M + j] = G[i][j];
+    fe_test_inverse(LR_M, Gl, Il);
+    for (size_t i = 0; i < LR_M; i++)
+        for (size_t j = 0; j < LR_M; j++)
+            Gi[i][j] = (double)Il[i * LR_M + j];
+}
+
 static void lr_haar(const double *x, size_t n, size_t B, double *e)
 {
     double y[FE_DISCOVER_FINE_BLOCKS] = {0};
@@ -2592,16 +2605,7 @@ static void lr_check(uint64_t seed, double wave, int shows, double *slope, doubl
         for (size_t i = 0; i < LR_M; i++)
             for (size_t j = 0; j < LR_M; j++)
                 G[i][j] += z[t][i] * z[t][j];
-    {
-        long double Gl[LR_M * LR_M], Il[LR_M * LR_M];
-        for (size_t i = 0; i < LR_M; i++)
-            for (size_t j = 0; j < LR_M; j++)
-                Gl[i * LR_M + j] = G[i][j];
-        fe_test_inverse(LR_M, Gl, Il);
-        for (size_t i = 0; i < LR_M; i++)
-            for (size_t j = 0; j < LR_M; j++)
-                Gi[i][j] = (double)Il[i * LR_M + j];
-    }
+    lr_inverse(G, Gi);
     for (size_t t = 0; t < LR_N; t++) {
         double fit = 0.0;
         for (size_t i = 0; i < LR_M; i++)
@@ -2791,16 +2795,7 @@ START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
         for (size_t i = 0; i < LR_M; i++)
             for (size_t j = 0; j < LR_M; j++)
                 G[i][j] += (z[t][i] - phi * z[t - 1][i]) * (z[t][j] - phi * z[t - 1][j]);
-    {
-        long double Gl[LR_M * LR_M], Il[LR_M * LR_M];
-        for (size_t i = 0; i < LR_M; i++)
-            for (size_t j = 0; j < LR_M; j++)
-                Gl[i * LR_M + j] = G[i][j];
-        fe_test_inverse(LR_M, Gl, Il);
-        for (size_t i = 0; i < LR_M; i++)
-            for (size_t j = 0; j < LR_M; j++)
-                Gi[i][j] = (double)Il[i * LR_M + j];
-    }
+    lr_inverse(G, Gi);
     for (size_t c = 0; c < LR_M; c++) {
         double lam[16], total = 0.0, F = 0.0, f, energy = 0.0;
         for (size_t t = 0; t < LR_N; t++) {
