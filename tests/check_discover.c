@@ -2744,18 +2744,21 @@ static void lr_check(uint64_t seed, double wave, int shows, double *slope, doubl
    a coefficient's whitened energy carries the whitening filter's power at
    the level's frequency, pi / m_t radians a row for levels of m_t = n
    2^(t-1) / B rows a side, and (1 - phi)^2 for the scaling coefficient.
-   The record: lr_check's columns and slow wave (0.3), AR(1) noise of
-   phi 0.5, the order held at 1; the scale fit reads ratios a little
-   above 1 (a flat line at 1.003), so every share counts in f.  From the rows: the whitened Gram matrix
+   The record: n rows of lr_check's columns and a slow wave of amplitude
+   `wave`, AR(1) noise of coefficient phi_true, the order held at 1.  It
+   is checked only if the noise model is an AR(1) with no short-lag
+   factor and the scale fit reads ratios above 1 (at every level, or with
+   `coarse` at the coarsest detail level), so that the shares count in f;
+   returns whether it was.  From the rows: the whitened Gram matrix
    sum_{t>=1} (z_t - phi z_{t-1})(z_t - phi z_{t-1})^T, each column made
    orthogonal to the others in it, the raw Haar energies of its
    fine-block sums over its whitened energy (the whole convolution, with
    the transient rows at both ends, which the lagged sums cannot take
-   out), and the factor f = (1 - sum lambda) + sum lambda
-   max(1, V_t) with the engine's ratios V_t (checked against the rows
-   under white noise above) and no short-lag factor.  Then se_c^2 /
-   (G~^-1)_cc / f_c is the same s^2 for every coefficient. */
-START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
+   out), and the factor f = (1 - sum lambda) + sum lambda max(1, V_t)
+   with the engine's ratios V_t (checked against the rows under white
+   noise above).  Then se_c^2 / (G~^-1)_cc / f_c is the same s^2 for
+   every coefficient. */
+static int lr_ar1_check(size_t n, double phi_true, double wave, uint64_t seed, int coarse)
 {
     static double z[LR_N][LR_M + 1];
     size_t nst = fe_discover_acc_doubles(LR_M, 20), nw = fe_discover_workspace_doubles(LR_M, 20);
@@ -2766,18 +2769,19 @@ START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
     fe_discover_options o = fe_discover_default_options();
     fe_discover_result *r = malloc(sizeof *r);
     fe_discover_acc a;
-    fe_rng g = fe_rng_seed(7);
+    fe_rng g = fe_rng_seed(seed);
     double G[LR_M][LR_M] = {{0}}, Gi[LR_M][LR_M], e = 0.0, phi, s2[LR_M], fmin = INFINITY,
            fmax = 0.0;
-    ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, LR_N, 0, st, nst), FE_OK);
-    for (size_t t = 0; t < LR_N; t++) {
-        double u = (double)t / LR_N;
-        e = 0.5 * e + fe_rng_normal(&g);
+    int usable;
+    ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, n, 0, st, nst), FE_OK);
+    for (size_t t = 0; t < n; t++) {
+        double u = (double)t / (double)n;
+        e = phi_true * e + fe_rng_normal(&g);
         z[t][0] = 1.0;
         z[t][1] = u;
         z[t][2] = sin(9.0 * u);
         z[t][3] = sin(0.47 * (double)t);
-        z[t][4] = 0.5 + 0.3 * u + e + 0.3 * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);
+        z[t][4] = 0.5 + 0.3 * u + e + wave * sin(2.0 * 3.14159265358979 * 1.4 * u + 0.7);
         ck_assert_int_eq(fe_discover_add(&a, z[t], z[t][4]), FE_OK);
     }
     o.base = base;
@@ -2785,31 +2789,42 @@ START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
     o.max_steps = 0;
     o.max_order = 1;
     ck_assert_int_eq(fe_discover_select(&a, groups, LR_M, &o, r, w, nw), FE_OK);
-    ck_assert_uint_eq(r->noise.order, 1);
-    ck_assert_int_eq(r->noise.long_run, 0);
     phi = r->noise.phi[0];
     J = r->noise.scales;
     B = a.fine;
-    ck_assert_uint_gt(J, 2);
-    for (size_t t = 1; t < LR_N; t++)
+    /* The record must be one the check is about: an AR(1), no short-lag
+       factor, and a ratio above 1 where it matters (any level, or with
+       `coarse` the coarsest detail level). */
+    usable = r->noise.order == 1 && !r->noise.long_run && J > 2
+             && (coarse ? r->noise.scale_ratio[J - 1] > 1.01 : 1);
+    for (size_t t = 0; t <= J && usable && !coarse; t++)
+        usable = r->noise.scale_ratio[t] > 1.001;
+    if (!usable) {
+        free(r);
+        free(st);
+        free(w);
+        free(x);
+        return 0;
+    }
+    for (size_t t = 1; t < n; t++)
         for (size_t i = 0; i < LR_M; i++)
             for (size_t j = 0; j < LR_M; j++)
                 G[i][j] += (z[t][i] - phi * z[t - 1][i]) * (z[t][j] - phi * z[t - 1][j]);
     lr_inverse(G, Gi);
     for (size_t c = 0; c < LR_M; c++) {
         double lam[16], total = 0.0, F = 0.0, f, energy = 0.0;
-        for (size_t t = 0; t < LR_N; t++) {
+        for (size_t t = 0; t < n; t++) {
             x[t] = 0.0;
             for (size_t k = 0; k < LR_M; k++)
                 x[t] += Gi[k][c] * z[t][k];
         }
-        for (size_t t = 0; t <= LR_N; t++) {       /* the whole convolution */
-            double v = (t < LR_N ? x[t] : 0.0) - (t > 0 ? phi * x[t - 1] : 0.0);
+        for (size_t t = 0; t <= n; t++) {          /* the whole convolution */
+            double v = (t < n ? x[t] : 0.0) - (t > 0 ? phi * x[t - 1] : 0.0);
             energy += v * v;
         }
-        lr_haar(x, LR_N, B, lam);
+        lr_haar(x, n, B, lam);
         for (size_t t = 1; t <= J + 1; t++) {
-            double mt = (double)LR_N * (double)((size_t)1 << (t - 1)) / (double)B;
+            double mt = (double)n * (double)((size_t)1 << (t - 1)) / (double)B;
             double wt = t <= J ? 3.14159265358979323846 / mt : 0.0;
             double power = 1.0 + phi * phi - 2.0 * phi * cos(wt);   /* |1 - phi e^{iw}|^2 */
             lam[t - 1] *= power / energy;
@@ -2825,16 +2840,32 @@ START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
         fmax = f > fmax ? f : fmax;
         s2[c] = r->stderr_[c] * r->stderr_[c] / Gi[c][c] / f;
     }
-    /* The shares count: the slow columns are widened, by the ratios above
-       1 that they weigh (1.003 here), and the ripple is not. */
+    /* The shares count: the slow columns are widened by the ratios above
+       1 that they weigh, and on the long record the ripple is not. */
     ck_assert_double_gt(fmax, 1.001);
-    ck_assert_double_lt(fmin, 1.0001);
+    ck_assert(coarse || fmin < 1.0001);
     for (size_t c = 1; c < LR_M; c++)
         FE_ASSERT_REL(s2[c], s2[0], 1e-8);
     free(r);
     free(st);
     free(w);
     free(x);
+    return 1;
+}
+
+START_TEST(long_range_shares_carry_the_filter_power_at_each_level)
+{
+    int found = 0;
+    /* 4096 rows, phi 0.5, a flat line of ratios at 1.003. */
+    ck_assert(lr_ar1_check(LR_N, 0.5, 0.3, 7, 0));
+    /* A short red record, where the coarsest detail level is few rows a
+       side and the filter's power there is far from its power at 0: the
+       first seed whose record keeps the portmanteau quiet and reads a
+       ratio above 1 at that level (seed 1, 256 rows in 16 fine blocks,
+       on the machine where it was written). */
+    for (uint64_t seed = 1; seed <= 200 && !found; seed++)
+        found = lr_ar1_check(256, 0.95, 0.0, seed, 1);
+    ck_assert(found);
 }
 END_TEST
 
