@@ -203,7 +203,14 @@ START_TEST(calibration_maps_to_the_unit_sphere)
         worst = fmax(worst, fabs(sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]) - 1.0));
     }
     ck_assert_double_le(worst, 1e-9);
-    ck_assert_double_le(f.rms_percent, 1e-7);
+    /* On exact data the RMS is 0, and what the moments give is the
+       rounding of S = theta^T Phi theta, whose terms cancel: the chapter
+       puts S / N at about 1e-14, so 50 sqrt(S / N) is at most 5e-6 per
+       cent.  (A bound of 1e-7 per cent held only while S came out at or
+       below 0: with the rounding of another summation order, the
+       four-lane kernel over blocks that grow the box, S / N = 2.6e-16
+       gave 8.1e-7.)  The map itself is checked above, to 1e-9. */
+    ck_assert_double_le(f.rms_percent, 50.0 * sqrt(1e-14));
     FE_ASSERT_REL(f.radius, cbrt(400.0 * 380.0 * 420.0), 1e-9);
     /* M is symmetric. */
     FE_ASSERT_REL(f.matrix[1], f.matrix[3], 1e-9);
