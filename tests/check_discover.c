@@ -3668,6 +3668,39 @@ START_TEST(documented_refusals_at_their_edges)
 }
 END_TEST
 
+/* An accumulation of m columns and k blocks holding `row` as its first
+   row (index 0), with a copy of it and of its storage, for the tests of a
+   row that starts a recording and is refused before the break. */
+struct break_snap { fe_discover_acc a, before; double *st, *copy; size_t nst; };
+
+static void break_snap_open(struct break_snap *b, size_t m, size_t k, fe_discover_row *row)
+{
+    b->nst = fe_discover_acc_doubles(m, k);
+    b->st = calloc(b->nst, sizeof *b->st);
+    b->copy = calloc(b->nst, sizeof *b->copy);
+    ck_assert_int_eq(fe_discover_acc_init(&b->a, m, k, 100, 0, b->st, b->nst), FE_OK);
+    ck_assert_int_eq(fe_discover_add_row(&b->a, row), FE_OK);
+    b->before = b->a;
+    memcpy(b->copy, b->st, b->nst * sizeof *b->st);
+    row->index = 1;
+    row->starts_recording = 1;
+}
+
+/* The row is refused (FE_ENONFINITE), the accumulation and its storage
+   unchanged to the byte. */
+static void break_snap_refused(struct break_snap *b, const fe_discover_row *row)
+{
+    ck_assert_int_eq(fe_discover_add_row(&b->a, row), FE_ENONFINITE);
+    ck_assert_mem_eq(&b->a, &b->before, sizeof b->a);
+    ck_assert_mem_eq(b->st, b->copy, b->nst * sizeof *b->st);
+}
+
+static void break_snap_close(struct break_snap *b)
+{
+    free(b->st);
+    free(b->copy);
+}
+
 /* A row that starts a recording with a value not finite in any one of
    its columns is refused before the break, the accumulation unchanged to
    the byte (discover.h: "a is then unchanged"); the refusals test put its
@@ -3679,30 +3712,20 @@ END_TEST
 START_TEST(a_break_row_not_finite_in_any_column_is_refused_before_the_break)
 {
     enum { M = 3, K = 4 };
-    size_t nst = fe_discover_acc_doubles(M, K);
-    double *st = calloc(nst, sizeof *st), *copy = calloc(nst, sizeof *copy);
     double phi[M] = {1.0, 2.0, 3.0};
     const double bad[2] = {NAN, INFINITY};
-    fe_discover_acc a, before;
     fe_discover_row row = {0, phi, 0.5, 0};
-    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
-    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
-    before = a;
-    memcpy(copy, st, nst * sizeof *st);
-    row.index = 1;
-    row.starts_recording = 1;
+    struct break_snap b;
+    break_snap_open(&b, M, K, &row);
     for (int c = 0; c < M; c++)
         for (int v = 0; v < 2; v++) {
             phi[c] = bad[v];
-            ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
-            ck_assert_mem_eq(&a, &before, sizeof a);
-            ck_assert_mem_eq(st, copy, nst * sizeof *st);
+            break_snap_refused(&b, &row);
             phi[c] = 1.0 + c;
         }
-    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
-    ck_assert_uint_eq(a.n, 2);
-    free(st);
-    free(copy);
+    ck_assert_int_eq(fe_discover_add_row(&b.a, &row), FE_OK);
+    ck_assert_uint_eq(b.a.n, 2);
+    break_snap_close(&b);
 }
 END_TEST
 
@@ -3767,25 +3790,15 @@ END_TEST
 START_TEST(a_break_row_whose_square_overflows_a_sum_is_refused_before_the_break)
 {
     enum { M = 2, K = 4 };
-    size_t nst = fe_discover_acc_doubles(M, K);
-    double *st = malloc(nst * sizeof *st), *copy = malloc(nst * sizeof *st);
     double phi[M] = {1e154, 0.0};
-    fe_discover_acc a, before;
     fe_discover_row row = {0, phi, 0.0, 0};
-    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, 100, 0, st, nst), FE_OK);
-    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
-    before = a;
-    memcpy(copy, st, nst * sizeof *st);
-    row.index = 1;
-    row.starts_recording = 1;
-    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_ENONFINITE);
-    ck_assert_mem_eq(&a, &before, sizeof a);
-    ck_assert_mem_eq(st, copy, nst * sizeof *st);
+    struct break_snap b;
+    break_snap_open(&b, M, K, &row);
+    break_snap_refused(&b, &row);
     phi[0] = 1e153;
-    ck_assert_int_eq(fe_discover_add_row(&a, &row), FE_OK);
-    ck_assert_uint_eq(a.n, 2);
-    free(st);
-    free(copy);
+    ck_assert_int_eq(fe_discover_add_row(&b.a, &row), FE_OK);
+    ck_assert_uint_eq(b.a.n, 2);
+    break_snap_close(&b);
 }
 END_TEST
 
