@@ -2286,6 +2286,182 @@ typedef struct fe__scalefit {
     double var[FE_DISCOVER_SCALES];
 } fe__scalefit;
 
+/* A random walk beside the AR model: see the text.  Levels, the fewest
+   for which the walk is tried, and the grid of its variance. */
+enum { FE__WALK_LEVELS = 6, FE__WALK_GRID = 49 };
+#define FE__WALK_GAIN 2.0       /* Akaike's price of the walk's one parameter */
+#define FE__WALK_FIT 0.05       /* the least p-value of the walk's own fit */
+
+/* The weighted line c + b x through y (weights wt, levels x = 1 .. J),
+   its slope at least 0 (the weighted mean otherwise); returns the
+   weighted sum of squares left. */
+static double fe__level_line(const double *y, const double *wt, size_t J, double *c,
+                             double *b)
+{
+    double sw = 0.0, sx = 0.0, sxx = 0.0, sy = 0.0, sxy = 0.0, det, ssr = 0.0;
+    for (size_t i = 1; i <= J; i++) {
+        double x = (double)i;
+        sw += wt[i - 1];
+        sx += wt[i - 1] * x;
+        sxx += wt[i - 1] * x * x;
+        sy += wt[i - 1] * y[i - 1];
+        sxy += wt[i - 1] * x * y[i - 1];
+    }
+    det = sw * sxx - sx * sx;
+    *b = det > 1e-12 * sw * sxx ? (sw * sxy - sx * sy) / det : 0.0;
+    if (!(*b > 0.0))
+        *b = 0.0;
+    *c = (sy - *b * sx) / sw;
+    for (size_t i = 1; i <= J; i++) {
+        double e = y[i - 1] - *c - *b * (double)i;
+        ssr += wt[i - 1] * e * e;
+    }
+    return ssr;
+}
+
+/* The line through y_i - ln(1 + A r_i) (y: room for J values); returns
+   its weighted sum of squares, the line in *c and *b. */
+static double fe__walk_ssr(const double *ly, const double *wt, const double *r, size_t J,
+                           double A, double *y, double *c, double *b)
+{
+    for (size_t i = 0; i < J; i++)
+        y[i] = ly[i] - log1p(A * r[i]);
+    return fe__level_line(y, wt, J, c, b);
+}
+
+/* r_t, t = 1 .. J + 1: a random walk's variance at each level (and at the
+   scaling coefficient, t = J + 1) per unit variance of its steps, over
+   the AR model's prediction nz->scale_model. */
+static void fe__walk_shape(const fe_discover_acc *a, const fe_discover_noise *nz, double *r)
+{
+    double n = fe__fitted_rows(a);
+    size_t J = nz->scales;
+    for (size_t t = 1; t <= J + 1; t++) {
+        double m = t <= J ? floor(n * (double)((size_t)1 << (t - 1)) / (double)a->fine + 0.5)
+                          : n, w;
+        if (m < 1.0)
+            m = 1.0;
+        /* Haar: two adjacent sums of m rows differ by
+           sum_s c_s eta_s, sum c_s^2 = m (2 m^2 + 1) / 3, over 2 m; the
+           whole record: sum of n rows, n (n + 1) (2 n + 1) / 6, over n. */
+        w = t <= J ? (2.0 * m * m + 1.0) / 6.0 : (m + 1.0) * (2.0 * m + 1.0) / 6.0;
+        r[t - 1] = nz->scale_model[t - 1] > 0.0 ? w / nz->scale_model[t - 1] : 0.0;
+    }
+}
+
+/* When a random walk beside the AR model, ln V_t = c + b t + ln(1 + A r_t),
+   fits the levels' y better than the line by more than Akaike's price of
+   its one more parameter, and fits them itself, it replaces the line in
+   sf: ln V at
+   every level and the scaling coefficient, and the linear map of the
+   y_i (Gauss-Newton's, at the fitted A) for the degrees of freedom. */
+static void fe__scale_walk(const fe_discover_acc *a, const fe_discover_noise *nz,
+                           const double *ly, const double *wt, size_t usable,
+                           fe__scalefit *sf)
+{
+    size_t J = nz->scales, np;
+    double r[FE_DISCOVER_SCALES + 1] = {0}, y[FE_DISCOVER_SCALES], rmax = 0.0;
+    double c, b, ssr0, best = 0.0, bc = 0.0, bb = 0.0, A = 0.0;
+    double jt[FE_DISCOVER_SCALES][3], m[3][3] = {{0}}, inv[3][3], det;
+    fe__walk_shape(a, nz, r);
+    for (size_t i = 0; i < J; i++)
+        if (wt[i] > 0.0 && r[i] > rmax)
+            rmax = r[i];
+    if (!(rmax > 0.0))
+        return;
+    ssr0 = fe__level_line(ly, wt, J, &c, &b);
+    best = ssr0;
+    for (int g = 0; g < FE__WALK_GRID; g++) {
+        double u = -2.0 + 8.0 * (double)g / (FE__WALK_GRID - 1);
+        double ssr = fe__walk_ssr(ly, wt, r, J, pow(10.0, u) / rmax, y, &c, &b);
+        if (ssr < best) {
+            best = ssr;
+            A = pow(10.0, u) / rmax;
+        }
+    }
+    if (A > 0.0) {
+        /* Golden section on log10(A max r) between the best point's
+           neighbours on the grid. */
+        const double gr = 0.6180339887498949, step = 8.0 / (FE__WALK_GRID - 1);
+        double u0 = log10(A * rmax), lo = u0 - step, hi = u0 + step, u1, u2, f1, f2;
+        lo = lo < -2.0 ? -2.0 : lo;
+        hi = hi > 6.0 ? 6.0 : hi;
+        u1 = hi - gr * (hi - lo);
+        u2 = lo + gr * (hi - lo);
+        f1 = fe__walk_ssr(ly, wt, r, J, pow(10.0, u1) / rmax, y, &c, &b);
+        f2 = fe__walk_ssr(ly, wt, r, J, pow(10.0, u2) / rmax, y, &c, &b);
+        for (int it = 0; it < 60; it++) {
+            if (f1 <= f2) {
+                hi = u2;
+                u2 = u1;
+                f2 = f1;
+                u1 = hi - gr * (hi - lo);
+                f1 = fe__walk_ssr(ly, wt, r, J, pow(10.0, u1) / rmax, y, &c, &b);
+            } else {
+                lo = u1;
+                u1 = u2;
+                f1 = f2;
+                u2 = lo + gr * (hi - lo);
+                f2 = fe__walk_ssr(ly, wt, r, J, pow(10.0, u2) / rmax, y, &c, &b);
+            }
+        }
+        if ((f1 <= f2 ? f1 : f2) < best)
+            A = pow(10.0, f1 <= f2 ? u1 : u2) / rmax;
+        best = fe__walk_ssr(ly, wt, r, J, A, y, &bc, &bb);
+    }
+    /* The walk must beat the line and describe the levels itself: a
+       missing effect bends the levels too, but not as a walk does. */
+    np = bb > 0.0 ? 3 : 2;
+    if (!(ssr0 - best > FE__WALK_GAIN)
+        || !(fe_chi2_upper(best, (double)(usable - np)) >= FE__WALK_FIT))
+        return;
+    /* Gauss-Newton's linear map at A: the columns 1, t (unless the slope
+       is held at 0) and r_t / (1 + A r_t). */
+    for (size_t i = 0; i < J; i++) {
+        jt[i][0] = 1.0;
+        jt[i][1] = (double)(i + 1);
+        jt[i][2] = r[i] / (1.0 + A * r[i]);
+        if (np == 2)
+            jt[i][1] = jt[i][2];
+        for (size_t p = 0; p < np; p++)
+            for (size_t q = 0; q < np; q++)
+                m[p][q] += wt[i] * jt[i][p] * jt[i][q];
+    }
+    if (np == 2) {
+        det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        if (!(det > 0.0))
+            return;
+        inv[0][0] = m[1][1] / det;
+        inv[1][1] = m[0][0] / det;
+        inv[0][1] = inv[1][0] = -m[0][1] / det;
+    } else {
+        det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+              - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+              + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        if (!(det > 0.0))
+            return;
+        for (size_t p = 0; p < 3; p++)
+            for (size_t q = 0; q < 3; q++) {
+                size_t p1 = (q + 1) % 3, p2 = (q + 2) % 3, q1 = (p + 1) % 3,
+                       q2 = (p + 2) % 3;
+                inv[p][q] = (m[p1][q1] * m[p2][q2] - m[p1][q2] * m[p2][q1]) / det;
+            }
+    }
+    for (size_t t = 1; t <= J + 1; t++) {
+        double gt[3] = {1.0, (double)t, r[t - 1] / (1.0 + A * r[t - 1])};
+        if (np == 2)
+            gt[1] = gt[2];
+        sf->lnv[t - 1] = bc + bb * (double)t + log1p(A * r[t - 1]);
+        for (size_t i = 0; i < J; i++) {
+            double s = 0.0;
+            for (size_t p = 0; p < np; p++)
+                for (size_t q = 0; q < np; q++)
+                    s += gt[p] * inv[p][q] * jt[i][q];
+            sf->coef[t - 1][i] = s * wt[i];
+        }
+    }
+}
+
 static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
                           const double *u, double var, const double *used, fe__scalefit *sf)
 {
@@ -2329,6 +2505,8 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
             sf->coef[t - 1][i - 1] = c;
             sf->lnv[t - 1] += c * ly[i - 1];
         }
+    if (usable >= FE__WALK_LEVELS)
+        fe__scale_walk(a, nz, ly, wt, usable, sf);
 }
 
 /* The long-range part of a variance factor: sum_t lambda_t max(1, V_t)

@@ -13,8 +13,10 @@ See tests/accept/README.md.
 
     run.py              everything (make accept)
     run.py --dynamics   the dynamics section only (make accept-dynamics)
+    run.py --static     everything but the dynamics section
 
-Environment: SEEDS (default 20), QUICK=1 (3 seeds), JOBS (at most 2),
+Environment: SEEDS (default 20), SEED0 (the first seed, default 0), QUICK=1 (3 seeds), JOBS (at most 2),
+ACCEPT_MODES (the noise modes of the static section to run, e.g. default),
 FOLDEST (build/bin/foldest), GEN (build/accept/gen), GEN_DYN
 (build/accept/gen_dyn), ACCEPT_OUT (build/accept/runs), FOLDEST_DATA
 (../shared/data), KEEP=1 keeps the files.  Results: ACCEPT_OUT/results.json,
@@ -38,6 +40,7 @@ OUT = os.environ.get("ACCEPT_OUT", "build/accept/runs")
 DATA = os.environ.get("FOLDEST_DATA", "../shared/data")
 QUICK = os.environ.get("QUICK", "") not in ("", "0")
 SEEDS = int(os.environ.get("SEEDS", "3" if QUICK else "20"))
+SEED0 = int(os.environ.get("SEED0", "0"))   # the first seed: SEED0 .. SEED0 + SEEDS - 1
 JOBS = max(1, min(2, int(os.environ.get("JOBS", "2"))))
 KEEP = os.environ.get("KEEP", "") not in ("", "0")
 
@@ -55,6 +58,8 @@ def discover_help():
 MODES = [("default", [])]
 if "--noise" in discover_help():
     MODES.append(("batch", ["--noise", "batch"]))
+if os.environ.get("ACCEPT_MODES"):      # e.g. ACCEPT_MODES=default: one column only
+    MODES = [m for m in MODES if m[0] in os.environ["ACCEPT_MODES"].split(",")]
 
 
 def discover(args):
@@ -376,7 +381,7 @@ def dynamics():
     modes, has_order = dyn_modes()
     cases = [l.split()[0] for l in subprocess.run([GEN_DYN, "--list"], capture_output=True, text=True,
                                                   check=True).stdout.splitlines()]
-    tasks = [(c, s) for s in range(SEEDS) for c in cases]
+    tasks = [(c, s) for s in range(SEED0, SEED0 + SEEDS) for c in cases]
     print("\nfoldest discover dynamics acceptance: %d cases x %d seeds, modes: %s, %d workers"
           % (len(cases), SEEDS, ", ".join(m for m, _ in modes), JOBS))
     t0 = time.time()
@@ -423,7 +428,7 @@ def main():
         return
     cases = [l.split()[0] for l in subprocess.run([GEN, "--list"], capture_output=True, text=True,
                                                   check=True).stdout.splitlines()]
-    tasks = [(c, s) for s in range(SEEDS) for c in cases]
+    tasks = [(c, s) for s in range(SEED0, SEED0 + SEEDS) for c in cases]
     print("foldest discover acceptance: %d cases x %d seeds, modes: %s, %d workers"
           % (len(cases), SEEDS, ", ".join(m if not e else " ".join(e) for m, e in MODES), JOBS))
     t0 = time.time()
@@ -439,6 +444,10 @@ def main():
     print_tables(runs)
     real_recordings()
     user_terms_table()
+    if "--static" in sys.argv[1:]:
+        print("\nper-run results: %s (key static); %.0f s"
+              % (os.path.join(OUT, "results.json"), time.time() - t0))
+        return
     save("dynamics", dynamics())
     print("\nper-run results: %s (keys static, dynamics); %.0f s"
           % (os.path.join(OUT, "results.json"), time.time() - t0))
