@@ -900,11 +900,21 @@ START_TEST(columns_stop_at_the_first_refused_row)
     /* By columns, into a screen and into a narrow full accumulation: a NaN
        at row 150 stops the fold there, as row by row; a value of 1e150
        goes through the row step's guard and the fold goes on; 1e200 is
-       refused at its row. */
-    static const size_t ms[] = {PM, WM}, nbs[] = {PM, 2};
+       refused at its row.  The bad values are in column 3, and in the last
+       case in column 9.  The third case is a screen of four columns whose
+       one band column (3, past the three base columns) holds them: the
+       panel's guard on the band's sums of squares must stop it alone (seed
+       10303's neighbour discover:1940, that guard turned round, which let
+       a panel through only when every band column failed it: with several
+       band columns and one bad, the others' sums refused every panel).
+       The fourth puts them in the last of eight band columns, whose sum of
+       squares is the band's entry 21 (seed 10303's neighbour
+       discover:1944, the guard reading entry 7, a product of two other
+       columns). */
+    static const size_t ms[] = {PM, WM, 4, WM}, nbs[] = {PM, 2, 3, 2}, bads[] = {3, 3, 3, 9};
     wide_rows();
-    for (size_t c = 0; c < 2; c++) {
-        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK), done = 99;
+    for (size_t c = 0; c < 4; c++) {
+        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK), done = 99, b = bads[c];
         double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2), keep;
         fe_discover_acc rows, cols;
         ck_assert_int_eq(fe_discover_screen_init(&rows, m, nbs[c], PK, PFIT, 0, s1, nst), FE_OK);
@@ -912,24 +922,24 @@ START_TEST(columns_stop_at_the_first_refused_row)
         ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], 1, pr, 2, &done), FE_EINVAL);
         ck_assert_uint_eq(done, 0);
         add_wide_rows(&rows, 0, 150);
-        keep = wcol[3][150];
-        wcol[3][150] = NAN;
+        keep = wcol[b][150];
+        wcol[b][150] = NAN;
         ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], PN, pr, 400, &done),
                          FE_ENONFINITE);
         ck_assert_uint_eq(done, 150);
         assert_same_sums(&cols, &rows);
-        wcol[3][150] = 1e200;
+        wcol[b][150] = 1e200;
         ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 100, &done),
                          FE_ENONFINITE);
         ck_assert_uint_eq(done, 0);
-        wcol[3][150] = 1e150;
-        wide[150][3] = 1e150;
+        wcol[b][150] = 1e150;
+        wide[150][b] = 1e150;
         ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 300, &done),
                          FE_OK);
         ck_assert_uint_eq(done, 300);
         add_wide_rows(&rows, 150, 450);
-        wcol[3][150] = keep;
-        wide[150][3] = keep;
+        wcol[b][150] = keep;
+        wide[150][b] = keep;
         assert_same_sums(&cols, &rows);
         /* Values of 8e99 in a column of 100 rows: each passes the row
            step's guard, their sum of squares (6.4e201) does not pass the
