@@ -586,6 +586,94 @@ START_TEST(row_and_term_strides_at_their_edges)
 }
 END_TEST
 
+/* Each pointer argument of each catalog function null alone, the others
+   valid: FE_EINVAL, and nothing written (seed 10301's catalog:176, two
+   of the three null checks of fe_catalog_eval joined by && instead of ||:
+   the only null tested was the catalog's, with sample and output given). */
+START_TEST(each_null_argument_is_refused_alone)
+{
+    enum { N = 2 };
+    fe_catalog_scale scale = {0, 0, 0, 0, 0, 0};
+    fe_catalog c;
+    fe_catalog_axes ax;
+    fe_sample s = {5.0, 1.0, 3.0, -0.5, 2.0, -4.0, 30.0, 10.0, 7.0};
+    double phi[N * FE_DISCOVER_MAX_GROUPS], rows[N * FE_CATALOG_VARS], r = 0;
+    double k = 3.0, *work = malloc(fe_catalog_work_doubles(N) * sizeof *work);
+    const double b[3] = {10, -20, 30}, x[3] = {13, -20, 34};
+    size_t nv, col = 0, count;
+    const char *const *vn = fe_catalog_var_names(&nv);
+    fe_expr e;
+    ck_assert_ptr_nonnull(work);
+    ck_assert_int_eq(fe_expr_compile(&e, "2*t", vn, nv, &col, NULL, 0), FE_OK);
+    ck_assert_int_eq(fe_catalog_scale_add(&scale, &s), FE_OK);
+    ck_assert_int_eq(fe_catalog_scale_add(&scale, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_scale_add(NULL, &s), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY, &scale), FE_OK);
+    ck_assert_int_eq(fe_catalog_init(NULL, 0, &scale), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_init(&c, 0, NULL), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_init(&c, FE_ROLE_POSITION | FE_ROLE_VELOCITY, &scale), FE_OK);
+    count = c.count;
+    /* Adding a term: catalog, name, function or expression null. */
+    ck_assert_int_eq(fe_catalog_add(NULL, "u", "user", user_term, &k), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add(&c, NULL, "user", user_term, &k), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add(&c, "u", "user", NULL, &k), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(NULL, "v", "", &e), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, NULL, "", &e), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "v", "", NULL), FE_EINVAL);
+    ck_assert_uint_eq(c.count, count);
+    ck_assert_int_eq(fe_catalog_add(&c, "u", "user", user_term, &k), FE_OK);
+    ck_assert_int_eq(fe_catalog_add_expr(&c, "v", "", &e), FE_OK);
+    count = c.count;
+    /* One sample: catalog, sample or output null; phi untouched. */
+    for (size_t j = 0; j < count; j++)
+        phi[j] = -7.0;
+    ck_assert_int_eq(fe_catalog_eval(NULL, &s, phi), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval(&c, NULL, phi), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, NULL), FE_EINVAL);
+    for (size_t j = 0; j < count; j++)
+        ck_assert_double_eq(phi[j], -7.0);
+    ck_assert_int_eq(fe_catalog_eval(&c, &s, phi), FE_OK);
+    ck_assert_double_eq(phi[count - 2], 3.0 * s.t);
+    ck_assert_double_eq(phi[count - 1], 2.0 * s.t);
+    /* Rows: catalog, rows, output or workspace null; phi untouched. */
+    fe_catalog_row(&s, rows);
+    fe_catalog_row(&s, rows + FE_CATALOG_VARS);
+    for (size_t j = 0; j < N * count; j++)
+        phi[j] = -7.0;
+    ck_assert_int_eq(fe_catalog_eval_rows(NULL, rows, FE_CATALOG_VARS, N, phi, count, work, NULL),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, NULL, FE_CATALOG_VARS, N, phi, count, work, NULL),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, N, NULL, count, work, NULL),
+                     FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, N, phi, count, NULL, NULL),
+                     FE_EINVAL);
+    for (size_t j = 0; j < N * count; j++)
+        ck_assert_double_eq(phi[j], -7.0);
+    ck_assert_int_eq(fe_catalog_eval_rows(&c, rows, FE_CATALOG_VARS, N, phi, count, work, NULL),
+                     FE_OK);
+    ck_assert_double_eq(phi[2 * count - 2], 3.0 * s.t);
+    /* Probes: catalog null. */
+    ck_assert_int_eq(fe_catalog_add_probes(NULL, FE_CATALOG_VAR_VELOCITY, 0, 1, 4), FE_EINVAL);
+    /* Three axes: catalog, centre, sample, output or radius null. */
+    ck_assert_int_eq(fe_catalog_axes_init(NULL, b, 0, 0, 0, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_init(&ax, NULL, 0, 0, 0, 0), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_init(&ax, b, 0, 0, 0, 0), FE_OK);
+    for (size_t j = 0; j < FE_CATALOG_AXES_COLUMNS; j++)
+        phi[j] = -7.0;
+    ck_assert_int_eq(fe_catalog_axes_eval(NULL, x, 0, 0, phi, &r), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_eval(&ax, NULL, 0, 0, phi, &r), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_eval(&ax, x, 0, 0, NULL, &r), FE_EINVAL);
+    ck_assert_int_eq(fe_catalog_axes_eval(&ax, x, 0, 0, phi, NULL), FE_EINVAL);
+    for (size_t j = 0; j < FE_CATALOG_AXES_COLUMNS; j++)
+        ck_assert_double_eq(phi[j], -7.0);
+    ck_assert_double_eq(r, 0.0);
+    ck_assert_int_eq(fe_catalog_axes_eval(&ax, x, 0, 0, phi, &r), FE_OK);
+    ck_assert_double_eq_tol(r, 5.0, 1e-14);   /* |(3, 0, 4)| */
+    free(work);
+}
+END_TEST
+
 Suite *fe_catalog_suite(void)
 {
     Suite *s = suite_create("catalog");
@@ -602,6 +690,7 @@ Suite *fe_catalog_suite(void)
     tcase_add_test(t, three_axis_centre_refused_in_each_coordinate);
     tcase_add_test(t, scale_is_the_first_sample_and_the_largest_speed);
     tcase_add_test(t, row_and_term_strides_at_their_edges);
+    tcase_add_test(t, each_null_argument_is_refused_alone);
     suite_add_tcase(s, t);
     return s;
 }

@@ -900,11 +900,21 @@ START_TEST(columns_stop_at_the_first_refused_row)
     /* By columns, into a screen and into a narrow full accumulation: a NaN
        at row 150 stops the fold there, as row by row; a value of 1e150
        goes through the row step's guard and the fold goes on; 1e200 is
-       refused at its row. */
-    static const size_t ms[] = {PM, WM}, nbs[] = {PM, 2};
+       refused at its row.  The bad values are in column 3, and in the last
+       case in column 9.  The third case is a screen of four columns whose
+       one band column (3, past the three base columns) holds them: the
+       panel's guard on the band's sums of squares must stop it alone (seed
+       10303's neighbour discover:1940, that guard turned round, which let
+       a panel through only when every band column failed it: with several
+       band columns and one bad, the others' sums refused every panel).
+       The fourth puts them in the last of eight band columns, whose sum of
+       squares is the band's entry 21 (seed 10303's neighbour
+       discover:1944, the guard reading entry 7, a product of two other
+       columns). */
+    static const size_t ms[] = {PM, WM, 4, WM}, nbs[] = {PM, 2, 3, 2}, bads[] = {3, 3, 3, 9};
     wide_rows();
-    for (size_t c = 0; c < 2; c++) {
-        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK), done = 99;
+    for (size_t c = 0; c < 4; c++) {
+        size_t m = ms[c], nst = fe_discover_acc_doubles(m, PK), done = 99, b = bads[c];
         double *s1 = malloc(nst * sizeof *s1), *s2 = malloc(nst * sizeof *s2), keep;
         fe_discover_acc rows, cols;
         ck_assert_int_eq(fe_discover_screen_init(&rows, m, nbs[c], PK, PFIT, 0, s1, nst), FE_OK);
@@ -912,24 +922,24 @@ START_TEST(columns_stop_at_the_first_refused_row)
         ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], 1, pr, 2, &done), FE_EINVAL);
         ck_assert_uint_eq(done, 0);
         add_wide_rows(&rows, 0, 150);
-        keep = wcol[3][150];
-        wcol[3][150] = NAN;
+        keep = wcol[b][150];
+        wcol[b][150] = NAN;
         ck_assert_int_eq(fe_discover_add_columns(&cols, wcol[0], PN, pr, 400, &done),
                          FE_ENONFINITE);
         ck_assert_uint_eq(done, 150);
         assert_same_sums(&cols, &rows);
-        wcol[3][150] = 1e200;
+        wcol[b][150] = 1e200;
         ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 100, &done),
                          FE_ENONFINITE);
         ck_assert_uint_eq(done, 0);
-        wcol[3][150] = 1e150;
-        wide[150][3] = 1e150;
+        wcol[b][150] = 1e150;
+        wide[150][b] = 1e150;
         ck_assert_int_eq(fe_discover_add_columns(&cols, &wcol[0][150], PN, pr + 150, 300, &done),
                          FE_OK);
         ck_assert_uint_eq(done, 300);
         add_wide_rows(&rows, 150, 450);
-        wcol[3][150] = keep;
-        wide[150][3] = keep;
+        wcol[b][150] = keep;
+        wide[150][b] = keep;
         assert_same_sums(&cols, &rows);
         /* Values of 8e99 in a column of 100 rows: each passes the row
            step's guard, their sum of squares (6.4e201) does not pass the
@@ -1904,6 +1914,188 @@ START_TEST(levinson_recovers_a_known_autoregression)
     ck_assert_int_eq(fe_discover_noise_fit(q, 1.0, 4, &nz), FE_EINVAL);
     ck_assert_int_eq(fe_discover_noise_fit(q, n, FE_DISCOVER_LAGS, &nz), FE_EINVAL);
     ck_assert_int_eq(fe_discover_noise_fit(NULL, n, 4, &nz), FE_EINVAL);
+}
+END_TEST
+
+/* Every figure of both fits' summaries against the rows themselves, on
+   red noise (AR(1), phi 0.6: lag-one correlation of the residual near
+   +0.6) and on blue noise (MA(1), e_t = z_t - 0.8 z_{t-1}: near -0.49),
+   with a break in the fitted rows and a quarter of the rows held out.
+   fe_discover_fit_columns: the coefficients against the normal equations
+   solved in long double; RSS, RMS, lag-one correlation (no pair across
+   the break), high-frequency floor, n, the effective sample size n (1 -
+   rho) / (1 + rho) with rho held in [0, 0.99] (so n itself under blue
+   noise), its BIC n_eff ln(RSS / n) + k ln n_eff, and the held-out RMS,
+   each from the residual of the returned coefficients over the stored
+   rows.  fe_discover_fit_noise: the same raw figures from its own
+   coefficients, and its BIC from its innovation variance and order (seed
+   10301's discover:4459: the RSS taken only while the lag-one sum Z_1 is
+   positive, which every test's residual had been).  The noise is small
+   (standard deviation 0.01 of the white part), so that each RSS is below
+   1: a unit slipped into a test of the RSS shows. */
+enum { SN = 3000, SM = 3, SK = 8, SFIT = 2250, SBREAK = 1000 };
+
+static double sphi[SN][SM], sr[SN];
+
+static void summary_rows(int blue)
+{
+    fe_rng g = fe_rng_seed(blue ? 77 : 76);
+    double e1 = 0, z1 = 0;
+    for (size_t t = 0; t < SN; t++) {
+        double z = fe_rng_normal(&g), e = blue ? z - 0.8 * z1 : 0.6 * e1 + z;
+        z1 = z;
+        e1 = e;
+        sphi[t][0] = 1.0;
+        sphi[t][1] = (double)t / SN;
+        sphi[t][2] = sin(0.01 * (double)t);
+        sr[t] = 0.5 + 0.3 * sphi[t][1] - 0.2 * sphi[t][2] + 0.01 * e;
+    }
+}
+
+/* RSS, lag-one sum (none across the break) over the fitted rows and RSS
+   over the held-out ones, of the residual of coefficients b. */
+static void summary_brute(const double *b, long double *rss, long double *z1, long double *hss)
+{
+    long double prev = 0;
+    *rss = *z1 = *hss = 0;
+    for (size_t t = 0; t < SN; t++) {
+        long double e = sr[t];
+        for (int c = 0; c < SM; c++)
+            e -= (long double)b[c] * sphi[t][c];
+        if (t >= SFIT) {
+            *hss += e * e;
+            continue;
+        }
+        *rss += e * e;
+        if (t > 0 && t != SBREAK)
+            *z1 += e * prev;
+        prev = e;
+    }
+}
+
+START_TEST(fit_summaries_match_the_rows_under_red_and_blue_noise)
+{
+    size_t nst = fe_discover_acc_doubles(SM, SK), nw = fe_discover_workspace_doubles(SM, SK);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
+    const size_t cols[SM] = {0, 1, 2};
+    const double n = SFIT, nh = SN - SFIT;
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    for (int blue = 0; blue < 2; blue++) {
+        fe_discover_acc a;
+        fe_discover_fit fit;
+        fe_discover_noise nz;
+        double coef[SM], se[SM], neff, rho;
+        long double xtx[SM][SM + 1] = {{0}}, b[SM], rss, z1, hss;
+        summary_rows(blue);
+        ck_assert_int_eq(fe_discover_acc_init(&a, SM, SK, SFIT, 0, st, nst), FE_OK);
+        for (size_t t = 0; t < SN; t++) {
+            if (t == SBREAK)
+                fe_discover_break(&a);
+            ck_assert_int_eq(fe_discover_add(&a, sphi[t], sr[t]), FE_OK);
+        }
+        /* Least squares: the normal equations over the fitted rows. */
+        for (size_t t = 0; t < SFIT; t++)
+            for (int c = 0; c < SM; c++) {
+                for (int d = 0; d < SM; d++)
+                    xtx[c][d] += (long double)sphi[t][c] * sphi[t][d];
+                xtx[c][SM] += (long double)sphi[t][c] * sr[t];
+            }
+        for (int c = 0; c < SM; c++)
+            for (int r = c + 1; r < SM; r++) {
+                long double f = xtx[r][c] / xtx[c][c];
+                for (int d = c; d <= SM; d++)
+                    xtx[r][d] -= f * xtx[c][d];
+            }
+        for (int c = SM - 1; c >= 0; c--) {
+            b[c] = xtx[c][SM];
+            for (int d = c + 1; d < SM; d++)
+                b[c] -= xtx[c][d] * b[d];
+            b[c] /= xtx[c][c];
+        }
+        ck_assert_int_eq(fe_discover_fit_columns(&a, cols, SM, coef, se, &fit, w, nw), FE_OK);
+        for (int c = 0; c < SM; c++)
+            FE_ASSERT_REL(coef[c], (double)b[c], 1e-9);
+        summary_brute(coef, &rss, &z1, &hss);
+        rho = (double)(z1 / rss);
+        /* The case is what it says: the residual's lag-one correlation
+           has the noise's sign, well away from 0. */
+        ck_assert_msg(blue ? rho < -0.3 : rho > 0.3, "lag-one correlation %g", rho);
+        ck_assert_msg(rss > 0 && rss < 1, "RSS %Lg", rss);
+        ck_assert_double_eq(fit.n, n);
+        ck_assert_uint_eq(fit.params, SM);
+        FE_ASSERT_REL(fit.rss, (double)rss, 1e-9);
+        FE_ASSERT_REL(fit.rms, (double)sqrtl(rss / SFIT), 1e-9);
+        FE_ASSERT_REL(fit.lag1, rho, 1e-8);
+        FE_ASSERT_REL(fit.floor, (double)sqrtl((rss - z1) / SFIT), 1e-8);
+        neff = n * (1.0 - fmax(rho, 0.0)) / (1.0 + fmax(rho, 0.0));
+        FE_ASSERT_REL(fit.n_eff, neff, 1e-8);
+        FE_ASSERT_REL(fit.bic, neff * log((double)rss / n) + SM * log(neff), 1e-8);
+        ck_assert_double_eq(fit.heldout_n, nh);
+        FE_ASSERT_REL(fit.heldout_rms, (double)sqrtl(hss / nh), 1e-9);
+        /* The GLS fit: the raw residual of its own coefficients. */
+        ck_assert_int_eq(fe_discover_fit_noise(&a, cols, SM, 4, coef, se, &fit, &nz, w, nw), FE_OK);
+        ck_assert_uint_ge(nz.order, 1);
+        summary_brute(coef, &rss, &z1, &hss);
+        rho = (double)(z1 / rss);
+        ck_assert_msg(blue ? rho < -0.3 : rho > 0.3, "lag-one correlation %g", rho);
+        ck_assert_msg(rss > 0 && rss < 1, "RSS %Lg", rss);
+        ck_assert_double_eq(fit.n, n);
+        ck_assert_uint_eq(fit.params, SM);
+        FE_ASSERT_REL(fit.rss, (double)rss, 1e-9);
+        FE_ASSERT_REL(fit.rms, (double)sqrtl(rss / SFIT), 1e-9);
+        FE_ASSERT_REL(fit.lag1, rho, 1e-8);
+        FE_ASSERT_REL(fit.floor, (double)sqrtl((rss - z1) / SFIT), 1e-8);
+        FE_ASSERT_REL(fit.bic, n * log(nz.innovation_variance) + (double)(SM + nz.order) * log(n),
+                      1e-12);
+        ck_assert_double_eq(fit.heldout_n, nh);
+        FE_ASSERT_REL(fit.heldout_rms, (double)sqrtl(hss / nh), 1e-9);
+    }
+    free(st);
+    free(w);
+}
+END_TEST
+
+/* An exact fit: r = 3 on every row, the bias its one column, 64 fitted
+   rows in 4 blocks and 16 held out.  Every sum is exact in doubles (64 is
+   a power of four), so the coefficient is 3 to the bit and the residual 0:
+   RSS, RMS, lag-one correlation, floor and held-out RMS are 0, n_eff is n,
+   in both fits (seed 10301's neighbours discover:2733 and 4480, a floor of
+   1 for a residual with no lag-one sum below its RSS, and 4463). */
+START_TEST(an_exact_fit_has_no_residual)
+{
+    enum { M = 1, K = 4, N = 80, NF = 64 };
+    size_t nst = fe_discover_acc_doubles(M, K), nw = fe_discover_workspace_doubles(M, K);
+    double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w), coef[M], se[M];
+    const double one[M] = {1.0};
+    const size_t cols[M] = {0};
+    fe_discover_acc a;
+    fe_discover_fit fit;
+    fe_discover_noise nz;
+    ck_assert_ptr_nonnull(st);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(fe_discover_acc_init(&a, M, K, NF, 0, st, nst), FE_OK);
+    for (int t = 0; t < N; t++)
+        ck_assert_int_eq(fe_discover_add(&a, one, 3.0), FE_OK);
+    for (int noise = 0; noise < 2; noise++) {
+        if (noise)
+            ck_assert_int_eq(fe_discover_fit_noise(&a, cols, M, 2, coef, se, &fit, &nz, w, nw),
+                             FE_OK);
+        else
+            ck_assert_int_eq(fe_discover_fit_columns(&a, cols, M, coef, se, &fit, w, nw), FE_OK);
+        ck_assert_double_eq(coef[0], 3.0);
+        ck_assert_double_eq(fit.rss, 0.0);
+        ck_assert_double_eq(fit.rms, 0.0);
+        ck_assert_double_eq(fit.lag1, 0.0);
+        ck_assert_double_eq(fit.floor, 0.0);
+        ck_assert_double_eq(fit.n, NF);
+        ck_assert_double_eq(fit.n_eff, NF);
+        ck_assert_uint_eq(fit.params, M);
+        ck_assert_double_eq(fit.heldout_n, N - NF);
+        ck_assert_double_eq(fit.heldout_rms, 0.0);
+    }
+    free(st);
+    free(w);
 }
 END_TEST
 
@@ -4271,6 +4463,8 @@ Suite *fe_discover_suite(void)
     tcase_add_test(t, p_values_are_probabilities_on_the_shortest_records);
     tcase_add_test(t, levinson_recovers_a_known_autoregression);
     tcase_add_test(t, gls_matches_prewhitened_least_squares);
+    tcase_add_test(t, fit_summaries_match_the_rows_under_red_and_blue_noise);
+    tcase_add_test(t, an_exact_fit_has_no_residual);
     tcase_add_test(t, long_range_model_of_the_fine_blocks);
     tcase_add_test(t, merged_parts_fit_as_the_whole_near_breaks);
     tcase_add_test(t, lags_are_an_option_of_an_empty_accumulation);

@@ -1451,6 +1451,47 @@ START_TEST(pipeline_bad_arguments_read_nothing)
 }
 END_TEST
 
+/* Every two slots of a ring of five that share an accumulation or a
+   batch buffer, whichever two: FE_EINVAL, nothing read or folded; the
+   ring with none shared folds the three values (seed 10303's
+   parallel:320, the pairs' loop stepped down, which compared each slot
+   with the first alone: the tests had only rings of two). */
+START_TEST(pipeline_refuses_any_two_slots_that_share)
+{
+    enum { R = 5 };
+    const double x[3] = {1, 2, 3};
+    fe_accumulator f = fe_meanvar_accumulator();
+    fe_array_source st;
+    fe_source src;
+    fe_parallel_slot ring[R];
+    slot accs[R];
+    fe_meanvar a = FE_MEANVAR_EMPTY;
+    size_t done = 5;
+    fe_source_from_array(&src, &st, x, 3, sizeof x[0]);
+    ring_make(ring, accs, R, 2, sizeof(double));
+    for (unsigned t = 1; t < R; t++)
+        for (unsigned u = 0; u < t; u++) {
+            void *acc = ring[t].acc, *obs = ring[t].obs;
+            ring[t].acc = ring[u].acc;
+            ck_assert_msg(fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, R, &done) == FE_EINVAL,
+                          "slots %u and %u share an accumulation", u, t);
+            ring[t].acc = acc;
+            ring[t].obs = ring[u].obs;
+            ck_assert_msg(fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, R, &done) == FE_EINVAL,
+                          "slots %u and %u share a buffer", u, t);
+            ring[t].obs = obs;
+            ck_assert_uint_eq(done, 0);
+            ck_assert_uint_eq(a.n, 0);
+            ck_assert_uint_eq(st.pos, 0);       /* nothing was read */
+        }
+    ck_assert_int_eq(fe_parallel_fold_source(&f, &a, &src, 1, 2, ring, R, &done), FE_OK);
+    ck_assert_uint_eq(done, 3);
+    ck_assert_uint_eq(a.n, 3);
+    ck_assert_double_eq_tol(a.mean, 2.0, 1e-15);
+    ring_free(ring, R);
+}
+END_TEST
+
 /* A source's own error is a refusal like a step's: an fd source whose
    last record lacks 4 of its 8 bytes gives FE_EPARSE after the records
    before it, with `*done` and the accumulation those of the whole records;
@@ -1573,6 +1614,7 @@ Suite *fe_parallel_suite(void)
     tcase_add_test(t, pipeline_first_refusal_wins);
     tcase_add_test(t, pipeline_source_error_after_earlier_batches);
     tcase_add_test(t, pipeline_bad_arguments_read_nothing);
+    tcase_add_test(t, pipeline_refuses_any_two_slots_that_share);
     tcase_add_test(t, the_most_threads_sources_workers_and_slots_fold);
     suite_add_tcase(s, t);
     return s;
