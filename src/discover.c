@@ -2289,7 +2289,7 @@ typedef struct fe__scalefit {
 /* A random walk beside the AR model: see the text.  Levels, the fewest
    for which the walk is tried, and the grid of its variance. */
 enum { FE__WALK_LEVELS = 6, FE__WALK_GRID = 49 };
-#define FE__WALK_GAIN 2.0       /* Akaike's price of the walk's one parameter */
+#define FE__WALK_GAIN 6.635     /* chi-square, one degree of freedom, 0.99 */
 #define FE__WALK_FIT 0.05       /* the least p-value of the walk's own fit */
 
 /* The weighted line c + b x through y (weights wt, levels x = 1 .. J),
@@ -2350,8 +2350,8 @@ static void fe__walk_shape(const fe_discover_acc *a, const fe_discover_noise *nz
 }
 
 /* When a random walk beside the AR model, ln V_t = c + b t + ln(1 + A r_t),
-   fits the levels' y better than the line by more than Akaike's price of
-   its one more parameter, and fits them itself, it replaces the line in
+   fits the levels' y better than the line by more than chi-square's 99 %
+   point for its one more parameter, and fits them itself, it replaces the line in
    sf: ln V at
    every level and the scaling coefficient, and the linear map of the
    y_i (Gauss-Newton's, at the fitted A) for the degrees of freedom. */

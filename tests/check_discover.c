@@ -2763,7 +2763,7 @@ static void lr_haar(const double *x, size_t n, size_t B, double *e)
    rows a side, (n + 1)(2 n + 1) / 6 for the whole record; the line
    through y_i - ln(1 + A r_i) for A on 8001 points of log10(A max r) from
    -2 to 6, then ternary search around the best; taken when it beats the
-   line by more than 2 (Akaike) and its own sum of squares passes chi-square
+   line by more than 6.635 (chi-square, 1 %) and its own sum of squares passes chi-square
    with usable - 3 degrees of freedom (usable - 2 when its slope is held at
    0) at 5 %.  Then ln V_t and the linear map of Gauss-Newton at A; returns
    whether it was taken. */
@@ -2834,7 +2834,7 @@ static int lr_walk(size_t n, size_t B, size_t J, const double *ly, const double 
     A = pow(10.0, 0.5 * (lo + hi)) / rmax;
     best = lr_walk_ssr(ly, wt, r, J, A, &c, &b);
     np = b > 0 ? 3 : 2;
-    if (!(ssr0 - best > 2.0) || !(fe_chi2_upper(best, (double)usable - (double)np) >= 0.05))
+    if (!(ssr0 - best > 6.635) || !(fe_chi2_upper(best, (double)usable - (double)np) >= 0.05))
         return 0;
     for (size_t i = 0; i < J; i++) {
         double j3[3] = {1.0, (double)(i + 1), r[i] / (1 + A * r[i])};
@@ -3220,8 +3220,8 @@ END_TEST
    noise sds), in ten records: wherever the walk beside the line is
    taken, the ratios, factors and degrees of freedom are checked against
    the rows with it (lr_walk), and wherever it is not, with the line.  The
-   walk must be taken in at least seven of the ten (nine, on the machine
-   where this was written: in the other the model's four slow columns
+   walk must be taken in at least five of the ten (six, on the machine
+   where this was written: in the others the model's four slow columns
    take up the walk's coarse levels, and what is left does not bend
    enough as a walk does), and in none of the same ten records without
    the walk.  (The slow wave of lr_check's records, slow physics the model
@@ -3239,7 +3239,7 @@ START_TEST(a_walk_beside_the_line_against_the_rows)
         lr_check_walk(seed, 0.0, 0.0, 0, &slope, &sw, &sx, &walked);
         white += walked;
     }
-    ck_assert_int_ge(taken, 7);
+    ck_assert_int_ge(taken, 5);
     ck_assert_int_eq(white, 0);
 }
 END_TEST
