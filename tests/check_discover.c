@@ -1973,12 +1973,36 @@ static void summary_brute(const double *b, long double *rss, long double *z1, lo
     }
 }
 
+/* The raw figures of a fit's summary against the residual of its
+   coefficients over the stored rows: n, the parameters, RSS, RMS, lag-one
+   correlation (its sign the noise's, well away from 0: the case is what
+   it says), floor, held-out n and RMS; returns the RSS, the lag-one
+   correlation in *rho. */
+static long double summary_raw(const fe_discover_fit *fit, const double *coef, int blue,
+                               double *rho)
+{
+    long double rss, z1, hss;
+    summary_brute(coef, &rss, &z1, &hss);
+    *rho = (double)(z1 / rss);
+    ck_assert_msg(blue ? *rho < -0.3 : *rho > 0.3, "lag-one correlation %g", *rho);
+    ck_assert_msg(rss > 0 && rss < 1, "RSS %Lg", rss);
+    ck_assert_double_eq(fit->n, SFIT);
+    ck_assert_uint_eq(fit->params, SM);
+    FE_ASSERT_REL(fit->rss, (double)rss, 1e-9);
+    FE_ASSERT_REL(fit->rms, (double)sqrtl(rss / SFIT), 1e-9);
+    FE_ASSERT_REL(fit->lag1, *rho, 1e-8);
+    FE_ASSERT_REL(fit->floor, (double)sqrtl((rss - z1) / SFIT), 1e-8);
+    ck_assert_double_eq(fit->heldout_n, SN - SFIT);
+    FE_ASSERT_REL(fit->heldout_rms, (double)sqrtl(hss / (SN - SFIT)), 1e-9);
+    return rss;
+}
+
 START_TEST(fit_summaries_match_the_rows_under_red_and_blue_noise)
 {
     size_t nst = fe_discover_acc_doubles(SM, SK), nw = fe_discover_workspace_doubles(SM, SK);
     double *st = malloc(nst * sizeof *st), *w = malloc(nw * sizeof *w);
     const size_t cols[SM] = {0, 1, 2};
-    const double n = SFIT, nh = SN - SFIT;
+    const double n = SFIT;
     ck_assert_ptr_nonnull(st);
     ck_assert_ptr_nonnull(w);
     for (int blue = 0; blue < 2; blue++) {
@@ -1986,7 +2010,7 @@ START_TEST(fit_summaries_match_the_rows_under_red_and_blue_noise)
         fe_discover_fit fit;
         fe_discover_noise nz;
         double coef[SM], se[SM], neff, rho;
-        long double xtx[SM][SM + 1] = {{0}}, b[SM], rss, z1, hss;
+        long double xtx[SM][SM + 1] = {{0}}, b[SM], rss;
         summary_rows(blue);
         ck_assert_int_eq(fe_discover_acc_init(&a, SM, SK, SFIT, 0, st, nst), FE_OK);
         for (size_t t = 0; t < SN; t++) {
@@ -2016,40 +2040,16 @@ START_TEST(fit_summaries_match_the_rows_under_red_and_blue_noise)
         ck_assert_int_eq(fe_discover_fit_columns(&a, cols, SM, coef, se, &fit, w, nw), FE_OK);
         for (int c = 0; c < SM; c++)
             FE_ASSERT_REL(coef[c], (double)b[c], 1e-9);
-        summary_brute(coef, &rss, &z1, &hss);
-        rho = (double)(z1 / rss);
-        /* The case is what it says: the residual's lag-one correlation
-           has the noise's sign, well away from 0. */
-        ck_assert_msg(blue ? rho < -0.3 : rho > 0.3, "lag-one correlation %g", rho);
-        ck_assert_msg(rss > 0 && rss < 1, "RSS %Lg", rss);
-        ck_assert_double_eq(fit.n, n);
-        ck_assert_uint_eq(fit.params, SM);
-        FE_ASSERT_REL(fit.rss, (double)rss, 1e-9);
-        FE_ASSERT_REL(fit.rms, (double)sqrtl(rss / SFIT), 1e-9);
-        FE_ASSERT_REL(fit.lag1, rho, 1e-8);
-        FE_ASSERT_REL(fit.floor, (double)sqrtl((rss - z1) / SFIT), 1e-8);
+        rss = summary_raw(&fit, coef, blue, &rho);
         neff = n * (1.0 - fmax(rho, 0.0)) / (1.0 + fmax(rho, 0.0));
         FE_ASSERT_REL(fit.n_eff, neff, 1e-8);
         FE_ASSERT_REL(fit.bic, neff * log((double)rss / n) + SM * log(neff), 1e-8);
-        ck_assert_double_eq(fit.heldout_n, nh);
-        FE_ASSERT_REL(fit.heldout_rms, (double)sqrtl(hss / nh), 1e-9);
         /* The GLS fit: the raw residual of its own coefficients. */
         ck_assert_int_eq(fe_discover_fit_noise(&a, cols, SM, 4, coef, se, &fit, &nz, w, nw), FE_OK);
         ck_assert_uint_ge(nz.order, 1);
-        summary_brute(coef, &rss, &z1, &hss);
-        rho = (double)(z1 / rss);
-        ck_assert_msg(blue ? rho < -0.3 : rho > 0.3, "lag-one correlation %g", rho);
-        ck_assert_msg(rss > 0 && rss < 1, "RSS %Lg", rss);
-        ck_assert_double_eq(fit.n, n);
-        ck_assert_uint_eq(fit.params, SM);
-        FE_ASSERT_REL(fit.rss, (double)rss, 1e-9);
-        FE_ASSERT_REL(fit.rms, (double)sqrtl(rss / SFIT), 1e-9);
-        FE_ASSERT_REL(fit.lag1, rho, 1e-8);
-        FE_ASSERT_REL(fit.floor, (double)sqrtl((rss - z1) / SFIT), 1e-8);
+        summary_raw(&fit, coef, blue, &rho);
         FE_ASSERT_REL(fit.bic, n * log(nz.innovation_variance) + (double)(SM + nz.order) * log(n),
                       1e-12);
-        ck_assert_double_eq(fit.heldout_n, nh);
-        FE_ASSERT_REL(fit.heldout_rms, (double)sqrtl(hss / nh), 1e-9);
     }
     free(st);
     free(w);
