@@ -2351,10 +2351,10 @@ static void fe__walk_shape(const fe_discover_acc *a, const fe_discover_noise *nz
 
 /* When a random walk beside the AR model, ln V_t = c + b t + ln(1 + A r_t),
    fits the levels' y better than the line by more than chi-square's 99 %
-   point for its one more parameter, and fits them itself, it replaces the line in
-   sf: ln V at
-   every level and the scaling coefficient, and the linear map of the
-   y_i (Gauss-Newton's, at the fitted A) for the degrees of freedom. */
+   point for its one more parameter, and fits them itself, it replaces
+   the line in sf: ln V at every level and the scaling coefficient, and
+   the linear map of the y_i (Gauss-Newton's, at the fitted A) for the
+   degrees of freedom. */
 static void fe__scale_walk(const fe_discover_acc *a, const fe_discover_noise *nz,
                            const double *ly, const double *wt, size_t usable,
                            fe__scalefit *sf)
