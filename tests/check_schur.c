@@ -399,6 +399,25 @@ START_TEST(weights_blocks_and_damping_at_their_edges)
 }
 END_TEST
 
+/* A missing accumulator, and one bound to no storage (all zeros, as a
+   static one starts), are refused with FE_EINVAL, each by itself, before
+   any row is read (CI's sample of seed 40756: schur:39, the first || of
+   the check made &&, which let the unbound one through to its storage). */
+START_TEST(add_refuses_a_missing_or_unbound_accumulator)
+{
+    const double jg[1] = {1.0}, jl[1] = {1.0};
+    fe_schur z;
+    memset(&z, 0, sizeof z);
+    z.ng = 1;
+    z.nl = 1;
+    z.nb = 2;
+    ck_assert_int_eq(fe_schur_add(NULL, jg, FE_SCHUR_NONE, NULL, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_add(&z, jg, FE_SCHUR_NONE, NULL, 1.0, 1.0), FE_EINVAL);
+    ck_assert_int_eq(fe_schur_add(&z, jg, 0, jl, 1.0, 1.0), FE_EINVAL);
+    ck_assert_ptr_null(z.blk);
+}
+END_TEST
+
 /* Issue 20: a damped diagonal A_kk (1 + lambda) that overflows is
    refused with FE_ESINGULAR, in a block and in the reduced system, with
    the rest of the system harmless.  A_kk = 2^1020 (one row of 2^510,
@@ -448,6 +467,7 @@ Suite *fe_schur_suite(void)
     tcase_set_timeout(t, 120);
     tcase_add_test(t, merge_refuses_an_overflow_in_any_local_diagonal);
     tcase_add_test(t, weights_blocks_and_damping_at_their_edges);
+    tcase_add_test(t, add_refuses_a_missing_or_unbound_accumulator);
     tcase_add_test(t, elimination_equals_dense_and_qr);
     tcase_add_test(t, damped_elimination_equals_damped_dense);
     tcase_add_test(t, merge_every_split_equals_the_whole);
