@@ -2160,6 +2160,14 @@ static void fe__ar_sum_variances(const fe_discover_noise *nz, const uint64_t *m,
     }
 }
 
+/* m_j: the rows on either side of a Haar coefficient of level j of the
+   fine blocks, n 2^(j-1) / B rounded, at least 1 (n the fitted rows). */
+static double fe__level_rows(const fe_discover_acc *a, size_t j)
+{
+    double m = floor(fe__fitted_rows(a) * (double)((size_t)1 << (j - 1)) / (double)a->fine + 0.5);
+    return m < 1.0 ? 1.0 : m;
+}
+
 /* nz->scale_model: the variance of a Haar coefficient of the fine block
    sums that the AR model nz predicts, per unit innovation variance, at
    each level j = 1 .. J of the B = 2^J blocks (two halves of m_j rows,
@@ -2178,9 +2186,7 @@ static void fe__scale_model(const fe_discover_acc *a, fe_discover_noise *nz)
     /* m_1, 2 m_1, m_2, 2 m_2, ..., n: increasing, as m_j >= 2 m_{j-1} - 1
        is not guaranteed by rounding, sorted below. */
     for (size_t j = 1; j <= J; j++) {
-        m[2 * j - 2] = (uint64_t)(n * (double)((size_t)1 << (j - 1)) / (double)a->fine + 0.5);
-        if (m[2 * j - 2] < 1)
-            m[2 * j - 2] = 1;
+        m[2 * j - 2] = (uint64_t)fe__level_rows(a, j);
         m[2 * j - 1] = 2 * m[2 * j - 2];
     }
     m[2 * J] = (uint64_t)n;
@@ -2334,13 +2340,9 @@ static double fe__walk_ssr(const double *ly, const double *wt, const double *r, 
    the AR model's prediction nz->scale_model. */
 static void fe__walk_shape(const fe_discover_acc *a, const fe_discover_noise *nz, double *r)
 {
-    double n = fe__fitted_rows(a);
     size_t J = nz->scales;
     for (size_t t = 1; t <= J + 1; t++) {
-        double m = t <= J ? floor(n * (double)((size_t)1 << (t - 1)) / (double)a->fine + 0.5)
-                          : n, w;
-        if (m < 1.0)
-            m = 1.0;
+        double m = t <= J ? fe__level_rows(a, t) : fe__fitted_rows(a), w;
         /* Haar: two adjacent sums of m rows differ by
            sum_s c_s eta_s, sum c_s^2 = m (2 m^2 + 1) / 3, over 2 m; the
            whole record: sum of n rows, n (n + 1) (2 n + 1) / 6, over n. */
