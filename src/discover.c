@@ -2284,12 +2284,16 @@ static void fe__scale_used(const fe_discover_acc *a, const fe__model *mo,
    coef[t][i] holds the linear map ln V_t = sum_i coef y_i, which carries
    the variances of the y_i to any combination.  var[i] > 0 marks a level
    with coefficients of its own left free (k_i >= 1/2); the others, and
-   the scaling coefficient, the line reaches only by extrapolation. */
+   the scaling coefficient, the line reaches only by extrapolation.
+   shape, slope and walk say which fit it was (fe_discover_noise's
+   scale_shape, scale_slope and walk_ratio). */
 typedef struct fe__scalefit {
     size_t levels;                                      /* J (0: none) */
     double lnv[FE_DISCOVER_SCALES + 1];
     double coef[FE_DISCOVER_SCALES + 1][FE_DISCOVER_SCALES];
     double var[FE_DISCOVER_SCALES];
+    int shape;
+    double slope, walk;
 } fe__scalefit;
 
 /* A random walk beside the AR model: see the text.  Levels, the fewest
@@ -2449,6 +2453,9 @@ static void fe__scale_walk(const fe_discover_acc *a, const fe_discover_noise *nz
                 inv[p][q] = (m[p1][q1] * m[p2][q2] - m[p1][q2] * m[p2][q1]) / det;
             }
     }
+    sf->shape = FE_DISCOVER_SCALE_WALK;
+    sf->slope = bb;
+    sf->walk = A * exp(bc + bb * (double)(J + 1));
     for (size_t t = 1; t <= J + 1; t++) {
         double gt[3] = {1.0, (double)t, r[t - 1] / (1.0 + A * r[t - 1])};
         if (np == 2)
@@ -2499,6 +2506,8 @@ static void fe__scale_fit(const fe_discover_acc *a, const fe_discover_noise *nz,
     sf->levels = J;
     det = sw * sxx - sx * sx;
     line = usable >= 2 && det > 1e-12 * sw * sxx && sw * sxy - sx * sy > 0.0;
+    sf->shape = line ? FE_DISCOVER_SCALE_LINE : FE_DISCOVER_SCALE_FLAT;
+    sf->slope = line ? (sw * sxy - sx * sy) / det : 0.0;
     for (size_t t = 1; t <= J + 1; t++)
         for (size_t i = 1; i <= J; i++) {
             double x = (double)i, x0 = (double)t, c;
@@ -2671,6 +2680,9 @@ static int fe__gls(const fe_discover_acc *a, const fe__ws *w, const size_t *cols
         fe__scale_fit(a, nz, w->uv, nz->innovation_variance, nz->scale_used, &sf);
         for (size_t t = 0; t <= nz->scales; t++)
             nz->scale_ratio[t] = sf.levels > 0 ? exp(sf.lnv[t]) : 1.0;
+        nz->scale_shape = sf.shape;
+        nz->scale_slope = sf.slope;
+        nz->walk_ratio = sf.walk;
     }
     return FE_OK;
 }

@@ -2797,7 +2797,7 @@ static double lr_walk_ssr(const double *ly, const double *wt, const double *r, s
 }
 
 static int lr_walk(size_t n, size_t B, size_t J, const double *ly, const double *wt,
-                   int usable, double *lnv, double coef[][8])
+                   int usable, double *lnv, double coef[][8], double *A_out, double *b_out)
 {
     double r[9], rmax = 0, c, b, ssr0, best, ubest = 0, lo, hi, A;
     long double m[9] = {0}, inv[9];
@@ -2836,6 +2836,8 @@ static int lr_walk(size_t n, size_t B, size_t J, const double *ly, const double 
     np = b > 0 ? 3 : 2;
     if (!(ssr0 - best > 6.635) || !(fe_chi2_upper(best, (double)usable - (double)np) >= 0.05))
         return 0;
+    *A_out = A * exp(c + b * (double)(J + 1));   /* at the record's scale */
+    *b_out = b;
     for (size_t i = 0; i < J; i++) {
         double j3[3] = {1.0, (double)(i + 1), r[i] / (1 + A * r[i])};
         if (np == 2)
@@ -2881,7 +2883,7 @@ static void lr_check_walk(uint64_t seed, double wave, double walk_sd, int shows,
     fe_rng g = fe_rng_seed(seed);
     double G[LR_M][LR_M] = {{0}}, Gi[LR_M][LR_M], used[9] = {0}, e[9], ly[8], var[8], wt[8];
     double rss = 0.0, nu = LR_N - LR_M, sw = 0, sx = 0, sxx = 0, sy = 0, sxy = 0, det;
-    double lnv[9], coef[9][8], walk = 0.0, rw = 0.0, tol;
+    double lnv[9], coef[9][8], walk = 0.0, rw = 0.0, tol, wA = 0.0, wb = 0.0;
     int line, usable = 0;
     ck_assert_int_eq(fe_discover_acc_init(&a, LR_M, 20, LR_N, 0, st, nst), FE_OK);
     for (size_t t = 0; t < LR_N; t++) {
@@ -2980,8 +2982,22 @@ static void lr_check_walk(uint64_t seed, double wave, double walk_sd, int shows,
     /* The walk, where it fits: its A is a minimum found by search, here
        and in the library, so the figures agree to the search's precision,
        not to rounding. */
-    *walked = lr_walk(LR_N, B, J, ly, wt, usable, lnv, coef);
+    *walked = lr_walk(LR_N, B, J, ly, wt, usable, lnv, coef, &wA, &wb);
     tol = *walked ? 1e-6 : 1e-9;
+    /* The noise model says which fit it took, with its slope and walk. */
+    if (*walked) {
+        ck_assert_int_eq(r->noise.scale_shape, FE_DISCOVER_SCALE_WALK);
+        FE_ASSERT_REL(r->noise.walk_ratio, wA, 1e-4);
+        ck_assert_msg(fabs(r->noise.scale_slope - wb) <= 1e-5, "slope %g, rows %g",
+                      r->noise.scale_slope, wb);
+    } else {
+        ck_assert_int_eq(r->noise.scale_shape, line ? FE_DISCOVER_SCALE_LINE : FE_DISCOVER_SCALE_FLAT);
+        ck_assert(r->noise.walk_ratio == 0.0);
+        if (line)
+            FE_ASSERT_REL(r->noise.scale_slope, (sw * sxy - sx * sy) / det, 1e-9);
+        else
+            ck_assert(r->noise.scale_slope == 0.0);
+    }
     for (size_t t = 1; t <= J + 1; t++)
         FE_ASSERT_REL(r->noise.scale_ratio[t - 1], exp(lnv[t - 1]), tol);
     if (shows)

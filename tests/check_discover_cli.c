@@ -105,6 +105,62 @@ START_TEST(concealed_drag_is_named_and_the_null_is_not)
 }
 END_TEST
 
+/* The story and the JSON say how the residual's slow levels were read:
+   white noise and a slow random walk beside it is read as a walk, whose step
+   variance over the innovations' the story gives as the JSON does; white
+   noise alone is not. */
+START_TEST(the_story_says_how_the_slow_levels_were_read)
+{
+    static char out[65536], story[65536];
+    char cmd[2048];
+    for (int walk = 0; walk <= 1; walk++) {
+        FILE *r, *sm;
+        fe_rng g = fe_rng_seed(31);
+        double w = 0.0, ratio = -1.0, told = -1.0;
+        const char *s;
+        make_dir();
+        open_pair("r.csv", "s.csv", &r, &sm);
+        fprintf(r, "time,y\n");
+        fprintf(sm, "time,y\n");
+        for (int t = 0; t < 20000; t++) {
+            w += walk ? 0.01 * fe_rng_normal(&g) : 0.0;
+            fprintf(sm, "%d,0\n", t);
+            fprintf(r, "%d,%.17g\n", t, w + fe_rng_normal(&g));
+        }
+        ck_assert_int_eq(fclose(r), 0);
+        ck_assert_int_eq(fclose(sm), 0);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y",
+                 FE_TEST_CLI, dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, story, sizeof story), 0);
+        snprintf(cmd, sizeof cmd, "%s discover --real %s/r.csv --sim %s/s.csv --channel y --json",
+                 FE_TEST_CLI, dir, dir);
+        ck_assert_int_eq(fe_test_run(cmd, FE_TEST_STDOUT, out, sizeof out), 0);
+        s = strstr(out, "\"baseline_noise\": ");
+        ck_assert_ptr_nonnull(s);
+        s = strstr(s, "\"shape\": ");
+        ck_assert_ptr_nonnull(s);
+        if (!walk) {
+            ck_assert_msg(strncmp(s, "\"shape\": \"random_walk\"", 22) != 0, "%s", out);
+            ck_assert_msg(strstr(story, "random walk") == NULL, "%s", story);
+            fe_test_remove_dir(dir);
+            continue;
+        }
+        ck_assert_msg(strncmp(s, "\"shape\": \"random_walk\"", 22) == 0, "%s", out);
+        ck_assert_int_eq(sscanf(strstr(s, "\"walk_ratio\": "), "\"walk_ratio\": %lf", &ratio), 1);
+        /* A walk of step 0.01 beside unit white noise: sigma_eta^2 / sigma^2
+           = 1e-4, read within a factor of three from 20 000 rows (6.3e-5 seen). */
+        ck_assert_msg(ratio > 3.3e-5 && ratio < 3e-4, "%g", ratio);
+        s = strstr(story, "noise (baseline): ");
+        ck_assert_ptr_nonnull(s);
+        s = strstr(s, "read as a random walk beside it (step variance ");
+        ck_assert_msg(s != NULL, "%s", story);
+        ck_assert_int_eq(sscanf(s, "read as a random walk beside it (step variance %lf", &told), 1);
+        FE_ASSERT_REL(told, ratio, 5e-3);           /* printed to 3 digits */
+        fe_test_remove_dir(dir);
+    }
+}
+END_TEST
+
 /* Two terms of the user's that explain only together (the pair of
    check_discover's two_candidates_that_only_explain_together_enter_as_a_pair,
    written as a recording and its simulation): the story and the JSON say
@@ -1051,6 +1107,7 @@ Suite *fe_discover_cli_suite(void)
     TCase *t = tcase_create("cli");
     tcase_set_timeout(t, 300);
     tcase_add_test(t, concealed_drag_is_named_and_the_null_is_not);
+    tcase_add_test(t, the_story_says_how_the_slow_levels_were_read);
     tcase_add_test(t, reader_options);
     tcase_add_test(t, synth_rho_sets_the_noise_colour);
     tcase_add_test(t, synth_takes_the_reader_options);

@@ -250,6 +250,18 @@ enum {
     FE_DISCOVER_NOISE_BATCH = 1 /* batch means over the K blocks */
 };
 
+/* How the Haar levels' ratios V_t were read (fe_discover_noise's
+   scale_shape). */
+enum {
+    FE_DISCOVER_SCALE_NONE = 0, /* no levels: too few rows, or batch means */
+    FE_DISCOVER_SCALE_FLAT = 1, /* their weighted mean, the same at every
+                                   level (a line would fall) */
+    FE_DISCOVER_SCALE_LINE = 2, /* a line in the level, ln V_t = c + b t:
+                                   a power law in the scale */
+    FE_DISCOVER_SCALE_WALK = 3  /* a random walk beside the AR model,
+                                   ln V_t = c + b t + ln(1 + A r_t) */
+};
+
 typedef struct fe_discover_options {
     double alpha;               /* family-wise level of a step: 0.05 */
     size_t max_steps;           /* at most this many terms added: 8 */
@@ -306,6 +318,14 @@ typedef struct fe_discover_noise {
                                 /* per level, V_j: the residual's Haar
                                    variance over the prediction, fitted
                                    (1 for noise the AR model describes) */
+    int scale_shape;            /* FE_DISCOVER_SCALE_*: the fit that gave
+                                   scale_ratio */
+    double scale_slope;         /* b: ln V_t's rise per level (0 unless
+                                   _LINE or _WALK) */
+    double walk_ratio;          /* the walk's step variance over the
+                                   innovation variance, read at the
+                                   record's scale: A e^(c + b (J + 1)) (0
+                                   unless _WALK) */
 } fe_discover_noise;
 
 /* fe_discover_noise_fit: the AR noise model of a series from its lagged

@@ -1169,6 +1169,17 @@ static void fe__json_fit(FILE *f, const char *name, const fe_discover_fit *fit)
     fprintf(f, ", \"params\": %zu}", fit->params);
 }
 
+/* The word for how the Haar levels were read (FE_DISCOVER_SCALE_*). */
+static const char *fe__scale_shape_name(int shape)
+{
+    switch (shape) {
+    case FE_DISCOVER_SCALE_FLAT: return "flat";
+    case FE_DISCOVER_SCALE_LINE: return "power_law";
+    case FE_DISCOVER_SCALE_WALK: return "random_walk";
+    default: return "none";
+    }
+}
+
 static void fe__json_noise(FILE *f, const fe_discover_noise *nz)
 {
     fprintf(f, "{\"model\": \"%s\", \"order\": %zu, \"phi\": [",
@@ -1203,7 +1214,10 @@ static void fe__json_noise(FILE *f, const fe_discover_noise *nz)
             fprintf(f, "%s", t ? ", " : "");
             fe__json_number(f, nz->scale_ratio[t]);
         }
-        fprintf(f, "]}");
+        fprintf(f, "], \"shape\": \"%s\"", fe__scale_shape_name(nz->scale_shape));
+        fe__json_pair(f, "slope", nz->scale_slope);
+        fe__json_pair(f, "walk_ratio", nz->walk_ratio);
+        fprintf(f, "}");
     }
     fprintf(f, "}");
 }
@@ -1389,11 +1403,21 @@ static void fe__story_noise(FILE *f, const char *what, const fe_discover_noise *
                 nz->kind == FE_DISCOVER_NOISE_AR ? "whitened" : "the",
                 nz->portmanteau_p < 0.01 ? "not white" : "white", nz->lags_tested,
                 nz->portmanteau_p, nz->long_run ? ", variances widened by the long-run factor" : "");
-    if (nz->kind == FE_DISCOVER_NOISE_AR && nz->scales > 0 && nz->scale_ratio[nz->scales] >= 1.5)
-        fprintf(f, "; slow variation beyond the AR model: at the record's scale the residual "
+    if (nz->kind == FE_DISCOVER_NOISE_AR && nz->scales > 0 && nz->scale_ratio[nz->scales] >= 1.5) {
+        fprintf(f, "; slow variation beyond the AR model, read as ");
+        if (nz->scale_shape == FE_DISCOVER_SCALE_WALK)
+            fprintf(f, "a random walk beside it (step variance %.3g times the innovations')",
+                    nz->walk_ratio);
+        else if (nz->scale_shape == FE_DISCOVER_SCALE_LINE)
+            fprintf(f, "a power law across the levels (growing as the scale to the power %.3g)",
+                    nz->scale_slope / log(2.0));
+        else
+            fprintf(f, "the same excess at every level");
+        fprintf(f, ": at the record's scale the residual "
                    "varies %.3g times as much as it predicts (%zu Haar levels of %zu blocks), "
                    "and slow terms' variances carry that",
                 nz->scale_ratio[nz->scales], nz->scales, (size_t)1 << nz->scales);
+    }
     if (nz->long_range)
         fprintf(f, "; block means vary %.3g times as much as white noise would (p = %.2g), "
                    "and the located windows are tested with that", nz->block_ratio, nz->block_p);
