@@ -1535,8 +1535,8 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
         fprintf(f, "\ncandidates, first step (batch-means tests over %zu time blocks):\n",
                 o->blocks);
     else
-        fprintf(f, "\ncandidates, first step (generalised least squares, noise re-estimated "
-                   "with each candidate):\n");
+        fprintf(f, "\ncandidates, first step (generalised least squares under the baseline's "
+                   "noise model, its slow levels read with each candidate in):\n");
     memcpy(sorted, r->ranking[0], r->nranked[0] * sizeof *sorted);
     qsort(sorted, r->nranked[0], sizeof *sorted, fe__cmp_rank);
     for (size_t i = 0; i < r->nranked[0]; i++)
@@ -1559,6 +1559,10 @@ static void fe__print_story(FILE *f, const fe__outcome *o)
                 s + 1, t->name, t->description, c.value, c.se, c.value - c.halfwidth,
                 c.value + c.halfwidth, c.dof < 1.0 ? few : "", r->added_rank[s].statistic,
                 r->added_rank[s].p_value, words);
+        if (c.dof >= 1.0 && c.value - c.halfwidth <= 0.0 && c.value + c.halfwidth >= 0.0)
+            fprintf(f, "     its own 95%% interval includes zero: in the final fit, with the noise "
+                       "model and the other terms estimated beside it, it does not stand out, so "
+                       "it is doubtful\n");
         if (r->paired[s] != 0)
             fprintf(f, "     entered with %s: no candidate passed alone, and each of the two "
                        "passes given the other (the statistic above is that test)\n",
