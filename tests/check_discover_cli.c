@@ -129,8 +129,8 @@ static void write_walk_pair(uint64_t seed, double step)
    white noise and a slow random walk beside it is read as a walk, whose
    step variance over the innovations' the story gives as the JSON does;
    white noise alone is not.  And a term named whose own interval in the
-   final fit includes zero (a drift named under a strong walk: its test,
-   under the baseline's noise model, t = 6.5) is called doubtful. */
+   final fit includes zero (a drift named under a stronger walk, passed by
+   its test under the baseline's noise model) is called doubtful. */
 START_TEST(the_story_says_how_the_slow_levels_were_read)
 {
     static char out[65536], story[65536];
