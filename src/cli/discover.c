@@ -63,6 +63,12 @@ typedef struct fe__pair {
     double step, sim_first, sim_last, first_real_t;
     size_t outside[3];
     int span_checked;
+    /* --order K: the hook that takes the simulation's own rows between two
+       recording rows returned (fe__run_node; NULL: none), and the time of
+       the last row returned (-inf: none yet). */
+    int (*node)(void *user, const struct fe__pair *p, fe_sample *s);
+    void *node_user;
+    double node_after;
 } fe__pair;
 
 /* Why a recording row is outside the simulation. */
@@ -190,6 +196,32 @@ static double *fe__slot(fe__pair *p, fe_sample *s, int r)
     return r < FE__ROLES ? fe__role(s, r) : &p->simx[r - FE__ROLES];
 }
 
+/* After the window moved on: w[1], a simulation row strictly between the
+   last recording row returned and the next one, at t, and linked to the
+   row before it, goes to the hook as a sample without a recording value. */
+static int fe__pair_node(fe__pair *p, double t, char *err, size_t errlen)
+{
+    fe_sample s;
+    int nr = FE__ROLES + (int)p->nsimx;
+    if (p->node == NULL || !p->w[1].valid || !(p->node_after > -INFINITY)
+        || !(p->w[1].t > p->node_after) || !(p->w[1].t < t) || !p->w[0].valid
+        || !fe__linked(p, &p->w[0], &p->w[1]))
+        return FE_CLI_OK;
+    memset(&s, 0, sizeof s);
+    s.t = p->w[1].t;
+    s.real = NAN;
+    s.sim = p->w[1].s;
+    s.dsim = fe__dsim(p, 1);
+    for (int r = 0; r < nr; r++)
+        *fe__slot(p, &s, r) = p->w[1].role[r];
+    if (p->node(p->node_user, p, &s) != FE_OK) {
+        snprintf(err, errlen, "%s: a signature is not finite at t = %.17g (a row of the "
+                 "simulation between two of the recording)", p->sim.name, s.t);
+        return FE_CLI_INPUT;
+    }
+    return FE_CLI_OK;
+}
+
 /* The next recording row that the simulation covers, as a sample.
    Returns FE_OK, FE_END, or an exit status with a message. */
 static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
@@ -202,6 +234,7 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
                 return rc;
         p->started = 1;
         p->last_real_t = -INFINITY;
+        p->node_after = -INFINITY;
     }
     for (;;) {
         double t, lambda;
@@ -221,7 +254,8 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
         }
         p->last_real_t = t;
         while (p->w[2].valid && p->w[2].t < t)
-            if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK)
+            if ((rc = fe__sim_advance(p, err, errlen)) != FE_CLI_OK
+                || (rc = fe__pair_node(p, t, err, errlen)) != FE_CLI_OK)
                 return rc;
         /* Now w[1].t < t <= w[2].t, or the simulation has ended or not
            begun.  A time the simulation has is always covered, whether it
@@ -244,6 +278,7 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
                 out->dsim = fe__dsim(p, 2);
                 for (int r = 0; r < nr; r++)
                     *fe__slot(p, out, r) = p->w[2].role[r];
+                p->node_after = t;
                 return FE_OK;
             }
         }
@@ -262,6 +297,7 @@ static int fe__pair_next(fe__pair *p, fe_sample *out, char *err, size_t errlen)
             for (int r = 0; r < nr; r++)
                 *fe__slot(p, out, r) = p->w[1].role[r] + lambda * (p->w[2].role[r] - p->w[1].role[r]);
         }
+        p->node_after = t;
         return FE_OK;
     }
 }
@@ -1990,6 +2026,9 @@ typedef struct fe__run {
     fe_dynamics_sens sens;
     fe_dynamics_deviation dev;
     int refine;                         /* Gauss-Newton: about x(theta) */
+    int nodes;                          /* the simulation's rows between the
+                                           recording's step the signatures
+                                           (the fold and map passes) */
     double theta[FE_DISCOVER_MAX_GROUPS];
     double adj;                         /* the row's residual adjustment */
     fe__outcome out;
@@ -2432,10 +2471,14 @@ static fe_sample fe__sim_sample(const fe__pair *p, long order, const fe__simrow 
     return s;
 }
 
+static int fe__run_node(void *user, const fe__pair *p, fe_sample *s);
+
 /* The pass that identifies the simulation's dynamics (--order K), from
    the simulation's own rows: the recording's times may be uneven and the
    simulation interpolated onto them, and the second difference of an
-   interpolated position is mostly the interpolation's kinks. */
+   interpolated position is mostly the interpolation's kinks.  It also
+   gives each pair the hook that carries the signatures through the
+   simulation's rows between the recording's (fe__run_node). */
 static int fe__run_ident(fe__run *u)
 {
     fe_dynamics_ident id;
@@ -2451,6 +2494,8 @@ static int fe__run_ident(fe__run *u)
         double v[2 + FE__ROLES];
         size_t k = 2, n = 0;
         int rc;
+        p->node = fe__run_node;
+        p->node_user = u;
         for (int r = 0; r < FE__ROLES; r++)
             if (p->role_col[r] >= 0 && (size_t)p->role_col[r] + 1 > k)
                 k = (size_t)p->role_col[r] + 1;
@@ -2566,6 +2611,19 @@ static int fe__run_columns(fe__run *u, fe_sample *s, int new_pair, double *phi)
     return FE_OK;
 }
 
+/* A row of the simulation between two of the recording's (the pair's
+   hook): the signatures and the deviation are carried through it, and
+   nothing is folded.  Only while a pass folds or maps (u->nodes). */
+static int fe__run_node(void *user, const fe__pair *p, fe_sample *s)
+{
+    fe__run *u = user;
+    double phi[FE_DISCOVER_MAX_COLUMNS];
+    if (!u->nodes)
+        return FE_OK;
+    fe__fill_state(u->a.order, p, s);
+    return fe__run_columns(u, s, 0, phi);
+}
+
 
 /* Pass 2: every candidate term of every row into the engine's
    accumulation, a panel at a time (the terms by fe_catalog_eval_rows,
@@ -2602,6 +2660,7 @@ static int fe__run_fold(fe__run *u)
         return fe__run_fold_parts(u, cut, nst);
     fe_dynamics_sens_restart(&u->sens);
     p->n = p->nbreak = 0;
+    u->nodes = u->a.order != 0;
     while ((rc = fe__stream_next(&u->st, &s, &new_pair, u->err, sizeof u->err)) == FE_OK) {
         size_t k = p->n;
         if ((new_pair || k == FE_DISCOVER_PANEL_ROWS)
@@ -2624,6 +2683,7 @@ static int fe__run_fold(fe__run *u)
         }
         p->n++;
     }
+    u->nodes = 0;
     if (rc == FE_OK
         || (rc == FE_END && (fe__panel_terms(u->a.order == 0 ? &u->cat : NULL, p, u->term_work)
                              != FE_OK || fe__panel_fold(&u->acc, p) != FE_OK))) {
@@ -2849,6 +2909,7 @@ static void fe__part_map(fe__part *w)
     double phi[FE_DISCOVER_MAX_COLUMNS];
     w->refused = FE_OK;
     w->err[0] = '\0';
+    u->nodes = u->a.order != 0;         /* one part only under --order */
     while (done < w->limit
            && (rc = fe__stream_next(w->st, &s, &new_pair, w->err, sizeof w->err)) == FE_OK) {
         double before = s.real - s.sim, after;
@@ -2907,6 +2968,7 @@ static void fe__part_map(fe__part *w)
         done++;
         rc = FE_END;
     }
+    u->nodes = 0;
     w->rc = rc;
 }
 
