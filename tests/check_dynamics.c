@@ -303,6 +303,118 @@ START_TEST(a_heated_body_is_identified)
 }
 END_TEST
 
+/* The basis's variables are centred and scaled over the record: "p, v,
+   w the position, velocity and input centred and scaled to [-1, 1] over
+   the record", and "a variable that does not vary keeps scale 1"
+   (dynamics.org).  Against the rows themselves: each variable's least and
+   greatest value found by a pass of the test's own, the centre
+   (lo + hi) / 2 and the scale (hi - lo) / 2 to the bit (both are exact
+   halvings of the same sum and difference), in the fold and in the fit,
+   for both orders, with the ambient held at 20 (centre 20, scale 1) in
+   the order-2 record and the rate (0 at order 1) at centre 0, scale 1;
+   variables centred on 0 exactly, and one that varies by 1e-13 only.
+   Then the fit's value at rows across the record against the documented
+   basis evaluated by the test at those scaled variables (K = 2: 1, p, v,
+   w, p^2, p^3, v|v|, v^3, p^5, p v, and the input before and after, at a
+   single sample the sample's own; K = 1: 1, p, w, b, p^2, p^3, b^2, p b,
+   p^4, and the same two).  Seed 10307's dynamics:288 (the centre taken as
+   the half range, (hi - lo) / 2) went through every other test: a fit
+   centred elsewhere still fits a pendulum, and at order 1 the basis is
+   closed under a shift; its neighbours dynamics:291 (the scale's threshold
+   1e-12 (|c| + 1e-300) made 1e-12 / (|c| + 1e-300): scale 1 for every
+   variable centred on 0) and dynamics:294 (1e-300 made 1: scale 1 for a
+   range below 1e-12 about 0) by the two last records. */
+static void check_centred_and_scaled(const fe_sample *r, size_t n, size_t order)
+{
+    fe_dynamics_span sp;
+    fe_dynamics_ident id;
+    fe_dynamics_fit fit;
+    double lo[FE_DYNAMICS_VARS], hi[FE_DYNAMICS_VARS];
+    for (size_t i = 0; i < n; i++) {
+        const double v[FE_DYNAMICS_VARS] = {order == 2 ? r[i].position : r[i].temperature,
+                                            order == 2 ? r[i].velocity : 0.0, r[i].input,
+                                            r[i].ambient};
+        for (int j = 0; j < FE_DYNAMICS_VARS; j++) {
+            lo[j] = i == 0 || v[j] < lo[j] ? v[j] : lo[j];
+            hi[j] = i == 0 || v[j] > hi[j] ? v[j] : hi[j];
+        }
+    }
+    ck_assert_int_eq(fe_dynamics_span_init(&sp, order), FE_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(fe_dynamics_span_add(&sp, &r[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_init(&id, &sp), FE_OK);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_int_eq(fe_dynamics_ident_add(&id, &r[i]), FE_OK);
+    ck_assert_int_eq(fe_dynamics_ident_solve(&id, &fit), FE_OK);
+    for (int j = 0; j < FE_DYNAMICS_VARS; j++) {
+        double centre = (lo[j] + hi[j]) / 2, scale = hi[j] > lo[j] ? (hi[j] - lo[j]) / 2 : 1.0;
+        ck_assert_msg(id.centre[j] == centre && fit.centre[j] == centre,
+                      "order %zu variable %d: centre %.17g (fit %.17g), want %.17g", order, j,
+                      id.centre[j], fit.centre[j], centre);
+        ck_assert_msg(id.scale[j] == scale && fit.scale[j] == scale,
+                      "order %zu variable %d: scale %.17g (fit %.17g), want %.17g", order, j,
+                      id.scale[j], fit.scale[j], scale);
+    }
+    for (size_t i = 1; i < n; i += n / 7) {
+        double x[FE_DYNAMICS_VARS], f[FE_DYNAMICS_BASIS] = {0}, want = 0.0, size = 0.0, got;
+        const double v[FE_DYNAMICS_VARS] = {order == 2 ? r[i].position : r[i].temperature,
+                                            order == 2 ? r[i].velocity : 0.0, r[i].input,
+                                            r[i].ambient};
+        for (int j = 0; j < FE_DYNAMICS_VARS; j++)
+            x[j] = (v[j] - (lo[j] + hi[j]) / 2) / (hi[j] > lo[j] ? (hi[j] - lo[j]) / 2 : 1.0);
+        if (order == 2) {
+            const double p = x[0], u = x[1], w = x[2];
+            const double g[12] = {1.0, p, u, w, p * p, p * p * p, u * fabs(u), u * u * u,
+                                  p * p * p * p * p, p * u, w, w};
+            memcpy(f, g, sizeof g);
+        } else {
+            const double p = x[0], w = x[2], b = x[3];
+            const double g[11] = {1.0, p, w, b, p * p, p * p * p, b * b, p * b, p * p * p * p,
+                                  w, w};
+            memcpy(f, g, sizeof g);
+        }
+        for (size_t k = 0; k < FE_DYNAMICS_BASIS; k++) {
+            want += fit.coef[k] * f[k];
+            size += fabs(fit.coef[k] * f[k]);
+        }
+        ck_assert_int_eq(fe_dynamics_fit_eval(&r[i], &got, &fit), FE_OK);
+        ck_assert_msg(fabs(got - want) <= 1e-12 * size, "order %zu row %zu: %.17g, want %.17g",
+                      order, i, got, want);
+    }
+}
+
+START_TEST(the_variables_are_centred_and_scaled_over_the_record)
+{
+    /* Order 2: a pendulum released from 1 rad (a span not symmetric about
+       0: it decays), driven; then the same with an ambient that varies by
+       1e-13 about 0 (scaled, as any variable that varies).  Order 1: the
+       heated body of the test above, heated and cooled (an input of
+       +-1500, centred on 0 exactly). */
+    plant p = {1, 2 * PI * 0.7, 0.02, 3.0, 0.0};
+    double T = 20.0, t = 0.0;
+    simulate(&p, 1.0, 0.01, NSIM, rows);
+    for (size_t i = 0; i < NSIM; i++)
+        rows[i].ambient = 20.0;
+    check_centred_and_scaled(rows, NSIM, 2);
+    for (size_t i = 0; i < NSIM; i++)
+        rows[i].ambient = i % 2 ? 1e-13 : 0.0;  /* it varies, if little: scaled */
+    check_centred_and_scaled(rows, NSIM, 2);
+    for (size_t i = 0; i < 1000; i++) {
+        fe_sample *s = &rows2[i];
+        double d, h = 0.7 + 0.6 * (double)(i % 3) / 2.0;
+        memset(s, 0, sizeof *s);
+        s->t = t;
+        s->temperature = s->sim = T;
+        s->ambient = 18.0 + 3.0 * sin(2 * PI * t / 700.0);
+        s->input = (i / 150) % 2 ? 1500.0 : -1500.0;    /* centred on 0 */
+        heat_body(s, &d, NULL);
+        T += h * d;
+        t += h;
+    }
+    check_centred_and_scaled(rows2, 1000, 1);
+}
+END_TEST
+
 /* A radiating body, dT/dt = -e (T_K^4 - Ta_K^4): the Jacobian
    -4 e T_K^3 varies along the trajectory (the basis's higher powers). */
 static int radiating(const fe_sample *s, double *d, void *user)
@@ -1116,6 +1228,7 @@ Suite *fe_dynamics_suite(void)
     tcase_add_test(t, the_kept_basis_functions_are_flagged_used);
     tcase_add_test(t, a_pendulum_jacobian_is_its_cosine);
     tcase_add_test(t, a_heated_body_is_identified);
+    tcase_add_test(t, the_variables_are_centred_and_scaled_over_the_record);
     tcase_add_test(t, a_radiating_body_jacobian_follows_its_temperature);
     tcase_add_test(t, a_deviation_follows_its_closed_form);
     tcase_add_test(t, a_deviation_starts_again_from_zero_after_a_restart);
