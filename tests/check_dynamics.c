@@ -264,25 +264,33 @@ static int heat_body(const fe_sample *s, double *d, void *user)
     return 0;
 }
 
-START_TEST(a_heated_body_is_identified)
+/* The heated body's record of n rows: dT/dt = -0.01 (T - Ta) + 0.002 P,
+   minutes, on an uneven clock (steps of 0.7, 1 and 1.3); the ambient
+   swings; the heater at 1500 and at `off` in turns of 150 rows. */
+static void heated_record(fe_sample *r, size_t n, double off)
 {
-    /* dT/dt = -0.01 (T - Ta) + 0.002 P, minutes, on an uneven clock; the
-       ambient swings.  Then R^2 against the three-point derivatives the
-       test takes itself. */
-    fe_dynamics_fit fit;
-    double T = 20.0, a[1], afd[1], t = 0.0, sum = 0.0, sq = 0.0, n = 0.0, var;
-    for (size_t i = 0; i < 1000; i++) {
-        fe_sample *s = &rows[i];
+    double T = 20.0, t = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        fe_sample *s = &r[i];
         double d, h = 0.7 + 0.6 * (double)(i % 3) / 2.0;
         memset(s, 0, sizeof *s);
         s->t = t;
         s->temperature = s->sim = T;
         s->ambient = 18.0 + 3.0 * sin(2 * PI * t / 700.0);
-        s->input = (i / 150) % 2 ? 1500.0 : 0.0;
+        s->input = (i / 150) % 2 ? 1500.0 : off;
         heat_body(s, &d, NULL);
         T += h * d;             /* an Euler step: the identification sees its own rows */
         t += h;
     }
+}
+
+START_TEST(a_heated_body_is_identified)
+{
+    /* The heated body, heater on and off.  Then R^2 against the
+       three-point derivatives the test takes itself. */
+    fe_dynamics_fit fit;
+    double a[1], afd[1], sum = 0.0, sq = 0.0, n = 0.0, var;
+    heated_record(rows, 1000, 0.0);
     identify(rows, 1000, 1, &fit);
     ck_assert_int_eq(fe_dynamics_fit_jacobian(&rows[500], a, &fit), FE_OK);
     ck_assert_int_eq(fe_dynamics_jacobian_fd(heat_body, NULL, 1, &rows[500], afd), FE_OK);
@@ -391,7 +399,6 @@ START_TEST(the_variables_are_centred_and_scaled_over_the_record)
        heated body of the test above, heated and cooled (an input of
        +-1500, centred on 0 exactly). */
     plant p = {1, 2 * PI * 0.7, 0.02, 3.0, 0.0};
-    double T = 20.0, t = 0.0;
     simulate(&p, 1.0, 0.01, NSIM, rows);
     for (size_t i = 0; i < NSIM; i++)
         rows[i].ambient = 20.0;
@@ -399,18 +406,7 @@ START_TEST(the_variables_are_centred_and_scaled_over_the_record)
     for (size_t i = 0; i < NSIM; i++)
         rows[i].ambient = i % 2 ? 1e-13 : 0.0;  /* it varies, if little: scaled */
     check_centred_and_scaled(rows, NSIM, 2);
-    for (size_t i = 0; i < 1000; i++) {
-        fe_sample *s = &rows2[i];
-        double d, h = 0.7 + 0.6 * (double)(i % 3) / 2.0;
-        memset(s, 0, sizeof *s);
-        s->t = t;
-        s->temperature = s->sim = T;
-        s->ambient = 18.0 + 3.0 * sin(2 * PI * t / 700.0);
-        s->input = (i / 150) % 2 ? 1500.0 : -1500.0;    /* centred on 0 */
-        heat_body(s, &d, NULL);
-        T += h * d;
-        t += h;
-    }
+    heated_record(rows2, 1000, -1500.0);               /* an input centred on 0 */
     check_centred_and_scaled(rows2, 1000, 1);
 }
 END_TEST
