@@ -2909,7 +2909,6 @@ static void fe__part_map(fe__part *w)
     double phi[FE_DISCOVER_MAX_COLUMNS];
     w->refused = FE_OK;
     w->err[0] = '\0';
-    u->nodes = u->a.order != 0;         /* one part only under --order */
     while (done < w->limit
            && (rc = fe__stream_next(w->st, &s, &new_pair, w->err, sizeof w->err)) == FE_OK) {
         double before = s.real - s.sim, after;
@@ -2968,7 +2967,6 @@ static void fe__part_map(fe__part *w)
         done++;
         rc = FE_END;
     }
-    u->nodes = 0;
     w->rc = rc;
 }
 
@@ -3069,7 +3067,9 @@ static int fe__run_map(fe__run *u)
     cut = u->pts == NULL && u->pblocks == NULL ? fe__cut(u, u->out.rows / 2) : NULL;
     if (cut != NULL)
         return fe__run_map_parts(u, part, cut);
+    u->nodes = u->a.order != 0;         /* one part, on this thread (--order is never cut) */
     fe__part_map(&part[0]);
+    u->nodes = 0;
     if (part[0].refused != FE_OK || part[0].rc != FE_END) {
         snprintf(u->err, sizeof u->err, "%s", part[0].err);
         return part[0].refused != FE_OK ? FE_CLI_INPUT : part[0].rc;
